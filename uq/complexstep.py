@@ -1,0 +1,46 @@
+"""Complex-step-safe versions of the few non-analytic functions the models use.
+
+Complex-step differentiation evaluates f(x + i h) and reads df/dx = Im f / h, exact to
+machine precision for analytic f (Squire & Trapp 1998; Martins et al. 2003). Functions
+that are not complex-analytic (``abs``, ``arctan2``, ``mod``, comparisons) would lose or
+corrupt the imaginary part; these replacements carry it through by the chain rule
+(first order in h, which is all the method uses). For real input they equal the numpy
+functions.
+
+References
+----------
+.. [1] Squire, W. and Trapp, G. (1998). Using complex variables to estimate derivatives
+   of real functions. SIAM Review 40(1), 110-112.
+.. [2] Martins, J., Sturdza, P. and Alonso, J. (2003). The complex-step derivative
+   approximation. ACM TOMS 29(3), 245-262.
+"""
+import numpy as np
+
+
+def arctan2(y, x):
+    """``numpy.arctan2`` carrying a complex-step perturbation [rad]."""
+    if not (np.iscomplexobj(y) or np.iscomplexobj(x)):
+        return np.arctan2(y, x)
+    y, x = np.asarray(y, dtype=complex), np.asarray(x, dtype=complex)
+    radius2 = x.real**2 + y.real**2
+    # d atan2(y, x) = (x dy - y dx) / (x^2 + y^2)
+    return np.arctan2(y.real, x.real) + 1j * (x.real * y.imag - y.real * x.imag) / radius2
+
+
+def hypot(x, y):
+    """sqrt(x^2 + y^2), analytic for complex-step (``numpy.hypot`` drops Im)."""
+    if not (np.iscomplexobj(y) or np.iscomplexobj(x)):
+        return np.hypot(x, y)
+    return np.sqrt(x * x + y * y)
+
+
+def mod(x, period):
+    """``numpy.mod`` of the real part; the imaginary part passes unchanged."""
+    if not np.iscomplexobj(x):
+        return np.mod(x, period)
+    return np.mod(x.real, period) + 1j * x.imag
+
+
+def real_part(x):
+    """Real part for comparisons and domain masks (works on real input too)."""
+    return np.real(x)

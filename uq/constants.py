@@ -1,0 +1,36 @@
+"""Named constants, each with its unit and source.
+
+Nothing else in the package writes a bare number that carries meaning.
+"""
+
+#: Coverage probability of the reported coverage intervals [1]. JCGM 101:2008, 7.7.
+COVERAGE_PROBABILITY = 0.95
+
+#: Default number of significant decimal digits for the numerical tolerance [1].
+#: JCGM 101:2008, 7.9.2 and 8.2 (n_dig = 2 is the usual choice).
+DEFAULT_DIGITS = 2
+
+#: Samples per random-number block [1]. Every block has its own independent stream
+#: (``numpy.random.SeedSequence`` spawn key = block index), which is what makes results
+#: independent of the chunk size. A power of two so that Sobol' blocks stay balanced, and
+#: >= 10^4 = max(100 / (1 - p), 10^4), the batch size of JCGM 101:2008, 7.9.4 a).
+RNG_BLOCK_SIZE = 2**16
+
+#: Default number of blocks evaluated together in one chunk [1]. Bounds memory: the lidar
+#: model holds a few dozen float64 arrays of (chunk, beams, gates) at a time.
+DEFAULT_BLOCKS_PER_CHUNK = 2
+
+#: Largest number of Monte Carlo trials adaptive sampling (``digits``) may use [1].
+ADAPTIVE_MAX_SAMPLES = 2**24
+
+#: Complex-step size, relative to max(1, |x|) [1]. Complex-step differentiation has no
+#: subtractive cancellation, so any step far below sqrt(machine epsilon) times the
+#: curvature scale gives the derivative to machine precision (Squire & Trapp 1998);
+#: 1e-30 leaves a margin of ~20 orders and is far above the smallest normal double.
+COMPLEX_STEP = 1e-30
+
+#: Full circle [deg].
+FULL_CIRCLE_DEG = 360.0
+
+#: Half circle [deg]: the unwrapping window of circular outputs is reference +- this.
+HALF_CIRCLE_DEG = 180.0

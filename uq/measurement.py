@@ -1,0 +1,238 @@
+"""The ship-lidar measurement model: true scene -> measured radial velocities -> wind.
+
+One function, :func:`measurement_model`, is the model the Monte Carlo engine and the GUM
+propagate. Its random inputs are *errors* (deviations from the nominal scene):
+
+===========================  ===============  ========================================
+input                        shape            meaning
+===========================  ===============  ========================================
+``ins_heading``              (n, k)           INS heading error [deg]
+``ins_pitch``, ``ins_roll``  (n, k)           INS attitude errors [deg]
+``ins_sog``, ``ins_heave``   (n, k)           INS velocity errors [m s-1]
+``ins_cog``                  (n, k)           INS course error [deg]
+``lidar_half_cone``          (n,)             true minus configured half-cone [deg]
+``lidar_misalignment``       (n,)             true minus configured misalignment [deg]
+``lidar_radial_velocity``    (n, beams, gates) radial-velocity noise [m s-1]
+===========================  ===============  ========================================
+
+k = 1 when INS errors are shared by the beams of a scan (``scan``) and k = n_beams when
+each beam has its own reading (``beam``). Missing inputs are zero.
+
+The *true* radial velocities use the true attitude and ship velocity, the true
+geometry (configured + error), and the true wind at each beam's true height (power-law
+shear; the heights follow from the attitude). Reconstruction uses the INS readings
+(true + error) and the configured geometry, under the chosen correction model
+(:mod:`uq.correction`).
+
+The function is vectorised over samples and complex-step safe, so the GUM Jacobian is
+exact (:mod:`uq.gum`).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import wind
+from .beams import beam_unit_vectors, least_squares_operator, slant_distances
+from .correction import correction_rotation, correction_ship_velocity, reconstruct_wind
+from .rotation import attitude_matrix
+
+OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity")
+NAVIGATION = ("heading", "pitch", "roll", "sog", "cog", "heave")
+ANGULAR_NAVIGATION = ("heading", "pitch", "roll", "cog")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Nominal (true) scene of one measurement, SI units and radians.
+
+    Attributes
+    ----------
+    wind_speed : float
+        Horizontal wind speed at `reference_height` [m s-1].
+    wind_direction : float
+        Meteorological direction ("from"), clockwise from north [rad].
+    vertical_wind : float
+        [m s-1], positive up.
+    shear : float
+        Power-law exponent [1].
+    reference_height : float
+        [m] above sea level.
+    sog, cog, heading, pitch, roll, heave : float
+        True ship motion: [m s-1], [rad] x4 (marine convention, :mod:`uq.rotation`),
+        [m s-1].
+    lidar_height : float
+        [m] above sea level.
+    ranges : tuple of float
+        Range-gate heights above a level lidar [m].
+    half_cone, misalignment : float
+        Configured geometry [rad].
+    azimuths : tuple of float
+        Slanted-beam azimuths from the reference beam [rad].
+    vertical_beam : bool
+    correction : str
+        One of :data:`uq.correction.CORRECTION_MODELS`.
+    """
+
+    wind_speed: float
+    wind_direction: float
+    vertical_wind: float
+    shear: float
+    reference_height: float
+    sog: float
+    cog: float
+    heading: float
+    pitch: float
+    roll: float
+    heave: float
+    lidar_height: float
+    ranges: tuple
+    half_cone: float
+    misalignment: float
+    azimuths: tuple
+    vertical_beam: bool
+    correction: str
+
+    @property
+    def n_beams(self):
+        return len(self.azimuths) + int(self.vertical_beam)
+
+    def nominal_unit_vectors(self):
+        """Configured beam vectors in the ship frame, shape (n_beams, 3)."""
+        return beam_unit_vectors(self.half_cone, np.asarray(self.azimuths),
+                                 self.misalignment, self.vertical_beam)
+
+    def gate_heights(self):
+        """Nominal measurement heights above sea level [m], shape (n_gates,)."""
+        return self.lidar_height + np.asarray(self.ranges, dtype=float)
+
+
+def true_wind(scene, heights):
+    """True wind (north, east, up) [m s-1] at `heights` [m]; shape heights.shape + (3,)."""
+    speed = wind.power_law_speed(scene.wind_speed, heights, scene.reference_height,
+                                 scene.shear)
+    north, east = wind.wind_components(speed, np.rad2deg(scene.wind_direction))
+    up = np.zeros_like(north) + scene.vertical_wind
+    return np.stack([north, east, up], axis=-1)
+
+
+def true_radial_velocity(scene, beams_earth, ship_velocity):
+    """Radial velocities of the true wind seen from the moving lidar [m s-1].
+
+    Parameters
+    ----------
+    scene : Scene
+    beams_earth : ndarray, shape (..., n_beams, 3)
+        True earth-frame beam unit vectors.
+    ship_velocity : ndarray, shape (3,)
+        True ship velocity (north, east, up) [m s-1].
+
+    Returns
+    -------
+    radial : ndarray, shape (..., n_beams, n_gates)
+        ``n . (u_wind(z) - u_ship)`` (Eq. 2 of Rubio & Gottschall 2022, point-wise).
+    wind_only : ndarray, shape (..., n_beams, n_gates)
+        ``n . u_wind(z)``, the motion-free radial wind.
+    """
+    slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
+                            scene.vertical_beam)                        # (b, g)
+    heights = scene.lidar_height + slant * beams_earth[..., 2:3]        # (..., b, g)
+    wind_vector = true_wind(scene, heights)                             # (..., b, g, 3)
+    wind_only = np.sum(beams_earth[..., None, :] * wind_vector, axis=-1)
+    ship_along = beams_earth @ np.asarray(ship_velocity)                # (..., b)
+    return wind_only - ship_along[..., None], wind_only
+
+
+def measurement_model(scene, outputs=OUTPUTS, **errors):
+    """Propagate errors through measurement and correction; see the module docstring.
+
+    Returns
+    -------
+    dict
+        ``wind_speed`` [m s-1], ``wind_direction`` [deg], ``vertical_wind`` [m s-1], each
+        shape (n, n_gates); ``radial_velocity`` [m s-1] (n, n_beams, n_gates), the
+        motion-corrected radial velocity along the beam the correction believes in.
+    """
+    n = _sample_count(errors)
+    err = {name: np.asarray(errors.get(name, 0.0)) for name in _ERROR_NAMES}
+    for name in _ERROR_NAMES[:len(NAVIGATION)]:     # INS errors to shape (n, k)
+        value = err[name]
+        err[name] = value[:, None] if value.ndim == 1 else value + np.zeros((n, 1))
+    measured, navigation = _measure(scene, err, n)
+    unit_vectors = scene.nominal_unit_vectors()
+    operator = least_squares_operator(unit_vectors)
+    wind_vector = reconstruct_wind(measured, scene.correction, unit_vectors, operator,
+                                   navigation, scene.heading)
+    return _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors)
+
+
+_ERROR_NAMES = tuple(f"ins_{key}" for key in NAVIGATION) + (
+    "lidar_half_cone", "lidar_misalignment", "lidar_radial_velocity")
+
+
+def _sample_count(errors):
+    sizes = {np.shape(value)[0] for value in errors.values() if np.ndim(value) > 0}
+    return max(sizes) if sizes else 1
+
+
+def _measure(scene, err, n):
+    """True radial velocities plus noise, and the INS readings (true + error)."""
+    half_cone = scene.half_cone + np.deg2rad(err["lidar_half_cone"]) + np.zeros(n)
+    misalignment = scene.misalignment + np.deg2rad(err["lidar_misalignment"]) + np.zeros(n)
+    true_beams = beam_unit_vectors(half_cone, np.asarray(scene.azimuths), misalignment,
+                                   scene.vertical_beam)                    # (n, b, 3)
+    attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
+    beams_earth = true_beams @ np.swapaxes(attitude, -1, -2)
+    ship = (scene.sog * np.cos(scene.cog), scene.sog * np.sin(scene.cog), scene.heave)
+    radial, _ = true_radial_velocity(scene, beams_earth, ship)
+    measured = radial + err["lidar_radial_velocity"]
+    navigation = {}
+    for key in NAVIGATION:
+        error = err[f"ins_{key}"]
+        error = np.deg2rad(error) if key in ANGULAR_NAVIGATION else error
+        navigation[key] = getattr(scene, key) + error
+    return measured, navigation
+
+
+def _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors):
+    result = {}
+    north, east, up = wind_vector[..., 0, :], wind_vector[..., 1, :], wind_vector[..., 2, :]
+    if "wind_speed" in outputs:
+        result["wind_speed"] = wind.wind_speed(north, east)
+    if "wind_direction" in outputs:
+        result["wind_direction"] = wind.wind_direction(north, east)
+    if "vertical_wind" in outputs:
+        result["vertical_wind"] = up
+    if "radial_velocity" in outputs:
+        result["radial_velocity"] = _corrected_radial(scene, measured, navigation,
+                                                      unit_vectors)
+    return result
+
+
+def _corrected_radial(scene, measured, navigation, unit_vectors):
+    """Radial velocity freed of the believed ship motion, along the believed beam."""
+    nav = navigation
+    rotation = correction_rotation(scene.correction, nav["heading"], nav["pitch"],
+                                   nav["roll"], scene.heading)
+    ship = correction_ship_velocity(scene.correction, nav["sog"], nav["cog"], nav["heave"])
+    beams = (rotation @ unit_vectors[:, :, None])[..., 0]              # (n, k|b, 3)
+    return measured + np.sum(beams * ship, axis=-1)[..., None]
+
+
+def true_values(scene):
+    """The wind the lidar should measure at each nominal gate height.
+
+    Returns
+    -------
+    dict
+        ``wind_speed``, ``wind_direction`` [deg], ``vertical_wind``, shape (n_gates,);
+        ``radial_velocity`` (n_beams, n_gates): the motion-free radial wind along the
+        true beams at their true heights.
+    """
+    wind_vector = true_wind(scene, scene.gate_heights())
+    attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
+    beams_earth = scene.nominal_unit_vectors() @ attitude.T
+    _, wind_only = true_radial_velocity(scene, beams_earth, np.zeros(3))
+    return {"wind_speed": wind.wind_speed(wind_vector[:, 0], wind_vector[:, 1]),
+            "wind_direction": wind.wind_direction(wind_vector[:, 0], wind_vector[:, 1]),
+            "vertical_wind": wind_vector[:, 2],
+            "radial_velocity": wind_only}

@@ -1,0 +1,219 @@
+"""Model-agnostic propagation of distributions: Monte Carlo (JCGM 101) beside the GUM.
+
+:func:`propagate` works for any vectorised model of named inputs. The lidar pipeline is
+one such model (:mod:`uq.pipeline`); there is no second code path.
+
+References
+----------
+.. [1] JCGM 101:2008, Supplement 1 to the GUM - Propagation of distributions using a
+   Monte Carlo method: 7.7 (coverage intervals), 7.9 (adaptive procedure), 8
+   (validation of the GUM framework).
+"""
+import numpy as np
+import xarray as xr
+
+from . import gum
+from .constants import (ADAPTIVE_MAX_SAMPLES, COVERAGE_PROBABILITY, DEFAULT_BLOCKS_PER_CHUNK,
+                        DEFAULT_DIGITS, RNG_BLOCK_SIZE)
+from .inputs import input_set
+from .sampling import SAMPLING_METHODS, new_seed, normal_scores
+from .statistics import INTERVALS, StreamingStatistics, batch_statistics, tail_capacity
+
+_BATCH_KEYS = ("mean", "u", "low", "high")
+
+
+def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
+              correlation=None, circular=(), output_dims=None, interval="symmetric",
+              chunk_size=None):
+    """Propagate input distributions through `model` by Monte Carlo and by the GUM.
+
+    Parameters
+    ----------
+    model : callable
+        ``model(**arrays)``: every input by name as an array of shape (n, *shape);
+        returns an array of shape (n, ...) or a dict of them (a single array is named
+        ``y``). Must be complex-step safe for the GUM (:mod:`uq.gum`).
+    inputs : dict
+        name -> scipy.stats frozen distribution, float (a constant) or
+        :class:`uq.inputs.Input` (a distribution with a shape).
+    n : int, optional
+        Number of Monte Carlo trials.
+    digits : int, optional
+        Instead of `n`: adaptive sampling until mean, u and both interval endpoints are
+        stable to this many significant digits of u (JCGM 101, 7.9). Also the digits of
+        the GUM validation (default 2). With neither `n` nor `digits`, adaptive with 2.
+    method : {"mc", "lhs", "sobol"}
+        Sampler (:mod:`uq.sampling`).
+    seed : int, numpy.random.Generator or None
+        Same seed, same result, whatever `chunk_size`. None draws fresh entropy; the
+        seed used is recorded in the result's ``seed`` attribute.
+    correlation : dict, optional
+        ``{(name_a, name_b): rho}`` between scalar inputs (Gaussian copula).
+    circular : iterable of str
+        Outputs that are angles in degrees, period 360 (statistics on the circle).
+    output_dims : dict, optional
+        Output name -> dimension names of one sample of it.
+    interval : {"symmetric", "shortest"}
+        Probabilistically symmetric (default) or shortest 95 % coverage interval.
+    chunk_size : int, optional
+        Samples evaluated at once (rounded up to whole RNG blocks); bounds memory.
+
+    Returns
+    -------
+    xarray.Dataset
+        For each output q: ``q_mc_mean``, ``q_mc_u``, ``q_mc_low``, ``q_mc_high``,
+        ``q_mc_n_invalid`` (non-finite trials, excluded), ``q_mc_numerical_error``
+        (twice the largest standard deviation of the block means of mean, u and the
+        endpoints: the JCGM 101 7.9 stability measure), ``q_gum_value`` (model at the
+        input means), ``q_gum_u``, ``q_gum_valid`` (clause 8), ``q_budget`` (dimension
+        ``input``); circular outputs also ``q_mc_circular_std``.
+    """
+    _check_arguments(n, digits, method, interval)
+    seed = _entropy(seed)
+    inputs_laid = input_set(inputs, correlation)
+    circular = set(circular)
+    wrapped = _named_outputs(model)
+    gum_value, jacobian = gum.complex_step_jacobian(wrapped, inputs_laid)
+    references = {q: gum_value[q] if q in circular else None for q in gum_value}
+    runner = _Runner(wrapped, inputs_laid, method, seed, references, interval, chunk_size)
+    if n is not None:
+        runner.run_fixed(int(n))
+    else:
+        runner.run_adaptive(digits or DEFAULT_DIGITS)
+    validation_digits = digits or DEFAULT_DIGITS
+    dataset = _dataset(runner, gum_value, jacobian, inputs_laid, circular, output_dims or {},
+                       validation_digits)
+    dataset.attrs.update(n_samples=runner.n_done, seed=seed, sampling_method=method,
+                         digits=validation_digits, interval=interval,
+                         coverage_probability=COVERAGE_PROBABILITY)
+    return dataset
+
+
+def _check_arguments(n, digits, method, interval):
+    if n is not None and digits is not None:
+        raise ValueError("give either n or digits, not both")
+    if n is not None and int(n) < 2:
+        raise ValueError(f"n must be >= 2, got {n}")
+    if digits is not None and not 1 <= int(digits) <= 6:
+        raise ValueError(f"digits must be an integer from 1 to 6, got {digits}")
+    if method not in SAMPLING_METHODS:
+        raise ValueError(f"method must be one of {SAMPLING_METHODS}, got {method!r}")
+    if interval not in INTERVALS:
+        raise ValueError(f"interval must be one of {INTERVALS}, got {interval!r}")
+
+
+def _entropy(seed):
+    if seed is None:
+        return new_seed()
+    if isinstance(seed, np.random.Generator):
+        return int(seed.integers(2**63))
+    return int(seed)
+
+
+def _named_outputs(model):
+    def wrapped(**arrays):
+        out = model(**arrays)
+        return out if isinstance(out, dict) else {"y": out}
+    return wrapped
+
+
+class _Runner:
+    """Draws blocks, evaluates the model chunk by chunk, accumulates statistics."""
+
+    def __init__(self, model, inputs, method, seed, references, interval, chunk_size):
+        self.model, self.inputs, self.method, self.seed = model, inputs, method, seed
+        self.references, self.interval = references, interval
+        blocks = DEFAULT_BLOCKS_PER_CHUNK if chunk_size is None else -(-int(chunk_size) // RNG_BLOCK_SIZE)
+        self.blocks_per_chunk = max(1, blocks)
+        self.stats, self.batches, self.n_done = None, {}, 0
+
+    def _start(self, capacity, shapes):
+        self.stats = {q: StreamingStatistics(shape, capacity, self.references[q])
+                      for q, shape in shapes.items()}
+        self.batches = {q: {key: [] for key in _BATCH_KEYS} for q in shapes}
+
+    def _evaluate(self, first_block, n_blocks, n_samples):
+        scores = np.concatenate([normal_scores(self.method, self.seed, b, self.inputs.dimension)
+                                 for b in range(first_block, first_block + n_blocks)])
+        with np.errstate(all="ignore"):           # out-of-domain trials become NaN, counted
+            outputs = self.model(**self.inputs.values(scores[:n_samples]),
+                                 **self.inputs.constants)
+        return {q: np.real(np.asarray(v, dtype=float)) for q, v in outputs.items()}
+
+    def _accumulate(self, outputs):
+        for q, values in outputs.items():
+            self.stats[q].update(values)
+            for start in range(0, len(values) - RNG_BLOCK_SIZE + 1, RNG_BLOCK_SIZE):
+                batch = batch_statistics(values[start:start + RNG_BLOCK_SIZE],
+                                         self.references[q], kind=self.interval)
+                for key in _BATCH_KEYS:
+                    self.batches[q][key].append(batch[key])
+        self.n_done += len(next(iter(outputs.values())))
+
+    def run_fixed(self, n):
+        total_blocks = -(-n // RNG_BLOCK_SIZE)
+        for first in range(0, total_blocks, self.blocks_per_chunk):
+            blocks = min(self.blocks_per_chunk, total_blocks - first)
+            outputs = self._evaluate(first, blocks, min(n - first * RNG_BLOCK_SIZE,
+                                                       blocks * RNG_BLOCK_SIZE))
+            if self.stats is None:
+                self._start(tail_capacity(n) + 1, {q: v.shape[1:] for q, v in outputs.items()})
+            self._accumulate(outputs)
+
+    def run_adaptive(self, digits):
+        """JCGM 101:2008, 7.9.4, with batches of one RNG block (M = 2^16 >= 10^4)."""
+        block = 0
+        while True:
+            outputs = self._evaluate(block, 1, RNG_BLOCK_SIZE)
+            if self.stats is None:
+                self._start(tail_capacity(ADAPTIVE_MAX_SAMPLES) + 1,
+                            {q: v.shape[1:] for q, v in outputs.items()})
+            self._accumulate(outputs)
+            block += 1
+            if block >= 2 and (self._stable(digits)
+                               or self.n_done + RNG_BLOCK_SIZE > ADAPTIVE_MAX_SAMPLES):
+                return
+
+    def _stable(self, digits):
+        """7.9.4 i): 2 s <= delta for the average of the batch means, u and endpoints."""
+        for q, stats in self.stats.items():
+            result = stats.result(kind=self.interval)
+            delta = gum.numerical_tolerance(result["u"], digits)
+            if np.any(self.numerical_error(q) > delta):
+                return False
+        return True
+
+    def numerical_error(self, q):
+        """2 s of JCGM 101 7.9.4 f), the largest over mean, u and endpoints (NaN < 2 batches)."""
+        batches = self.batches[q]
+        h = len(batches["mean"])
+        if h < 2:
+            return np.full(self.stats[q].shape, np.nan)
+        spread = [np.std(np.array(batches[key]), axis=0, ddof=1) / np.sqrt(h)
+                  for key in _BATCH_KEYS]
+        return 2 * np.max(spread, axis=0)
+
+
+def _dataset(runner, gum_value, jacobian, inputs, circular, output_dims, digits):
+    data = {}
+    coords = {"input": list(inputs.names)}
+    for q, stats in runner.stats.items():
+        dims = tuple(output_dims.get(q, [f"{q}_dim{i}" for i in range(len(stats.shape))]))
+        result = stats.result(kind=runner.interval)
+        u_gum = gum.combined_uncertainty(jacobian[q], inputs)
+        data.update({
+            f"{q}_mc_mean": (dims, result["mean"]),
+            f"{q}_mc_u": (dims, result["u"]),
+            f"{q}_mc_low": (dims, result["low"]),
+            f"{q}_mc_high": (dims, result["high"]),
+            f"{q}_mc_n_invalid": (dims, runner.n_done - result["n_valid"]),
+            f"{q}_mc_numerical_error": (dims, runner.numerical_error(q)),
+            f"{q}_gum_value": (dims, gum_value[q]),
+            f"{q}_gum_u": (dims, u_gum),
+            f"{q}_gum_valid": (dims, gum.gum_interval_valid(
+                gum_value[q], u_gum, result["low"], result["high"], digits, q in circular)),
+            f"{q}_budget": (("input",) + dims, gum.variance_budget(jacobian[q], inputs)),
+        })
+        if q in circular:
+            data[f"{q}_mc_circular_std"] = (dims, result["circular_std"])
+    return xr.Dataset(data, coords=coords)

@@ -1,0 +1,140 @@
+"""Frames, rotations and the ship attitude convention.
+
+Frames
+------
+* Earth frame: axes (north, east, up). This is the frame of Rubio & Gottschall (2022),
+  Eq. 1 (x north, y east, z up), in which a beam of half-cone angle theta and azimuth
+  phi (clockwise from north) has the unit vector
+  ``(sin(theta) cos(phi), sin(theta) sin(phi), cos(theta))``.
+* Ship (body) frame: axes (bow, starboard, up of the deck). With the ship level and
+  heading north it coincides with the earth frame.
+
+Both triads are left-handed (north x east = down); every matrix below is nevertheless a
+proper rotation (orthogonal, determinant +1) in these coordinates, and its sense is fixed
+by what it does to named directions, which the tests pin.
+
+Attitude (marine convention)
+----------------------------
+* heading psi: bow azimuth, clockwise from north [0, 360).
+* pitch: positive bow up.
+* roll: positive starboard down.
+
+Body-to-earth matrix ``R = Rz(heading) @ Ry(pitch) @ Rx(roll)``: roll first about the bow
+axis, then pitch about the (rolled) starboard axis, then heading about the vertical; the
+usual aircraft/ship Tait-Bryan order. A vector in the ship frame, ``x_ship``, is
+``R @ x_ship`` in the earth frame.
+
+Rubio & Gottschall (2022) angles
+--------------------------------
+Their yaw gamma is clockwise (the heading of the lidar's reference beam). Their case ii
+rotation is ``R_roll(beta) @ R_pitch(delta)`` (Eq. 7), where, read off Eq. 7,
+``R_pitch(delta) = Ry(-delta)`` (delta positive *bow down*, their Sec. 3.3) and
+``R_roll(beta) = Rx(beta)`` (beta positive starboard down). The order differs from the
+marine one, so the exact mapping goes through the matrix: see
+:func:`rubio2022_angles_from_attitude` and :func:`attitude_from_rubio2022_angles`.
+
+All functions take angles in radians and broadcast over leading dimensions; they are
+complex-step safe (only sin/cos/arithmetic are used).
+
+References
+----------
+.. [1] Rubio, H. and Gottschall, J. (2022). Development of an uncertainty model for
+   ship-based lidar measurements. J. Phys.: Conf. Ser. 2362 012034.
+"""
+import numpy as np
+
+
+def _matrix(rows):
+    """Stack nested lists of broadcastable arrays into shape (..., 3, 3)."""
+    arrays = np.broadcast_arrays(*[np.asarray(e) for row in rows for e in row])
+    return np.stack(arrays, axis=-1).reshape(arrays[0].shape + (3, 3))
+
+
+def rotation_about_vertical(angle):
+    """Rotation that turns a vector clockwise (seen from above) by `angle` [rad].
+
+    A horizontal vector with azimuth phi gets azimuth phi + angle.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+    """
+    c, s = np.cos(angle), np.sin(angle)
+    zero, one = np.zeros_like(c), np.ones_like(c)
+    return _matrix([[c, -s, zero], [s, c, zero], [zero, zero, one]])
+
+
+def rotation_pitch(pitch):
+    """Pitch rotation about the starboard axis; positive pitch lifts the bow [rad].
+
+    The bow unit vector (1, 0, 0) becomes (cos p, 0, sin p).
+    """
+    c, s = np.cos(pitch), np.sin(pitch)
+    zero, one = np.zeros_like(c), np.ones_like(c)
+    return _matrix([[c, zero, -s], [zero, one, zero], [s, zero, c]])
+
+
+def rotation_roll(roll):
+    """Roll rotation about the bow axis; positive roll lowers starboard [rad].
+
+    The starboard unit vector (0, 1, 0) becomes (0, cos r, -sin r).
+    """
+    c, s = np.cos(roll), np.sin(roll)
+    zero, one = np.zeros_like(c), np.ones_like(c)
+    return _matrix([[one, zero, zero], [zero, c, s], [zero, -s, c]])
+
+
+def attitude_matrix(heading, pitch, roll):
+    """Body-to-earth rotation ``Rz(heading) @ Ry(pitch) @ Rx(roll)`` (marine convention).
+
+    Parameters
+    ----------
+    heading, pitch, roll : array_like
+        [rad]; heading clockwise from north, pitch positive bow up, roll positive
+        starboard down. Broadcast together.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+    """
+    return rotation_about_vertical(heading) @ rotation_pitch(pitch) @ rotation_roll(roll)
+
+
+def attitude_from_matrix(matrix):
+    """Invert :func:`attitude_matrix`: (heading, pitch, roll) [rad] of a rotation.
+
+    Valid for |pitch| < 90 deg. Heading is returned in [0, 2 pi).
+    """
+    m = np.asarray(matrix)
+    pitch = np.arcsin(np.clip(m[..., 2, 0], -1.0, 1.0))
+    heading = np.mod(np.arctan2(m[..., 1, 0], m[..., 0, 0]), 2 * np.pi)
+    roll = np.arctan2(-m[..., 2, 1], m[..., 2, 2])
+    return heading, pitch, roll
+
+
+def rubio2022_rotation(delta, beta):
+    """Rubio & Gottschall (2022) case ii rotation ``R_roll(beta) @ R_pitch(delta)``.
+
+    delta [rad] is their pitch (positive bow down), beta [rad] their roll (positive
+    starboard down). Read off Eq. 7 [1].
+    """
+    return rotation_roll(beta) @ rotation_pitch(-delta)
+
+
+def rubio2022_angles_from_attitude(pitch, roll):
+    """Exact Rubio & Gottschall (2022) (delta, beta) of a marine (pitch, roll) [rad].
+
+    ``rubio2022_rotation(delta, beta) == Ry(pitch) @ Rx(roll)``. To first order
+    delta = -pitch and beta = roll; the second-order difference comes from the
+    different rotation order.
+    """
+    m = rotation_pitch(pitch) @ rotation_roll(roll)
+    delta = np.arctan2(m[..., 0, 2], m[..., 0, 0])   # row 0 of Rx(b) Ry(-d) = (cd, 0, sd)
+    beta = np.arctan2(-m[..., 2, 1], m[..., 1, 1])   # m[2,1] = -sb, m[1,1] = cb
+    return delta, beta
+
+
+def attitude_from_rubio2022_angles(delta, beta):
+    """Inverse of :func:`rubio2022_angles_from_attitude`: marine (pitch, roll) [rad]."""
+    m = rubio2022_rotation(delta, beta)
+    return attitude_from_matrix(m)[1:]

@@ -1,0 +1,68 @@
+"""Random and quasi-random draws, in fixed-size blocks with their own streams.
+
+Every sample of a run belongs to a block of :data:`uq.constants.RNG_BLOCK_SIZE` samples.
+Block b draws from its own generator, ``numpy.random.default_rng(SeedSequence(seed,
+spawn_key=(b,)))``, so a sample's value depends only on (seed, its index), never on how
+many blocks are evaluated together: results are identical for every chunk size.
+
+Methods
+-------
+``mc``
+    Independent draws from numpy's default Generator (PCG64).
+``lhs``
+    Latin hypercube (scipy.stats.qmc.LatinHypercube), stratified within each block.
+``sobol``
+    One scrambled Sobol' sequence (scipy.stats.qmc.Sobol), block b being its points
+    b*B ... (b+1)*B - 1; the scrambling is seeded from the run's seed.
+
+Every method returns standard normal scores ``z`` of shape (block_size, dimension);
+inputs are obtained from them by inverse CDFs (:mod:`uq.inputs`), so each works with
+every distribution. mc draws ``z`` directly; lhs and sobol map uniforms through the
+normal inverse CDF.
+"""
+import numpy as np
+from scipy.special import ndtri
+from scipy.stats import qmc
+
+from .constants import RNG_BLOCK_SIZE
+
+SAMPLING_METHODS = ("mc", "lhs", "sobol")
+
+
+def block_generator(seed, block):
+    """Independent generator of block `block` for the run seeded with `seed` (int)."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(block,)))
+
+
+def normal_scores(method, seed, block, dimension, block_size=RNG_BLOCK_SIZE):
+    """Standard normal scores of one block, shape (block_size, dimension).
+
+    Parameters
+    ----------
+    method : {"mc", "lhs", "sobol"}
+    seed : int
+        Entropy of the run.
+    block : int
+        Block index, >= 0.
+    dimension : int
+        Number of scalar random inputs.
+    """
+    if dimension == 0:
+        return np.zeros((block_size, 0))
+    if method == "mc":
+        return block_generator(seed, block).standard_normal((block_size, dimension))
+    if method == "lhs":
+        engine = qmc.LatinHypercube(dimension, rng=block_generator(seed, block))
+        return ndtri(engine.random(block_size))
+    if method == "sobol":
+        scramble = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(2**31,)))
+        engine = qmc.Sobol(dimension, scramble=True, rng=scramble)
+        if block:
+            engine.fast_forward(block * block_size)
+        return ndtri(engine.random(block_size))
+    raise ValueError(f"unknown sampling method {method!r}; allowed: {SAMPLING_METHODS}")
+
+
+def new_seed():
+    """Fresh entropy for a run without a seed (recorded so the run can be repeated)."""
+    return int(np.random.SeedSequence().entropy % (2**63))
