@@ -44,3 +44,13 @@ def mod(x, period):
 def real_part(x):
     """Real part for comparisons and domain masks (works on real input too)."""
     return np.real(x)
+
+
+def radians(degrees):
+    """Degrees to radians; ``numpy.deg2rad`` rejects complex input."""
+    return np.asarray(degrees) * (np.pi / 180.0)
+
+
+def degrees(radians_):
+    """Radians to degrees; ``numpy.rad2deg`` rejects complex input."""
+    return np.asarray(radians_) * (180.0 / np.pi)

@@ -16,6 +16,11 @@ DEFAULT_DIGITS = 2
 #: >= 10^4 = max(100 / (1 - p), 10^4), the batch size of JCGM 101:2008, 7.9.4 a).
 RNG_BLOCK_SIZE = 2**16
 
+#: Samples per batch of the batch statistics that estimate the numerical error of the
+#: Monte Carlo results (JCGM 101:2008, 7.9.4 uses batches of M >= 10^4). Divides
+#: RNG_BLOCK_SIZE, so batches never straddle blocks.
+BATCH_SIZE = 2**14
+
 #: Default number of blocks evaluated together in one chunk [1]. Bounds memory: the lidar
 #: model holds a few dozen float64 arrays of (chunk, beams, gates) at a time.
 DEFAULT_BLOCKS_PER_CHUNK = 2

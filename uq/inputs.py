@@ -68,10 +68,10 @@ class InputSet:
     def values(self, scores):
         """Input arrays from normal scores of shape (n, dimension).
 
-        Returns dict name -> array of shape (n, *shape); constants as floats.
+        Returns dict name -> array of shape (n, *shape) of the random inputs only.
         """
         correlated = scores @ self.cholesky.T if self.dimension else scores
-        arrays = dict(self.constants)
+        arrays = {}
         for name in self.names:
             start = self.offsets[name]
             size = int(np.prod(self.shapes[name]))

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import wind
+from . import complexstep, wind
 from .beams import beam_unit_vectors, least_squares_operator, slant_distances
 from .correction import correction_rotation, correction_ship_velocity, reconstruct_wind
 from .rotation import attitude_matrix
@@ -110,7 +110,7 @@ def true_wind(scene, heights):
     """True wind (north, east, up) [m s-1] at `heights` [m]; shape heights.shape + (3,)."""
     speed = wind.power_law_speed(scene.wind_speed, heights, scene.reference_height,
                                  scene.shear)
-    north, east = wind.wind_components(speed, np.rad2deg(scene.wind_direction))
+    north, east = wind.wind_components(speed, complexstep.degrees(scene.wind_direction))
     up = np.zeros_like(north) + scene.vertical_wind
     return np.stack([north, east, up], axis=-1)
 
@@ -176,8 +176,8 @@ def _sample_count(errors):
 
 def _measure(scene, err, n):
     """True radial velocities plus noise, and the INS readings (true + error)."""
-    half_cone = scene.half_cone + np.deg2rad(err["lidar_half_cone"]) + np.zeros(n)
-    misalignment = scene.misalignment + np.deg2rad(err["lidar_misalignment"]) + np.zeros(n)
+    half_cone = scene.half_cone + complexstep.radians(err["lidar_half_cone"]) + np.zeros(n)
+    misalignment = scene.misalignment + complexstep.radians(err["lidar_misalignment"]) + np.zeros(n)
     true_beams = beam_unit_vectors(half_cone, np.asarray(scene.azimuths), misalignment,
                                    scene.vertical_beam)                    # (n, b, 3)
     attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
@@ -188,7 +188,7 @@ def _measure(scene, err, n):
     navigation = {}
     for key in NAVIGATION:
         error = err[f"ins_{key}"]
-        error = np.deg2rad(error) if key in ANGULAR_NAVIGATION else error
+        error = complexstep.radians(error) if key in ANGULAR_NAVIGATION else error
         navigation[key] = getattr(scene, key) + error
     return measured, navigation
 

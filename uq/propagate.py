@@ -13,8 +13,8 @@ import numpy as np
 import xarray as xr
 
 from . import gum
-from .constants import (ADAPTIVE_MAX_SAMPLES, COVERAGE_PROBABILITY, DEFAULT_BLOCKS_PER_CHUNK,
-                        DEFAULT_DIGITS, RNG_BLOCK_SIZE)
+from .constants import (ADAPTIVE_MAX_SAMPLES, BATCH_SIZE, COVERAGE_PROBABILITY,
+                        DEFAULT_BLOCKS_PER_CHUNK, DEFAULT_DIGITS, RNG_BLOCK_SIZE)
 from .inputs import input_set
 from .sampling import SAMPLING_METHODS, new_seed, normal_scores
 from .statistics import INTERVALS, StreamingStatistics, batch_statistics, tail_capacity
@@ -138,13 +138,16 @@ class _Runner:
         with np.errstate(all="ignore"):           # out-of-domain trials become NaN, counted
             outputs = self.model(**self.inputs.values(scores[:n_samples]),
                                  **self.inputs.constants)
-        return {q: np.real(np.asarray(v, dtype=float)) for q, v in outputs.items()}
+        # outputs that do not depend on any random input may come back with one row
+        return {q: np.broadcast_to(np.real(np.asarray(v, dtype=float)),
+                                   (n_samples,) + np.shape(v)[1:])
+                for q, v in outputs.items()}
 
     def _accumulate(self, outputs):
         for q, values in outputs.items():
             self.stats[q].update(values)
-            for start in range(0, len(values) - RNG_BLOCK_SIZE + 1, RNG_BLOCK_SIZE):
-                batch = batch_statistics(values[start:start + RNG_BLOCK_SIZE],
+            for start in range(0, len(values) - BATCH_SIZE + 1, BATCH_SIZE):
+                batch = batch_statistics(values[start:start + BATCH_SIZE],
                                          self.references[q], kind=self.interval)
                 for key in _BATCH_KEYS:
                     self.batches[q][key].append(batch[key])
@@ -161,7 +164,7 @@ class _Runner:
             self._accumulate(outputs)
 
     def run_adaptive(self, digits):
-        """JCGM 101:2008, 7.9.4, with batches of one RNG block (M = 2^16 >= 10^4)."""
+        """JCGM 101:2008, 7.9.4: batches of M = 2^14 >= 10^4 trials, one RNG block per step."""
         block = 0
         while True:
             outputs = self._evaluate(block, 1, RNG_BLOCK_SIZE)

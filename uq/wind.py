@@ -33,7 +33,7 @@ def wind_components(speed, direction):
     north, east : ndarray
         [m s-1]. Eqs. 4-5 [1].
     """
-    direction_rad = np.deg2rad(direction)
+    direction_rad = complexstep.radians(direction)
     return -speed * np.cos(direction_rad), -speed * np.sin(direction_rad)
 
 
@@ -49,7 +49,7 @@ def wind_direction(north, east):
     ``atan(v/u)``, gives the direction the wind blows *to*, modulo 180 deg; this is the
     corrected form.) Undefined (returned as 0) for zero wind.
     """
-    angle = np.rad2deg(complexstep.arctan2(-east, -north))
+    angle = complexstep.degrees(complexstep.arctan2(-east, -north))
     return complexstep.mod(angle, FULL_CIRCLE_DEG)
 
 
