@@ -31,6 +31,8 @@ STATISTICS = {
     "mc_n_invalid": ("Monte Carlo trials outside the model's domain (non-finite, excluded)", None),
     "gum_u": ("first-order GUM standard uncertainty of the physical model", "standard_error"),
     "gum_valid": ("GUM interval validated by Monte Carlo (JCGM 101 clause 8)", None),
+    "gum_validation_conclusive": ("Monte Carlo numerical error within the tolerance of the "
+                                  "validation, so gum_valid is conclusive", None),
     "paper_u": ("Rubio and Gottschall (2022) analytic standard uncertainty", "standard_error"),
     "budget": ("contribution of each input to the GUM variance, c_i^2 u_i^2", None),
 }
@@ -45,7 +47,7 @@ def variable_attributes(quantity, statistic):
         attrs["units"] = "1"
     elif statistic == "budget":
         attrs["units"] = "m2 s-2" if base["units"] == "m s-1" else "degree2"
-    elif statistic != "gum_valid":
+    elif statistic not in ("gum_valid", "gum_validation_conclusive"):
         attrs["units"] = base["units"]
     if statistic in ("true", "nominal", "gum_value", "mc_mean"):
         attrs["standard_name"] = base["standard_name"]

@@ -65,7 +65,9 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         ``q_mc_n_invalid`` (non-finite trials, excluded), ``q_mc_numerical_error``
         (twice the largest standard deviation of the block means of mean, u and the
         endpoints: the JCGM 101 7.9 stability measure), ``q_gum_value`` (model at the
-        input means), ``q_gum_u``, ``q_gum_valid`` (clause 8), ``q_budget`` (dimension
+        input means), ``q_gum_u``, ``q_gum_valid`` (clause 8), ``q_gum_validation_conclusive`` (the Monte Carlo
+        numerical error is within the tolerance of clause 8, so the verdict is not
+        decided by sampling noise), ``q_budget`` (dimension
         ``input``); circular outputs also ``q_mc_circular_std``.
     """
     _check_arguments(n, digits, method, interval)
@@ -215,6 +217,8 @@ def _dataset(runner, gum_value, jacobian, inputs, circular, output_dims, digits)
             f"{q}_gum_u": (dims, u_gum),
             f"{q}_gum_valid": (dims, gum.gum_interval_valid(
                 gum_value[q], u_gum, result["low"], result["high"], digits, q in circular)),
+            f"{q}_gum_validation_conclusive": (dims, runner.numerical_error(q)
+                                               <= gum.numerical_tolerance(u_gum, digits)),
             f"{q}_budget": (("input",) + dims, gum.variance_budget(jacobian[q], inputs)),
         })
         if q in circular:

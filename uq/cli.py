@@ -1,0 +1,102 @@
+"""Command line: ``uq run``, ``uq check``, ``uq --version``.
+
+Exit status: 0 success; 2 bad input (one line naming the file, the key and what is
+allowed; no traceback; no output file); 1 anything else.
+"""
+import argparse
+import sys
+from pathlib import Path
+
+import yaml
+
+from . import __version__
+from .errors import ScenarioError
+
+EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports usage errors as bad input (exit 2, one line)."""
+
+    def error(self, message):
+        self.exit(EXIT_BAD_INPUT, f"uq: error: {message}\n")
+
+
+def build_parser():
+    parser = _Parser(prog="uq", description="Uncertainty of ship-based and floating "
+                     "Doppler wind lidar: Monte Carlo beside the GUM.")
+    parser.add_argument("--version", action="version", version=f"uq {__version__}")
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    run = commands.add_parser("run", help="run a scenario and write its results (netCDF)")
+    run.add_argument("scenario", help="scenario YAML file")
+    run.add_argument("-o", "--output", help="output file (default results/<name>.nc)")
+    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                     help="override a scenario value (dotted key, YAML value); repeatable")
+    run.add_argument("--quiet", action="store_true", help="no summary table or progress")
+    check = commands.add_parser("check", help="validate a scenario without running it")
+    check.add_argument("scenario", help="scenario YAML file")
+    check.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    return parser
+
+
+def parse_overrides(items, source="--set"):
+    """``['a.b=1', ...]`` -> ``{'a.b': 1}`` (values parsed as YAML)."""
+    overrides = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        if not sep or not key.strip():
+            raise ScenarioError(source, item, "expected KEY=VALUE with a dotted key")
+        try:
+            overrides[key.strip()] = yaml.safe_load(text)
+        except yaml.YAMLError:
+            raise ScenarioError(source, key, f"value {text!r} is not valid YAML") from None
+    return overrides
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    try:
+        return _COMMANDS[args.command](args)
+    except ScenarioError as error:
+        print(f"uq: error: {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+
+def _check(args):
+    from .scenario import load_scenario
+    scenario = load_scenario(args.scenario, parse_overrides(args.set))
+    scenes = 1
+    for _, values in scenario.sweep:
+        scenes *= len(values)
+    print(f"{args.scenario}: ok ({scenario.name}: {scenes} scene(s), outputs "
+          f"{', '.join(scenario.outputs)})")
+    return EXIT_OK
+
+
+def _run(args):
+    from .io import write_results
+    from .pipeline import run
+    from .scenario import load_scenario
+    from .summary import summary_table
+    scenario = load_scenario(args.scenario, parse_overrides(args.set))
+    output = Path(args.output) if args.output else Path("results") / f"{scenario.name}.nc"
+    if output.suffix != ".nc":
+        raise ScenarioError("-o", str(output), "the output file must end in .nc")
+    progress = None if args.quiet else _progress
+    dataset = run(scenario, progress=progress)
+    write_results(dataset, output)
+    if not args.quiet:
+        print(summary_table(dataset))
+        print(f"wrote {output}")
+    return EXIT_OK
+
+
+def _progress(done, total):
+    if total > 1 and sys.stderr.isatty():
+        print(f"\rscene {done}/{total}", end="\n" if done == total else "", file=sys.stderr)
+
+
+_COMMANDS = {"run": _run, "check": _check}
+
+if __name__ == "__main__":
+    sys.exit(main())
