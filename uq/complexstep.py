@@ -35,10 +35,13 @@ def hypot(x, y):
 
 
 def mod(x, period):
-    """``numpy.mod`` of the real part; the imaginary part passes unchanged."""
-    if not np.iscomplexobj(x):
-        return np.mod(x, period)
-    return np.mod(x.real, period) + 1j * x.imag
+    """``numpy.mod`` into [0, period) of the real part; the imaginary part passes unchanged.
+
+    ``numpy.mod(-1e-17, 360)`` rounds to 360.0; that is folded to 0 here.
+    """
+    real = np.mod(np.real(x), period)
+    real = np.where(real >= period, real - period, real)
+    return real + 1j * np.imag(x) if np.iscomplexobj(x) else real
 
 
 def real_part(x):

@@ -30,7 +30,8 @@ Their yaw gamma is clockwise (the heading of the lidar's reference beam). Their 
 rotation is ``R_roll(beta) @ R_pitch(delta)`` (Eq. 7), where, read off Eq. 7,
 ``R_pitch(delta) = Ry(-delta)`` (delta positive *bow down*, their Sec. 3.3) and
 ``R_roll(beta) = Rx(beta)`` (beta positive starboard down). The order differs from the
-marine one, so the exact mapping goes through the matrix: see
+marine one, so the exact mapping goes through the matrix, with the yaw in front:
+``Rz(heading) Ry(pitch) Rx(roll) = Rz(gamma) Rx(beta) Ry(-delta)``; see
 :func:`rubio2022_angles_from_attitude` and :func:`attitude_from_rubio2022_angles`.
 
 All functions take angles in radians and broadcast over leading dimensions; they are
@@ -112,29 +113,33 @@ def attitude_from_matrix(matrix):
     return heading, pitch, roll
 
 
-def rubio2022_rotation(delta, beta):
-    """Rubio & Gottschall (2022) case ii rotation ``R_roll(beta) @ R_pitch(delta)``.
+def rubio2022_rotation(delta, beta, gamma=0.0):
+    """Rubio & Gottschall (2022) rotation ``R_yaw(gamma) @ R_roll(beta) @ R_pitch(delta)``.
 
     delta [rad] is their pitch (positive bow down), beta [rad] their roll (positive
-    starboard down). Read off Eq. 7 [1].
+    starboard down), gamma [rad] their yaw (clockwise). Case ii (Eq. 7 [1]) is gamma = 0.
     """
-    return rotation_roll(beta) @ rotation_pitch(-delta)
+    return rotation_about_vertical(gamma) @ rotation_roll(beta) @ rotation_pitch(-delta)
 
 
-def rubio2022_angles_from_attitude(pitch, roll):
-    """Exact Rubio & Gottschall (2022) (delta, beta) of a marine (pitch, roll) [rad].
+def rubio2022_angles_from_attitude(heading, pitch, roll):
+    """Exact Rubio & Gottschall (2022) angles (gamma, delta, beta) of a marine attitude [rad].
 
-    ``rubio2022_rotation(delta, beta) == Ry(pitch) @ Rx(roll)``. To first order
-    delta = -pitch and beta = roll; the second-order difference comes from the
-    different rotation order.
+    ``rubio2022_rotation(delta, beta, gamma) == attitude_matrix(heading, pitch, roll)``.
+    To first order gamma = heading, delta = -pitch and beta = roll. The orders of the
+    rotations differ (theirs: pitch first, then roll about the earth's north axis), so a
+    combined pitch and roll leaves a second-order yaw: gamma - heading = -1.75 deg at
+    pitch = roll = 10 deg.
     """
-    m = rotation_pitch(pitch) @ rotation_roll(roll)
-    delta = np.arctan2(m[..., 0, 2], m[..., 0, 0])   # row 0 of Rx(b) Ry(-d) = (cd, 0, sd)
-    beta = np.arctan2(-m[..., 2, 1], m[..., 1, 1])   # m[2,1] = -sb, m[1,1] = cb
-    return delta, beta
+    m = attitude_matrix(heading, pitch, roll)
+    # row 2 of Rz(g) Rx(b) Ry(-d) is (-cos b sin d, -sin b, cos b cos d)
+    beta = np.arcsin(np.clip(-m[..., 2, 1], -1.0, 1.0))
+    delta = np.arctan2(-m[..., 2, 0], m[..., 2, 2])
+    # column 1 is (-sin g cos b, cos g cos b, -sin b)
+    gamma = np.mod(np.arctan2(-m[..., 0, 1], m[..., 1, 1]), 2 * np.pi)
+    return gamma, delta, beta
 
 
-def attitude_from_rubio2022_angles(delta, beta):
-    """Inverse of :func:`rubio2022_angles_from_attitude`: marine (pitch, roll) [rad]."""
-    m = rubio2022_rotation(delta, beta)
-    return attitude_from_matrix(m)[1:]
+def attitude_from_rubio2022_angles(gamma, delta, beta):
+    """Inverse of :func:`rubio2022_angles_from_attitude`: marine (heading, pitch, roll) [rad]."""
+    return attitude_from_matrix(rubio2022_rotation(delta, beta, gamma))

@@ -11,8 +11,10 @@ module exists so the two can be compared.
 Angles are in radians, speeds in [m s-1]. Beams are N, E, S, W: azimuths 0, 90, 180,
 270 deg from the lidar's reference beam. Case i: the lidar's reference beam points at
 ``gamma`` (clockwise from north) = ship heading + misalignment. Case ii: no yaw; the
-angles are the paper's (delta positive bow down, beta positive starboard down; see
-:mod:`uq.rotation` for the exact mapping from the marine pitch and roll).
+angles are the paper's (delta positive bow down, beta positive starboard down), from the
+exact mapping of the marine pitch and roll (:func:`uq.rotation.rubio2022_angles_from_attitude`);
+the second-order yaw that the different rotation order leaves (-1.75 deg at 10 deg
+pitch and roll) has no place in case ii and is dropped, as in the paper.
 
 Misprints in the printed equations (each re-derived here and verified in the tests
 against complex-step derivatives of Eqs. 6, 7, 16-18 and of the case ii reconstruction)
@@ -207,7 +209,7 @@ def rubio2022_scene_uncertainty(scene, speed, u_heading, u_pitch, u_roll, u_sog,
         sens = rubio2022_wind_sensitivities_case_i(radial, speed, scene.wind_direction,
                                                    scene.sog, scene.cog, yaw, scene.half_cone)
     else:
-        delta, beta = rubio2022_angles_from_attitude(scene.pitch, scene.roll)
+        _, delta, beta = rubio2022_angles_from_attitude(0.0, scene.pitch, scene.roll)
         radial = rubio2022_radial_velocity_case_ii(*args, delta, beta, scene.half_cone,
                                                    RUBIO2022_AZIMUTHS)
         u_radial = rubio2022_radial_velocity_uncertainty_case_ii(
