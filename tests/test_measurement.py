@@ -1,0 +1,128 @@
+"""The measurement model against closed forms and limiting cases."""
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from conftest import make_scene
+from uq.beams import beam_unit_vectors, least_squares_operator
+from uq.measurement import measurement_model, true_values
+
+d = np.deg2rad
+
+
+def reconstruct(scene, **errors):
+    out = measurement_model(scene, **errors)
+    return {q: np.real(v[0]) for q, v in out.items()}
+
+
+azimuth_sets = st.lists(st.floats(0, 359), min_size=3, max_size=8, unique=True).filter(
+    lambda a: np.linalg.matrix_rank(beam_unit_vectors(d(28), d(np.array(a)))) == 3)
+
+
+@settings(max_examples=60, deadline=None)
+@given(azimuth_sets, st.booleans(), st.floats(5, 60), st.floats(0, 359.9), st.floats(0.5, 25),
+       st.sampled_from(["none", "yaw", "tilt2d", "full"]))
+def test_no_motion_no_error_returns_true_wind(azimuths, vertical, cone, direction, speed, model):
+    scene = make_scene(**{"lidar.azimuths": azimuths, "lidar.vertical_beam": vertical,
+                          "lidar.half_cone": cone, "wind.direction": direction,
+                          "wind.speed": speed, "wind.vertical": 0.3, "correction": model})
+    out, truth = reconstruct(scene), true_values(scene)
+    # least squares loses ~cond(A) machine epsilons; nearly coplanar beams are ill-conditioned
+    tolerance = 100 * np.finfo(float).eps * np.linalg.cond(scene.nominal_unit_vectors())
+    np.testing.assert_allclose(out["wind_speed"], truth["wind_speed"], rtol=tolerance)
+    angle_error = np.mod(out["wind_direction"] - truth["wind_direction"] + 180, 360) - 180
+    assert abs(np.deg2rad(angle_error)) * speed < tolerance * (speed + 0.3)
+    np.testing.assert_allclose(out["vertical_wind"], 0.3, atol=tolerance * (speed + 0.3))
+
+
+@pytest.mark.parametrize("tilt", [2.0, 5.0, 10.0, 20.0])
+def test_static_tilt_without_correction_tiana2017(tilt):
+    """Tiana-Alsina et al. (2017): a tilt underestimates the wind along the tilt plane by
+    cos(tilt) and leaves the wind along the tilt axis unchanged (level-assumed lidar)."""
+    along = make_scene(**{"ship.pitch": tilt, "wind.direction": 180.0, "correction": "none"})
+    across = make_scene(**{"ship.pitch": tilt, "wind.direction": 90.0, "correction": "none"})
+    assert reconstruct(along)["wind_speed"][0] == pytest.approx(5.0 * np.cos(d(tilt)), rel=1e-12)
+    assert reconstruct(across)["wind_speed"][0] == pytest.approx(5.0, rel=1e-12)
+    rolled = make_scene(**{"ship.roll": tilt, "wind.direction": 270.0, "correction": "none"})
+    assert reconstruct(rolled)["wind_speed"][0] == pytest.approx(5.0 * np.cos(d(tilt)), rel=1e-12)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.floats(0, 359.9), st.floats(-30, 30), st.floats(-30, 30), st.floats(0, 359.9),
+       st.floats(0, 8), st.floats(0, 359.9), st.floats(-1, 1), st.floats(0, 0.3))
+def test_full_correction_recovers_true_wind_under_any_static_attitude(
+        heading, pitch, roll, cog, sog, direction, heave, shear):
+    scene = make_scene(**{"ship.heading": heading, "ship.pitch": pitch, "ship.roll": roll,
+                          "ship.cog": cog, "ship.sog": sog, "ship.heave": heave,
+                          "wind.direction": direction, "wind.vertical": 0.2,
+                          "correction": "full"})
+    out, truth = reconstruct(scene), true_values(scene)
+    np.testing.assert_allclose(out["wind_speed"], truth["wind_speed"], rtol=1e-10)
+    np.testing.assert_allclose(out["vertical_wind"], 0.2, atol=1e-10)
+    assert abs(np.mod(out["wind_direction"] - truth["wind_direction"] + 180, 360) - 180) < 1e-8
+
+
+def test_yaw_correction_is_exact_without_tilt():
+    scene = make_scene(**{"ship.heading": 123.0, "ship.sog": 4.0, "ship.cog": 117.0,
+                          "wind.direction": 300.0, "correction": "yaw"})
+    assert reconstruct(scene)["wind_speed"][0] == pytest.approx(5.0, rel=1e-12)
+
+
+def test_tilt2d_is_biased_under_tilt_and_full_is_not():
+    changes = {"ship.pitch": 10.0, "wind.direction": 180.0, "ship.sog": 2.0}
+    tilt2d = reconstruct(make_scene(**changes, correction="tilt2d"))["wind_speed"][0]
+    full = reconstruct(make_scene(**changes, correction="full"))["wind_speed"][0]
+    assert full == pytest.approx(5.0, rel=1e-12)
+    # tilt2d drops the lidar-frame vertical of the relative wind. Here the relative wind is
+    # 5 - 2 = 3 m/s towards north (wind from the south, ship going north at 2 m/s); in the
+    # lidar frame it is (3 cos p, 0, -3 sin p); rotating back only (3 cos p, 0, 0) gives a
+    # north component 3 cos^2 p, plus the ship's 2 m/s.
+    relative = 5.0 - 2.0                       # relative wind towards north [m s-1]
+    expected = relative * np.cos(d(10)) ** 2 + 2.0
+    assert tilt2d == pytest.approx(expected, rel=1e-12)
+
+
+def test_beam_mode_with_equal_readings_equals_scan_mode():
+    for model in ("none", "yaw", "tilt2d", "full"):
+        scene = make_scene(**{"ship.heading": 40.0, "ship.pitch": 4.0, "ship.roll": -3.0,
+                              "ship.sog": 3.0, "ship.cog": 50.0, "wind.direction": 10.0,
+                              "correction": model})
+        errors = {"ins_heading": 0.7, "ins_pitch": -0.3, "ins_roll": 0.2, "ins_sog": 0.1,
+                  "ins_cog": 1.0}
+        scan = reconstruct(scene, **{k: np.full(2, v) for k, v in errors.items()})
+        beam = reconstruct(scene, **{k: np.full((2, 4), v) for k, v in errors.items()})
+        for q in scan:
+            np.testing.assert_allclose(beam[q], scan[q], rtol=1e-12, atol=1e-12)
+
+
+def test_least_squares_operator_is_classical_dbs():
+    beams = beam_unit_vectors(d(28), d(np.array([0.0, 90, 180, 270])))
+    operator = least_squares_operator(beams)
+    v = np.array([1.0, 2.0, -0.5, 0.3])
+    assert (operator @ v)[0] == pytest.approx((v[0] - v[2]) / (2 * np.sin(d(28))))   # Eq. 14
+    assert (operator @ v)[1] == pytest.approx((v[1] - v[3]) / (2 * np.sin(d(28))))   # Eq. 15
+    assert (operator @ v)[2] == pytest.approx(v.sum() / (4 * np.cos(d(28))))
+    with pytest.raises(ValueError):
+        least_squares_operator(beams[:2])
+
+
+def test_radial_velocity_sign_positive_away():
+    # ship at rest, wind from the south blows north: the north beam sees positive v_r
+    scene = make_scene(**{"wind.direction": 180.0})
+    radial = true_values(scene)["radial_velocity"][:, 0]
+    assert radial[0] == pytest.approx(5.0 * np.sin(d(28)))
+    assert radial[2] == pytest.approx(-5.0 * np.sin(d(28)))
+
+
+def test_shear_with_tilt_uses_true_beam_heights():
+    scene = make_scene(**{"wind.shear": 0.2, "ship.pitch": 10.0, "lidar.height": 0.0,
+                          "lidar.ranges": [100.0], "wind.direction": 90.0, "correction": "none"})
+    radial = true_values(scene)["radial_velocity"][:, 0]
+    slant = 100.0 / np.cos(d(28))
+    height_north = slant * np.cos(d(28) - d(10))       # bow up: north beam steeper
+    expected = -5.0 * (height_north / 100.0) ** 0.2 * 0.0   # wind from east: north beam sees 0
+    assert radial[0] == pytest.approx(expected, abs=1e-12)
+    east_height = slant * np.cos(d(28)) * np.cos(d(10))  # east beam tilted about its own axis
+    assert radial[1] == pytest.approx(-5.0 * (east_height / 100.0) ** 0.2 * np.sin(d(28)),
+                                      rel=1e-12)
