@@ -1,0 +1,199 @@
+"""Rubio & Gottschall (2022): every implemented equation against an independent derivation.
+
+Chain of evidence: Eqs. 6-7 equal the physical model's radial velocities (independent
+code, uq.measurement); Eq. 13/16 equals the physical model's correction (uq.correction);
+every partial derivative (Eqs. 9-11, A.1-A.20, corrected) equals the complex-step
+derivative of those equations, to machine precision.
+"""
+import numpy as np
+import pytest
+
+from conftest import make_scene
+from uq.correction import reconstruct_wind
+from uq.beams import least_squares_operator
+from uq.measurement import true_values
+from uq.rotation import rubio2022_angles_from_attitude
+from uq.rubio2022 import (RUBIO2022_AZIMUTHS, rubio2022_domain,
+                          rubio2022_radial_velocity_case_i, rubio2022_radial_velocity_case_ii,
+                          rubio2022_radial_velocity_uncertainty_case_i,
+                          rubio2022_radial_velocity_uncertainty_case_ii,
+                          rubio2022_reconstruction, rubio2022_wind_sensitivities_case_i,
+                          rubio2022_wind_sensitivities_case_ii)
+
+d = np.deg2rad
+H = 1e-30            # complex step: exact derivative, no cancellation
+# Derivatives agree to a few ulps of the terms they sum; 1e-12 relative is ~5000 ulps.
+RTOL = 1e-12
+POINTS = [dict(speed=5.0, direction=d(30), sog=2.0, cog=d(20), yaw=d(50), cone=d(28)),
+          dict(speed=11.0, direction=d(250), sog=6.0, cog=d(300), yaw=d(10), cone=d(15)),
+          dict(speed=3.0, direction=d(359), sog=0.5, cog=d(181), yaw=d(200), cone=d(60))]
+TILTS = [(d(7), d(-4)), (d(-10), d(10)), (d(3), d(0))]
+
+
+def derivative(function, x):
+    return np.imag(function(x + 1j * H)) / H
+
+
+def radial_i(p, **override):
+    q = {**p, **override}
+    return rubio2022_radial_velocity_case_i(q["speed"], q["direction"], q["sog"], q["cog"],
+                                            q["yaw"], q["cone"], RUBIO2022_AZIMUTHS)
+
+
+@pytest.mark.parametrize("p", POINTS)
+def test_eq6_equals_physical_model(p):
+    # physical model, ship at rest in the wind's frame: level lidar, yaw = heading
+    scene = make_scene(**{"wind.speed": p["speed"], "wind.direction": np.rad2deg(p["direction"]),
+                          "ship.sog": p["sog"], "ship.cog": np.rad2deg(p["cog"]),
+                          "ship.heading": np.rad2deg(p["yaw"]), "lidar.half_cone": np.rad2deg(p["cone"]),
+                          "wind.reference_height": 100.0, "lidar.height": 0.0,
+                          "lidar.ranges": [100.0], "correction": "yaw"})
+    from uq.measurement import _measure, _ERROR_NAMES
+    measured, _ = _measure(scene, {n: np.zeros(1) if not n.startswith("ins_") else np.zeros((1, 1))
+                                   for n in _ERROR_NAMES}, 1)
+    np.testing.assert_allclose(measured[0, :, 0], radial_i(p), rtol=1e-13, atol=1e-13)
+
+
+@pytest.mark.parametrize("p", POINTS)
+def test_eqs_9_to_11_are_derivatives_of_eq6(p):
+    args = (p["speed"], p["direction"], p["sog"], p["cog"], p["yaw"], p["cone"], RUBIO2022_AZIMUTHS)
+    for name, key in (("u_yaw", "yaw"), ("u_sog", "sog"), ("u_cog", "cog")):
+        u = {"u_yaw": 0.0, "u_sog": 0.0, "u_cog": 0.0, name: 1.0}
+        printed = rubio2022_radial_velocity_uncertainty_case_i(*args, **u)
+        exact = np.abs(derivative(lambda x: radial_i(p, **{key: x}), p[key]))
+        np.testing.assert_allclose(printed, exact, rtol=RTOL, atol=1e-14)
+
+
+def radial_ii(p, tilt_delta, tilt_beta, **override):
+    q = {**p, "delta": tilt_delta, "beta": tilt_beta, **override}
+    return rubio2022_radial_velocity_case_ii(q["speed"], q["direction"], q["sog"], q["cog"],
+                                             q["delta"], q["beta"], q["cone"], RUBIO2022_AZIMUTHS)
+
+
+@pytest.mark.parametrize("p", POINTS)
+@pytest.mark.parametrize("tilt", TILTS)
+def test_eq7_equals_physical_model(p, tilt):
+    from uq.rotation import attitude_from_rubio2022_angles
+    heading, pitch, roll = attitude_from_rubio2022_angles(0.0, *tilt)
+    scene = make_scene(**{"wind.speed": p["speed"], "wind.direction": np.rad2deg(p["direction"]),
+                          "ship.sog": p["sog"], "ship.cog": np.rad2deg(p["cog"]),
+                          "ship.heading": np.rad2deg(heading), "ship.pitch": np.rad2deg(pitch), "ship.roll": np.rad2deg(roll),
+                          "lidar.half_cone": np.rad2deg(p["cone"]), "correction": "tilt2d"})
+    from uq.measurement import _measure, _ERROR_NAMES
+    measured, _ = _measure(scene, {n: np.zeros(1) if not n.startswith("ins_") else np.zeros((1, 1))
+                                   for n in _ERROR_NAMES}, 1)
+    np.testing.assert_allclose(measured[0, :, 0], radial_ii(p, *tilt), rtol=1e-12, atol=1e-13)
+
+
+@pytest.mark.parametrize("p", POINTS)
+@pytest.mark.parametrize("tilt", TILTS)
+def test_a1_to_a4_are_derivatives_of_eq7(p, tilt):
+    delta, beta = tilt
+    args = (p["speed"], p["direction"], p["sog"], p["cog"], delta, beta, p["cone"], RUBIO2022_AZIMUTHS)
+    for name, key in (("u_delta", "delta"), ("u_beta", "beta"), ("u_sog", "sog"), ("u_cog", "cog")):
+        u = {"u_delta": 0.0, "u_beta": 0.0, "u_sog": 0.0, "u_cog": 0.0, name: 1.0}
+        printed = rubio2022_radial_velocity_uncertainty_case_ii(*args, **u)
+        exact = np.abs(derivative(lambda x: radial_ii(p, delta, beta, **{key: x}),
+                                  {"delta": delta, "beta": beta}.get(key, p.get(key))))
+        np.testing.assert_allclose(printed, exact, rtol=RTOL, atol=1e-14)
+
+
+def test_printed_a3_sign_is_a_misprint():
+    # A.3 as printed: -sin(cog)[E] + cos(cog)[N]. (For the untilted N, E, S, W beams its
+    # magnitude happens to equal Eq. 10's, so the misprint shows only under tilt.)
+    p, (delta, beta) = POINTS[0], TILTS[0]
+    from uq.rubio2022 import _tilted_beam
+    north, east = _tilted_beam(p["cone"], RUBIO2022_AZIMUTHS, delta, beta)
+    printed = -np.sin(p["cog"]) * east + np.cos(p["cog"]) * north
+    exact = derivative(lambda x: radial_ii(p, delta, beta, sog=x), p["sog"])
+    assert not np.allclose(np.abs(printed), np.abs(exact), rtol=1e-3)
+
+
+@pytest.mark.parametrize("p", POINTS)
+def test_eq16_equals_physical_yaw_correction(p):
+    radial = radial_i(p)
+    north, east = rubio2022_reconstruction(radial, p["sog"], p["cog"], p["cone"], yaw=p["yaw"])
+    scene = make_scene(**{"lidar.half_cone": np.rad2deg(p["cone"])})
+    units = scene.nominal_unit_vectors()
+    nav = {"heading": np.array([[p["yaw"]]]), "pitch": np.zeros((1, 1)), "roll": np.zeros((1, 1)),
+           "sog": np.array([[p["sog"]]]), "cog": np.array([[p["cog"]]]), "heave": np.zeros((1, 1))}
+    wind = reconstruct_wind(radial[None, :, None], "yaw", units, least_squares_operator(units), nav)
+    np.testing.assert_allclose([north, east], wind[0, :2, 0], rtol=1e-13, atol=1e-13)
+    # at the nominal point the correction is exact (Eqs. 4-5)
+    np.testing.assert_allclose([north, east], [-p["speed"] * np.cos(p["direction"]),
+                                               -p["speed"] * np.sin(p["direction"])], atol=1e-12)
+
+
+@pytest.mark.parametrize("tilt", TILTS)
+def test_case_ii_reconstruction_equals_physical_tilt2d(tilt):
+    from uq.rotation import attitude_from_rubio2022_angles
+    p = POINTS[0]
+    heading, pitch, roll = attitude_from_rubio2022_angles(0.0, *tilt)
+    radial = radial_ii(p, *tilt)
+    north, east = rubio2022_reconstruction(radial, p["sog"], p["cog"], p["cone"],
+                                           delta=tilt[0], beta=tilt[1])
+    scene = make_scene(**{"lidar.half_cone": np.rad2deg(p["cone"])})
+    units = scene.nominal_unit_vectors()
+    nav = {"heading": np.array([[heading]]), "pitch": np.array([[pitch]]), "roll": np.array([[roll]]),
+           "sog": np.array([[p["sog"]]]), "cog": np.array([[p["cog"]]]), "heave": np.zeros((1, 1))}
+    wind = reconstruct_wind(radial[None, :, None], "tilt2d", units, least_squares_operator(units), nav)
+    np.testing.assert_allclose([north, east], wind[0, :2, 0], rtol=1e-12, atol=1e-12)
+
+
+def wind_derivatives(radial, function):
+    """Complex-step d(speed)/dv_i and d(direction)/dv_i of a reconstruction."""
+    speed, direction = [], []
+    for i in range(4):
+        v = radial.astype(complex)
+        v[i] += 1j * H
+        north, east = function(v)
+        speed.append(np.imag(np.sqrt(north**2 + east**2)) / H)
+        # d atan2(-e, -n) = (n de - e dn) / (n^2 + e^2)
+        n, e = north.real, east.real
+        direction.append((n * np.imag(east) - e * np.imag(north)) / H / (n**2 + e**2))
+    return np.array(speed), np.array(direction)
+
+
+@pytest.mark.parametrize("p", POINTS)
+def test_a5_to_a8_and_a13_to_a16_corrected_are_derivatives(p):
+    radial = radial_i(p)
+    exact = wind_derivatives(radial, lambda v: rubio2022_reconstruction(
+        v, p["sog"], p["cog"], p["cone"], yaw=p["yaw"]))
+    ours = rubio2022_wind_sensitivities_case_i(radial, p["speed"], p["direction"], p["sog"],
+                                               p["cog"], p["yaw"], p["cone"])
+    np.testing.assert_allclose(ours[0], exact[0], rtol=1e-11, atol=1e-14)
+    np.testing.assert_allclose(ours[1], exact[1], rtol=1e-11, atol=1e-14)
+    # the printed A.6 (cos instead of sin) and A.15 (Theta + gamma) are not derivatives
+    s = np.sin(p["cone"])
+    printed_a6 = (radial[1] - radial[3] + 2 * s * np.cos(p["cog"] - p["yaw"]) * p["sog"]) / (
+        4 * p["speed"] * s**2)
+    printed_a15 = np.sin(p["direction"] + p["yaw"]) / (2 * p["speed"] * s)
+    assert not np.isclose(printed_a6, exact[0][1], rtol=1e-3)
+    assert not np.isclose(printed_a15, exact[1][2], rtol=1e-3)
+
+
+@pytest.mark.parametrize("p", POINTS)
+@pytest.mark.parametrize("tilt", TILTS)
+def test_a9_to_a12_and_a17_to_a20_corrected_are_derivatives(p, tilt):
+    delta, beta = tilt
+    radial = radial_ii(p, delta, beta)
+    function = lambda v: rubio2022_reconstruction(v, p["sog"], p["cog"], p["cone"],  # noqa: E731
+                                                  delta=delta, beta=beta)
+    north, east = function(radial)
+    speed, direction = np.hypot(north, east), np.arctan2(-east, -north)
+    exact = wind_derivatives(radial, function)
+    ours = rubio2022_wind_sensitivities_case_ii(radial, speed, direction, p["sog"], p["cog"],
+                                                delta, beta, p["cone"])
+    np.testing.assert_allclose(ours[0], exact[0], rtol=1e-11, atol=1e-14)
+    np.testing.assert_allclose(ours[1], exact[1], rtol=1e-11, atol=1e-14)
+
+
+def test_domain():
+    assert rubio2022_domain(make_scene(correction="yaw")) == "i"
+    assert rubio2022_domain(make_scene(correction="tilt2d", **{"ship.pitch": 5.0})) == "ii"
+    assert rubio2022_domain(make_scene(correction="yaw", **{"ship.pitch": 5.0})) is None
+    assert rubio2022_domain(make_scene(correction="full")) is None
+    assert rubio2022_domain(make_scene(correction="tilt2d", **{"ship.heading": 30.0})) is None
+    assert rubio2022_domain(make_scene(correction="yaw", **{"lidar.azimuths": [0, 120, 240]})) is None
+    assert rubio2022_domain(make_scene(correction="yaw", **{"lidar.azimuths": [90, 0, 270, 180],
+                                                             "lidar.vertical_beam": True})) == "i"
