@@ -127,7 +127,8 @@ def load_scenario(path_or_mapping, overrides=None):
     else:
         source = str(path_or_mapping)
         raw = _read_yaml(Path(path_or_mapping))
-        raw.setdefault("name", Path(path_or_mapping).stem)
+        if isinstance(raw, dict):
+            raw.setdefault("name", Path(path_or_mapping).stem)
     if not isinstance(raw, dict):
         raise ScenarioError(source, "", "a scenario must be a mapping of the top-level keys "
                             f"{', '.join(DEFAULTS)}")
