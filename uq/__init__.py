@@ -4,6 +4,7 @@ Public API (CONTRACT.md): :func:`load_scenario`, :func:`run`, :func:`propagate`.
 """
 __version__ = "0.1.0"
 
+from . import complexstep  # noqa: E402
 from .errors import ScenarioError  # noqa: E402
 from .inputs import Input  # noqa: E402
 from .pipeline import run  # noqa: E402

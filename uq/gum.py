@@ -54,7 +54,11 @@ def complex_step_jacobian(model, input_set):
     arrays = {name: perturbed[:, input_set.offsets[name]:
                               input_set.offsets[name] + means[name].size]
               .reshape((k,) + input_set.shapes[name]) for name in input_set.names}
-    outputs = model(**arrays, **input_set.constants)
+    try:
+        outputs = model(**arrays, **input_set.constants)
+    except TypeError as error:
+        raise NotComplexStepSafe(f"the model cannot be evaluated at complex inputs ({error}); "
+                                 "write it with analytic operations or uq.complexstep") from None
     value, jacobian = {}, {}
     for q, out in outputs.items():
         out = np.asarray(out)
@@ -62,6 +66,10 @@ def complex_step_jacobian(model, input_set):
         scale = steps.reshape((k,) + (1,) * (out.ndim - 1))
         jacobian[q] = np.imag(out) / scale if np.iscomplexobj(out) else np.zeros(out.shape)
     return value, jacobian
+
+
+class NotComplexStepSafe(TypeError):
+    """The model rejects complex input, so its exact Jacobian cannot be taken."""
 
 
 def _batch(input_set, means, n):

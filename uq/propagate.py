@@ -75,8 +75,14 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     inputs_laid = input_set(inputs, correlation)
     circular = set(circular)
     wrapped = _named_outputs(model)
-    gum_value, jacobian = gum.complex_step_jacobian(wrapped, inputs_laid)
-    references = {q: gum_value[q] if q in circular else None for q in gum_value}
+    try:
+        gum_value, jacobian = gum.complex_step_jacobian(wrapped, inputs_laid)
+        gum_note = "exact Jacobian by complex-step differentiation"
+    except gum.NotComplexStepSafe as error:
+        gum_value, jacobian = _no_gum(wrapped, inputs_laid)
+        gum_note = f"no GUM: {error}"
+    references = {q: _circular_reference(gum_value[q]) if q in circular else None
+                  for q in gum_value}
     runner = _Runner(wrapped, inputs_laid, method, seed, references, interval, chunk_size)
     if n is not None:
         runner.run_fixed(int(n))
@@ -87,8 +93,23 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
                        validation_digits)
     dataset.attrs.update(n_samples=runner.n_done, seed=seed, sampling_method=method,
                          digits=validation_digits, interval=interval,
-                         coverage_probability=COVERAGE_PROBABILITY)
+                         coverage_probability=COVERAGE_PROBABILITY, gum=gum_note)
     return dataset
+
+
+def _no_gum(model, inputs):
+    """NaN GUM results (shapes from one real evaluation) for models that are not
+    complex-step safe."""
+    means = {name: value[None] for name, value in inputs.means().items()}
+    outputs = model(**means, **inputs.constants)
+    value = {q: np.full(np.shape(v)[1:], np.nan) for q, v in outputs.items()}
+    return value, {q: np.full((inputs.dimension,) + np.shape(v)[1:], np.nan)
+                   for q, v in outputs.items()}
+
+
+def _circular_reference(value):
+    """Unwrapping reference of a circular output: the GUM value, or north if unknown."""
+    return np.where(np.isfinite(value), value, 0.0)
 
 
 def _check_arguments(n, digits, method, interval):
@@ -146,13 +167,17 @@ class _Runner:
                 for q, v in outputs.items()}
 
     def _accumulate(self, outputs):
+        """Statistics batch by batch; chunks start on block boundaries, so the sequence of
+        floating-point merges, and the result, is the same for every chunk size."""
         for q, values in outputs.items():
-            self.stats[q].update(values)
-            for start in range(0, len(values) - BATCH_SIZE + 1, BATCH_SIZE):
-                batch = batch_statistics(values[start:start + BATCH_SIZE],
-                                         self.references[q], kind=self.interval)
+            for start in range(0, len(values), BATCH_SIZE):
+                batch = values[start:start + BATCH_SIZE]
+                self.stats[q].update(batch)
+                if len(batch) < BATCH_SIZE:
+                    continue
+                summary = batch_statistics(batch, self.references[q], kind=self.interval)
                 for key in _BATCH_KEYS:
-                    self.batches[q][key].append(batch[key])
+                    self.batches[q][key].append(summary[key])
         self.n_done += len(next(iter(outputs.values())))
 
     def run_fixed(self, n):

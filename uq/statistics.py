@@ -63,14 +63,14 @@ def coverage_interval(smallest, largest, m, probability=COVERAGE_PROBABILITY,
     Returns
     -------
     low, high : float
-        NaN if M < 2.
+        NaN if M < 1 / (1 - p) (too few values for the interval: JCGM 101, 7.2.2) or if
+        fewer extreme values were kept than the ranks need.
     """
-    if m < 2:
-        return np.nan, np.nan
     q = _coverage_count(m, probability)
+    if m * (1 - probability) < 1 - 1e-9 or min(len(smallest), len(largest)) < m - q:
+        return np.nan, np.nan
     if kind == "symmetric":
         r = (m - q) // 2 if (m - q) % 2 == 0 else (m - q + 1) // 2
-        r = max(r, 1)
         return smallest[r - 1], largest[len(largest) - (m - (r + q)) - 1]
     lows = smallest[:m - q]                         # ranks 1 .. M - q
     highs = largest[len(largest) - (m - q):]        # ranks q + 1 .. M

@@ -1,0 +1,69 @@
+"""Streaming statistics equal their in-memory definitions."""
+import numpy as np
+import pytest
+
+from uq.statistics import (StreamingStatistics, coverage_interval, tail_capacity, unwrap)
+
+
+def direct_interval(values, p=0.95):
+    m = len(values)
+    s = np.sort(values)
+    q = int(np.floor(p * m + 0.5))
+    r = (m - q) // 2 if (m - q) % 2 == 0 else (m - q + 1) // 2
+    return s[r - 1], s[r + q - 1]
+
+
+@pytest.mark.parametrize("m", [20, 21, 40, 41, 1000, 12345])
+def test_symmetric_interval_is_jcgm101_ranks(m, rng):
+    values = rng.standard_normal(m)
+    s = np.sort(values)
+    assert coverage_interval(s, s, m) == direct_interval(values)
+
+
+@pytest.mark.parametrize("m", [1, 2, 19])
+def test_no_interval_from_too_few_values(m):
+    assert np.isnan(coverage_interval(np.arange(m), np.arange(m), m)).all()
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 100, 5000])
+def test_streaming_equals_in_memory(chunk, rng):
+    values = rng.gamma(2.0, size=(10_000, 2))
+    stats = StreamingStatistics((2,), tail_capacity(len(values)) + 1)
+    for start in range(0, len(values), chunk):
+        stats.update(values[start:start + chunk])
+    result = stats.result()
+    np.testing.assert_allclose(result["mean"], values.mean(axis=0), rtol=1e-13)
+    np.testing.assert_allclose(result["u"], values.std(axis=0, ddof=1), rtol=1e-12)
+    for j in range(2):
+        assert (result["low"][j], result["high"][j]) == direct_interval(values[:, j])
+
+
+def test_shortest_interval(rng):
+    values = rng.exponential(size=4000)
+    stats = StreamingStatistics((), tail_capacity(4000))
+    stats.update(values)
+    low, high = stats.result(kind="shortest")["low"], stats.result(kind="shortest")["high"]
+    s = np.sort(values)
+    q = int(np.floor(0.95 * 4000 + 0.5))
+    widths = s[q:] - s[:4000 - q]
+    assert high - low == pytest.approx(widths.min())
+
+
+def test_moments_stay_accurate_with_a_large_offset(rng):
+    values = 1e8 + rng.standard_normal(200_000)
+    stats = StreamingStatistics((), 10)
+    for chunk in np.split(values, 100):
+        stats.update(chunk)
+    assert stats.result()["u"] == pytest.approx(values.std(ddof=1), rel=1e-7)
+
+
+def test_unwrap():
+    np.testing.assert_allclose(unwrap(np.array([359.0, 1.0, 180.0]), 0.0), [-1.0, 1.0, 180.0])
+    np.testing.assert_allclose(unwrap(np.array([1.0]), 359.0), [361.0])
+
+
+def test_nan_excluded_and_counted():
+    stats = StreamingStatistics((), 100)
+    stats.update(np.array([1.0, np.nan, 3.0]))
+    result = stats.result()
+    assert result["n_valid"] == 2 and result["mean"] == 2.0
