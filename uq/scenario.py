@@ -151,8 +151,13 @@ def _read_yaml(path):
 
 
 def _assign(raw, dotted, value, source):
-    """Set raw[a][b]... = value for 'a.b...', creating mappings on the way."""
+    """Set raw[a][b]... = value for 'a.b...', creating mappings on the way.
+
+    ``sweep.<dotted key>`` sets the sweep of that (dotted) key.
+    """
     parts = dotted.split(".")
+    if parts[0] == "sweep" and len(parts) > 1:
+        parts = ["sweep", ".".join(parts[1:])]
     node = raw
     for part in parts[:-1]:
         child = node.get(part) if isinstance(node, dict) else None
