@@ -23,7 +23,8 @@ References
 import numpy as np
 from scipy.special import ndtri
 
-from .constants import COMPLEX_STEP, COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG
+from .constants import COMPLEX_STEP, COVERAGE_PROBABILITY
+from .statistics import unwrap
 
 
 def complex_step_jacobian(model, input_set):
@@ -114,8 +115,7 @@ def gum_interval_valid(estimate, u, low, high, digits, circular=False,
     d_low = estimate - k * u - low
     d_high = estimate + k * u - high
     if circular:
-        d_low = np.mod(d_low + HALF_CIRCLE_DEG, FULL_CIRCLE_DEG) - HALF_CIRCLE_DEG
-        d_high = np.mod(d_high + HALF_CIRCLE_DEG, FULL_CIRCLE_DEG) - HALF_CIRCLE_DEG
+        d_low, d_high = unwrap(d_low, 0.0), unwrap(d_high, 0.0)
     delta = numerical_tolerance(u, digits)
     with np.errstate(invalid="ignore"):
         return (np.abs(d_low) <= delta) & (np.abs(d_high) <= delta)

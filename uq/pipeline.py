@@ -14,14 +14,13 @@ import xarray as xr
 from . import __version__
 from .distributions import error_distribution
 from .inputs import Input
-from .measurement import Scene, measurement_model, true_values
+from .measurement import ANGULAR_NAVIGATION, Scene, measurement_model, true_values
 from .metadata import COORDINATES, QUANTITIES, variable_attributes
 from .propagate import propagate
 from .rubio2022 import rubio2022_scene_uncertainty
 from .sampling import new_seed
 from .scenario import INS_KEYS, load_scenario
-
-ANGULAR_INS = ("heading", "pitch", "roll", "cog")
+from .statistics import unwrap
 
 
 def run(scenario, progress=None):
@@ -124,7 +123,7 @@ def _scene_dataset(scene, settings, outputs, engine):
         data[f"{q}_paper_u"] = (dims, paper[q])
         bias = engine[f"{q}_mc_mean"].values - truth[q]
         if q == "wind_direction":
-            bias = np.mod(bias + 180.0, 360.0) - 180.0
+            bias = unwrap(bias, 0.0)
         data[f"{q}_mc_bias"] = (dims, bias)
     ds = engine.assign(data)
     ds = ds.assign_coords(input=[input_label(name) for name in ds["input"].values],
@@ -140,7 +139,8 @@ def _paper_uncertainty(scene, settings, gate_speeds):
     """Rubio & Gottschall (2022) u per output; NaN outside their model."""
     ins = settings["ins"]
     u = {key: _standard_uncertainty(ins.get(key)) for key in INS_KEYS}
-    u = {key: np.deg2rad(value) if key in ANGULAR_INS else value for key, value in u.items()}
+    u = {key: np.deg2rad(value) if key in ANGULAR_NAVIGATION else value
+         for key, value in u.items()}
     per_gate = [rubio2022_scene_uncertainty(scene, speed, u["heading"], u["pitch"], u["roll"],
                                             u["sog"], u["cog"]) for speed in gate_speeds]
     return {"wind_speed": np.array([g["wind_speed"] for g in per_gate]),

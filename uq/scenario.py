@@ -66,8 +66,6 @@ class Scenario:
         Dotted key and its values, in file order (outer product).
     source : str
         File path or ``<mapping>``, for messages.
-    text : str
-        The scenario as YAML text (as run).
     """
 
     name: str
@@ -75,7 +73,11 @@ class Scenario:
     settings: dict
     sweep: tuple
     source: str
-    text: str
+
+    @property
+    def text(self):
+        """The scenario as YAML text (as run), defaults filled in."""
+        return yaml.safe_dump(self.settings, sort_keys=False)
 
     def get(self, dotted):
         """Value at a dotted key, e.g. ``wind.direction``."""
@@ -92,7 +94,7 @@ class Scenario:
         settings = _validate(raw, self.source)
         settings["sweep"] = copy.deepcopy(self.settings["sweep"])
         return Scenario(settings["name"], settings["description"], settings, self.sweep,
-                        self.source, yaml.safe_dump(settings, sort_keys=False))
+                        self.source)
 
     @property
     def outputs(self):
@@ -173,8 +175,7 @@ def _build(raw, source):
     settings = _validate(raw, source)
     sweep = _validate_sweep(raw.get("sweep"), settings, source)
     settings["sweep"] = {key: list(values) for key, values in sweep}
-    text = yaml.safe_dump(settings, sort_keys=False)
-    return Scenario(settings["name"], settings["description"], settings, sweep, source, text)
+    return Scenario(settings["name"], settings["description"], settings, sweep, source)
 
 
 def _validate(raw, source):
