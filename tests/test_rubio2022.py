@@ -197,3 +197,72 @@ def test_domain():
     assert rubio2022_domain(make_scene(correction="yaw", **{"lidar.azimuths": [0, 120, 240]})) is None
     assert rubio2022_domain(make_scene(correction="yaw", **{"lidar.azimuths": [90, 0, 270, 180],
                                                              "lidar.vertical_beam": True})) == "i"
+
+
+def paper_by_complex_step(scene, u):
+    """The paper's model rebuilt from Eqs. 6/7 and 13-18 alone: u(v_i) from complex-step
+    derivatives of the radial velocity with respect to the INS angles, then Eqs. 19-20
+    with complex-step derivatives of the reconstruction. Independent of Eq. 8/12, A.*."""
+    speed, cog, sog, cone = scene.wind_speed, scene.cog, scene.sog, scene.half_cone
+    if scene.correction == "yaw":
+        angles = {"yaw": scene.heading + scene.misalignment}
+        radial = lambda a, s, c: rubio2022_radial_velocity_case_i(   # noqa: E731
+            speed, scene.wind_direction, s, c, a["yaw"], cone, RUBIO2022_AZIMUTHS)
+        recon = lambda v: rubio2022_reconstruction(v, sog, cog, cone, yaw=angles["yaw"])  # noqa: E731
+        u_angles = {"yaw": u["heading"]}
+    else:
+        _, delta, beta = rubio2022_angles_from_attitude(0.0, scene.pitch, scene.roll)
+        angles = {"delta": delta, "beta": beta}
+        radial = lambda a, s, c: rubio2022_radial_velocity_case_ii(  # noqa: E731
+            speed, scene.wind_direction, s, c, a["delta"], a["beta"], cone, RUBIO2022_AZIMUTHS)
+        recon = lambda v: rubio2022_reconstruction(v, sog, cog, cone, delta=delta, beta=beta)  # noqa: E731
+        u_angles = {"delta": u["pitch"], "beta": u["roll"]}
+    variance = np.zeros(4)
+    for name, u_angle in u_angles.items():
+        shifted = {**angles, name: angles[name] + 1j * H}
+        variance += (np.imag(radial(shifted, sog, cog)) / H * u_angle) ** 2
+    variance += (np.imag(radial(angles, sog + 1j * H, cog)) / H * u["sog"]) ** 2
+    variance += (np.imag(radial(angles, sog, cog + 1j * H)) / H * u["cog"]) ** 2
+    sens = wind_derivatives(radial(angles, sog, cog), recon)
+    return (np.sqrt(np.sum(sens[0] ** 2 * variance)),
+            np.rad2deg(np.sqrt(np.sum(sens[1] ** 2 * variance))), np.sqrt(variance))
+
+
+SCENES = [dict(correction="yaw", **{"ship.sog": 3.0, "ship.cog": 40.0, "ship.heading": 10.0,
+                                    "lidar.misalignment": 35.0, "wind.direction": 200.0}),
+          dict(correction="tilt2d", **{"ship.pitch": 6.0, "ship.roll": -8.0, "ship.sog": 2.0,
+                                       "ship.cog": 130.0, "wind.direction": 75.0}),
+          dict(correction="tilt2d", **{"ship.pitch": -10.0, "ship.roll": 10.0, "ship.sog": 4.0,
+                                       "wind.direction": 300.0, "lidar.half_cone": 15.0})]
+
+
+@pytest.mark.parametrize("changes", SCENES)
+def test_scene_uncertainty_equals_independent_evaluation(changes):
+    from uq.rubio2022 import rubio2022_scene_uncertainty
+    scene = make_scene(**changes)
+    u = {"heading": d(0.3), "pitch": d(0.2), "roll": d(0.1), "sog": 0.1, "cog": d(0.5)}
+    ours = rubio2022_scene_uncertainty(scene, scene.wind_speed, u["heading"], u["pitch"],
+                                       u["roll"], u["sog"], u["cog"])
+    speed, direction, radial = paper_by_complex_step(scene, u)
+    # both are exact first-order evaluations; 1e-10 leaves room for the sums of terms
+    np.testing.assert_allclose(ours["wind_speed"], speed, rtol=1e-10)
+    np.testing.assert_allclose(ours["wind_direction"], direction, rtol=1e-10)
+    np.testing.assert_allclose(ours["radial_velocity"], radial, rtol=1e-10)
+
+
+def test_scene_uncertainty_of_a_batch_equals_scene_by_scene():
+    import dataclasses
+    from uq.rubio2022 import rubio2022_scene_uncertainty
+    base = make_scene(correction="tilt2d", **{"ship.sog": 2.0})
+    fields = {"pitch": d(np.array([-10.0, 0.0, 4.0])), "roll": d(np.array([3.0, 0.0, -7.0])),
+              "wind_direction": d(np.array([10.0, 120.0, 350.0])),
+              "heading": d(np.array([0.0, 0.0, 30.0]))}           # the last is outside case ii
+    batch = rubio2022_scene_uncertainty(dataclasses.replace(base, **fields), 5.0,
+                                        0.001, 0.002, 0.003, 0.1, 0.002)
+    for i in range(3):
+        one = rubio2022_scene_uncertainty(
+            dataclasses.replace(base, **{k: v[i] for k, v in fields.items()}), 5.0,
+            0.001, 0.002, 0.003, 0.1, 0.002)
+        for q in one:   # same arithmetic element by element: equal to rounding
+            np.testing.assert_allclose(batch[q][i], one[q], rtol=1e-14)
+    assert np.isnan(batch["wind_speed"][2]) and np.all(np.isnan(batch["radial_velocity"][2]))

@@ -57,12 +57,12 @@ def least_squares_operator(unit_vectors):
 
     Parameters
     ----------
-    unit_vectors : ndarray, shape (n_beams, 3)
+    unit_vectors : ndarray, shape (..., n_beams, 3)
         Needs at least three beams that span three dimensions.
 
     Returns
     -------
-    ndarray, shape (3, n_beams)
+    ndarray, shape (..., 3, n_beams)
 
     Raises
     ------
@@ -70,7 +70,7 @@ def least_squares_operator(unit_vectors):
         If the beams do not determine all three wind components.
     """
     a = np.asarray(unit_vectors, dtype=float)
-    if a.shape[0] < 3 or np.linalg.matrix_rank(a) < 3:
+    if a.shape[-2] < 3 or np.any(np.linalg.matrix_rank(a) < 3):
         raise ValueError("the beams do not determine the 3-D wind: need >= 3 beams "
                          "that are not coplanar")
     return np.linalg.pinv(a)
@@ -83,12 +83,21 @@ def slant_distances(range_heights, half_cone, n_slanted, vertical_beam):
     slanted beam at the slant distance ``h / cos(half_cone)`` using its configured
     (nominal) half-cone, and that of the vertical beam at ``h``.
 
+    Parameters
+    ----------
+    range_heights : array_like, shape (n_gates,)
+        [m].
+    half_cone : array_like, shape S
+        Configured half-cone [rad] (S: scenes, may be empty).
+
     Returns
     -------
-    ndarray, shape (n_beams, n_gates)
+    ndarray, shape (*S, n_beams, n_gates)
     """
     heights = np.asarray(range_heights, dtype=float)
-    slanted = np.broadcast_to(heights / np.cos(half_cone), (n_slanted, heights.size))
+    cone = np.asarray(half_cone)[..., None, None]
+    slanted = np.broadcast_to(heights / np.cos(cone), cone.shape[:-2] + (n_slanted, heights.size))
     if vertical_beam:
-        return np.vstack([slanted, heights[None, :]])
+        vertical = np.broadcast_to(heights, cone.shape[:-2] + (1, heights.size))
+        return np.concatenate([slanted, vertical], axis=-2)
     return np.array(slanted)

@@ -39,3 +39,9 @@ FULL_CIRCLE_DEG = 360.0
 
 #: Half circle [deg]: the unwrapping window of circular outputs is reference +- this.
 HALF_CIRCLE_DEG = 180.0
+
+#: Trial x scene x beam x gate elements of one vectorised sweep evaluation [1]. With a
+#: few dozen float64 (or complex, for the GUM) temporaries of that size alive at once,
+#: 2^20 keeps one evaluation near 200 MB, and large enough that the per-call overhead
+#: (~1 ms) is small against the arithmetic.
+SWEEP_CHUNK_ELEMENTS = 2**20

@@ -81,16 +81,16 @@ def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navig
     radial_velocity : ndarray, shape (..., n_beams, n_gates)
         Measured radial velocities [m s-1].
     model : {"none", "yaw", "tilt2d", "full"}
-    lidar_unit_vectors : ndarray, shape (n_beams, 3)
-        Nominal beam vectors in the lidar/ship frame.
-    operator : ndarray, shape (3, n_beams)
+    lidar_unit_vectors : ndarray, shape (*S, n_beams, 3)
+        Nominal beam vectors in the lidar/ship frame (S: scenes, may be empty).
+    operator : ndarray, shape (*S, 3, n_beams)
         Least-squares operator of `lidar_unit_vectors`
         (:func:`uq.beams.least_squares_operator`).
     navigation : dict of ndarray, each shape (..., k)
         INS readings ``heading``, ``pitch``, ``roll`` [rad], ``sog`` [m s-1], ``cog``
         [rad], ``heave`` [m s-1]; k = 1 (scan) or n_beams (beam, point-wise).
-    nominal_heading : float
-        Heading assumed by ``none`` [rad].
+    nominal_heading : float or ndarray
+        Heading assumed by ``none`` [rad], broadcastable to the navigation arrays.
 
     Returns
     -------
@@ -131,7 +131,7 @@ def _horizontal_rotation(rotation, lidar_wind, ship_velocity):
 
 def _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship_velocity):
     """Least squares on point-wise corrected beams, each with its own reading."""
-    beams = (rotation @ lidar_unit_vectors[:, :, None])[..., 0]    # (..., b, 3)
+    beams = (rotation @ lidar_unit_vectors[..., None])[..., 0]     # (..., b, 3)
     ship_along_beam = np.sum(beams * ship_velocity, axis=-1)       # (..., b)
     corrected = radial_velocity + ship_along_beam[..., None]       # (..., b, g)
     beams_t = np.swapaxes(beams, -1, -2)                           # (..., 3, b)

@@ -25,7 +25,12 @@ shear; the heights follow from the attitude). Reconstruction uses the INS readin
 (:mod:`uq.correction`).
 
 The function is vectorised over samples and complex-step safe, so the GUM Jacobian is
-exact (:mod:`uq.gum`).
+exact (:mod:`uq.gum`). It is also vectorised over *scenes*: the numeric fields of a
+:class:`Scene` may be arrays of one common shape S (a batch of scenes that share their
+structure: beams, gates, correction). Outputs then have shape (n, *S, ...), and every
+scene sees the same error draws (common random numbers). Quantities that do not depend
+on the errors (nominal beam vectors, least-squares operator, slant distances) are
+computed once per scene, not per sample.
 """
 from dataclasses import dataclass
 
@@ -36,6 +41,9 @@ from .beams import beam_unit_vectors, least_squares_operator, slant_distances
 from .correction import correction_rotation, correction_ship_velocity, reconstruct_wind
 from .rotation import attitude_matrix
 
+SCENE_FIELDS = ("wind_speed", "wind_direction", "vertical_wind", "shear", "reference_height",
+                "sog", "cog", "heading", "pitch", "roll", "heave", "lidar_height",
+                "half_cone", "misalignment")
 OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity")
 NAVIGATION = ("heading", "pitch", "roll", "sog", "cog", "heave")
 ANGULAR_NAVIGATION = ("heading", "pitch", "roll", "cog")
@@ -93,6 +101,17 @@ class Scene:
     correction: str
 
     @property
+    def shape(self):
+        """Shape S of a batch of scenes (``()`` for one scene)."""
+        return np.broadcast(*[getattr(self, name) for name in SCENE_FIELDS]).shape
+
+    def field(self, name, trailing=0):
+        """A numeric field shaped ``S + (1,) * trailing``, to broadcast against data of
+        shape (..., *S, *trailing)."""
+        value = np.asarray(getattr(self, name))
+        return value if value.ndim == 0 else np.reshape(value, self.shape + (1,) * trailing)
+
+    @property
     def n_beams(self):
         return len(self.azimuths) + int(self.vertical_beam)
 
@@ -102,16 +121,18 @@ class Scene:
                                  self.misalignment, self.vertical_beam)
 
     def gate_heights(self):
-        """Nominal measurement heights above sea level [m], shape (n_gates,)."""
-        return self.lidar_height + np.asarray(self.ranges, dtype=float)
+        """Nominal measurement heights above sea level [m], shape (*S, n_gates)."""
+        return self.field("lidar_height", 1) + np.asarray(self.ranges, dtype=float)
 
 
-def true_wind(scene, heights):
-    """True wind (north, east, up) [m s-1] at `heights` [m]; shape heights.shape + (3,)."""
-    speed = wind.power_law_speed(scene.wind_speed, heights, scene.reference_height,
-                                 scene.shear)
-    north, east = wind.wind_components(speed, complexstep.degrees(scene.wind_direction))
-    up = np.zeros_like(north) + scene.vertical_wind
+def true_wind(scene, heights, trailing=1):
+    """True wind (north, east, up) [m s-1] at `heights` [m] of shape (..., *S, *T) with
+    `trailing` = len(T) dimensions after the scenes'; shape heights.shape + (3,)."""
+    field = lambda name: scene.field(name, trailing)       # noqa: E731
+    speed = wind.power_law_speed(field("wind_speed"), heights, field("reference_height"),
+                                 field("shear"))
+    north, east = wind.wind_components(speed, complexstep.degrees(field("wind_direction")))
+    up = np.zeros_like(north) + field("vertical_wind")
     return np.stack([north, east, up], axis=-1)
 
 
@@ -121,9 +142,9 @@ def true_radial_velocity(scene, beams_earth, ship_velocity):
     Parameters
     ----------
     scene : Scene
-    beams_earth : ndarray, shape (..., n_beams, 3)
+    beams_earth : ndarray, shape (..., *S, n_beams, 3)
         True earth-frame beam unit vectors.
-    ship_velocity : ndarray, shape (3,)
+    ship_velocity : ndarray, shape (*S, 3)
         True ship velocity (north, east, up) [m s-1].
 
     Returns
@@ -134,11 +155,11 @@ def true_radial_velocity(scene, beams_earth, ship_velocity):
         ``n . u_wind(z)``, the motion-free radial wind.
     """
     slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
-                            scene.vertical_beam)                        # (b, g)
-    heights = scene.lidar_height + slant * beams_earth[..., 2:3]        # (..., b, g)
-    wind_vector = true_wind(scene, heights)                             # (..., b, g, 3)
+                            scene.vertical_beam)                        # (*S, b, g)
+    heights = scene.field("lidar_height", 2) + slant * beams_earth[..., 2:3]  # (..., *S, b, g)
+    wind_vector = true_wind(scene, heights, trailing=2)                 # (..., *S, b, g, 3)
     wind_only = np.sum(beams_earth[..., None, :] * wind_vector, axis=-1)
-    ship_along = beams_earth @ np.asarray(ship_velocity)                # (..., b)
+    ship_along = np.sum(beams_earth * np.asarray(ship_velocity)[..., None, :], axis=-1)
     return wind_only - ship_along[..., None], wind_only
 
 
@@ -149,19 +170,23 @@ def measurement_model(scene, outputs=OUTPUTS, **errors):
     -------
     dict
         ``wind_speed`` [m s-1], ``wind_direction`` [deg], ``vertical_wind`` [m s-1], each
-        shape (n, n_gates); ``radial_velocity`` [m s-1] (n, n_beams, n_gates), the
+        shape (n, *S, n_gates); ``radial_velocity`` [m s-1] (n, *S, n_beams, n_gates), the
         motion-corrected radial velocity along the beam the correction believes in.
     """
     n = _sample_count(errors)
-    err = {name: np.asarray(errors.get(name, 0.0)) for name in _ERROR_NAMES}
-    for name in _ERROR_NAMES[:len(NAVIGATION)]:     # INS errors to shape (n, k)
-        value = err[name]
-        err[name] = value[:, None] if value.ndim == 1 else value + np.zeros((n, 1))
-    measured, navigation = _measure(scene, err, n)
+    scenes = (1,) * len(scene.shape)                 # scene axes follow the sample axis
+    err = {}
+    for name in _ERROR_NAMES:
+        value = np.asarray(errors.get(name, 0.0))
+        if name.startswith("ins_"):                  # INS errors to shape (n, *1, k)
+            value = value[:, None] if value.ndim == 1 else value + np.zeros((n, 1))
+        err[name] = value.reshape(value.shape[:1] + scenes + value.shape[1:]) \
+            if value.ndim else value
+    measured, navigation = _measure(scene, err, (n,) + scenes)
     unit_vectors = scene.nominal_unit_vectors()
     operator = least_squares_operator(unit_vectors)
     wind_vector = reconstruct_wind(measured, scene.correction, unit_vectors, operator,
-                                   navigation, scene.heading)
+                                   navigation, scene.field("heading", 1))
     return _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors)
 
 
@@ -174,23 +199,29 @@ def _sample_count(errors):
     return max(sizes) if sizes else 1
 
 
-def _measure(scene, err, n):
+def _measure(scene, err, batch):
     """True radial velocities plus noise, and the INS readings (true + error)."""
-    half_cone = scene.half_cone + complexstep.radians(err["lidar_half_cone"]) + np.zeros(n)
-    misalignment = scene.misalignment + complexstep.radians(err["lidar_misalignment"]) + np.zeros(n)
+    zero = np.zeros(batch)                                                 # (n, *1)
+    half_cone = scene.half_cone + complexstep.radians(err["lidar_half_cone"]) + zero
+    misalignment = scene.misalignment + complexstep.radians(err["lidar_misalignment"]) + zero
     true_beams = beam_unit_vectors(half_cone, np.asarray(scene.azimuths), misalignment,
-                                   scene.vertical_beam)                    # (n, b, 3)
-    attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
+                                   scene.vertical_beam)                    # (n, *S, b, 3)
+    attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)    # (*S, 3, 3)
     beams_earth = true_beams @ np.swapaxes(attitude, -1, -2)
-    ship = (scene.sog * np.cos(scene.cog), scene.sog * np.sin(scene.cog), scene.heave)
-    radial, _ = true_radial_velocity(scene, beams_earth, ship)
+    radial, _ = true_radial_velocity(scene, beams_earth, _ship_velocity(scene))
     measured = radial + err["lidar_radial_velocity"]
     navigation = {}
     for key in NAVIGATION:
         error = err[f"ins_{key}"]
         error = complexstep.radians(error) if key in ANGULAR_NAVIGATION else error
-        navigation[key] = getattr(scene, key) + error
+        navigation[key] = scene.field(key, 1) + error                     # (n, *S, k)
     return measured, navigation
+
+
+def _ship_velocity(scene):
+    """True ship velocity (north, east, up) [m s-1], shape (*S, 3)."""
+    sog, cog, heave = np.broadcast_arrays(scene.sog, scene.cog, scene.heave)
+    return np.stack([sog * np.cos(cog), sog * np.sin(cog), heave], axis=-1)
 
 
 def _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors):
@@ -212,9 +243,9 @@ def _corrected_radial(scene, measured, navigation, unit_vectors):
     """Radial velocity freed of the believed ship motion, along the believed beam."""
     nav = navigation
     rotation = correction_rotation(scene.correction, nav["heading"], nav["pitch"],
-                                   nav["roll"], scene.heading)
+                                   nav["roll"], scene.field("heading", 1))
     ship = correction_ship_velocity(scene.correction, nav["sog"], nav["cog"], nav["heave"])
-    beams = (rotation @ unit_vectors[:, :, None])[..., 0]              # (n, k|b, 3)
+    beams = (rotation @ unit_vectors[..., None])[..., 0]               # (n, *S, k|b, 3)
     return measured + np.sum(beams * ship, axis=-1)[..., None]
 
 
@@ -224,15 +255,16 @@ def true_values(scene):
     Returns
     -------
     dict
-        ``wind_speed``, ``wind_direction`` [deg], ``vertical_wind``, shape (n_gates,);
-        ``radial_velocity`` (n_beams, n_gates): the motion-free radial wind along the
+        ``wind_speed``, ``wind_direction`` [deg], ``vertical_wind``, shape (*S, n_gates);
+        ``radial_velocity`` (*S, n_beams, n_gates): the motion-free radial wind along the
         true beams at their true heights.
     """
     wind_vector = true_wind(scene, scene.gate_heights())
     attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
-    beams_earth = scene.nominal_unit_vectors() @ attitude.T
-    _, wind_only = true_radial_velocity(scene, beams_earth, np.zeros(3))
-    return {"wind_speed": wind.wind_speed(wind_vector[:, 0], wind_vector[:, 1]),
-            "wind_direction": wind.wind_direction(wind_vector[:, 0], wind_vector[:, 1]),
-            "vertical_wind": wind_vector[:, 2],
+    beams_earth = scene.nominal_unit_vectors() @ np.swapaxes(attitude, -1, -2)
+    _, wind_only = true_radial_velocity(scene, beams_earth, np.zeros(scene.shape + (3,)))
+    north, east = wind_vector[..., 0], wind_vector[..., 1]
+    return {"wind_speed": wind.wind_speed(north, east),
+            "wind_direction": wind.wind_direction(north, east),
+            "vertical_wind": wind_vector[..., 2],
             "radial_velocity": wind_only}

@@ -5,7 +5,6 @@ inputs, and run the measurement model through :func:`uq.propagate`; add the true
 the error-free reconstruction and the Rubio & Gottschall (2022) model. Every scene uses
 the same seed, and so the same underlying draws (common random numbers).
 """
-import itertools
 import time
 
 import numpy as np
@@ -14,16 +13,17 @@ import xarray as xr
 from . import __version__
 from .distributions import error_distribution
 from .inputs import Input
-from .measurement import ANGULAR_NAVIGATION, Scene, measurement_model, true_values
+from .measurement import ANGULAR_NAVIGATION, OUTPUTS, Scene, measurement_model, true_values
 from .metadata import COORDINATES, QUANTITIES, variable_attributes
 from .propagate import propagate
 from .rubio2022 import rubio2022_scene_uncertainty
 from .sampling import new_seed
 from .scenario import INS_KEYS, load_scenario
 from .statistics import unwrap
+from .sweep import batch_scene, group_assignments, sweep_plan, vector_fields
 
 
-def run(scenario, progress=None):
+def run(scenario, progress=None, *, client=None, checkpoint=None):
     """Run a scenario and return its results.
 
     Parameters
@@ -31,7 +31,11 @@ def run(scenario, progress=None):
     scenario : Scenario, dict, str or pathlib.Path
         Anything :func:`uq.load_scenario` accepts.
     progress : callable, optional
-        Called as ``progress(done, total)`` after each scene.
+        Called as ``progress(done, total)`` after each chunk of scenes.
+    client : dask.distributed.Client, optional
+        Compute the chunks on this dask cluster; the result is identical to a local run.
+    checkpoint : uq.checkpoint.Checkpoint, optional
+        Keeps finished chunks on disk and reuses those it already has (``--resume``).
 
     Returns
     -------
@@ -40,18 +44,51 @@ def run(scenario, progress=None):
     """
     started = time.perf_counter()
     scenario = load_scenario(scenario)
-    sampling = scenario.sampling
-    seed = sampling["seed"] if sampling["seed"] is not None else new_seed()
-    keys = [key for key, _ in scenario.sweep]
-    grid = list(itertools.product(*[values for _, values in scenario.sweep]))
-    scenes = []
-    for done, point in enumerate(grid, start=1):
-        scenes.append(run_scene(scenario.with_values(dict(zip(keys, point))), seed))
-        if progress:
-            progress(done, len(grid))
-    dataset = _combine(scenes, scenario.sweep)
+    seed = scenario.sampling["seed"]
+    if seed is None:
+        seed = checkpoint.seed if checkpoint and checkpoint.seed is not None else new_seed()
+    plan = sweep_plan(scenario)
+    if checkpoint:
+        checkpoint.start(scenario, seed, len(plan.chunks))
+    results = _compute(scenario, plan, seed, progress, client, checkpoint)
+    dataset = _assemble(scenario, plan, results)
     dataset.attrs.update(_global_attributes(scenario, seed, dataset, started))
     return dataset
+
+
+def _compute(scenario, plan, seed, progress, client, checkpoint):
+    """Results of every chunk, by index: from the checkpoint, else computed."""
+    results = checkpoint.load() if checkpoint else {}
+    todo = [chunk for chunk in plan.chunks if chunk.index not in results]
+    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed)) for chunk in todo) \
+        if client is None else _distributed(client, scenario, plan, todo, seed)
+    if progress and results:
+        progress(len(results), len(plan.chunks))
+    for index, dataset in finished:
+        results[index] = dataset
+        if checkpoint:
+            checkpoint.save(index, dataset)
+        if progress:
+            progress(len(results), len(plan.chunks))
+    return results
+
+
+def _distributed(client, scenario, plan, chunks, seed):
+    """Chunks on a dask cluster, yielded as they finish."""
+    from dask.distributed import as_completed
+    futures = {client.submit(run_chunk, scenario, plan, chunk, seed, pure=False): chunk.index
+               for chunk in chunks}
+    for future in as_completed(futures):
+        yield futures[future], future.result()
+
+
+def run_chunk(scenario, plan, chunk, seed):
+    """Results of one chunk of scenes: a Dataset with a ``scene`` dimension."""
+    if plan.group_keys:
+        scenario = scenario.with_values(group_assignments(scenario, plan, chunk.group))
+    base = scene_from_settings(scenario.settings)
+    fields = vector_fields(scenario, plan, chunk) or {"wind_speed": np.array([base.wind_speed])}
+    return run_scene(scenario, batch_scene(base, fields), seed)
 
 
 def scene_from_settings(settings):
@@ -90,10 +127,9 @@ def input_label(name):
     return f"ins.{key}" if section == "ins" else f"lidar.errors.{key}"
 
 
-def run_scene(scenario, seed):
-    """Results of one scene (no sweep dimensions)."""
+def run_scene(scenario, scene, seed):
+    """Results of a batch of scenes (dimension ``scene``) that share `scenario`'s structure."""
     settings = scenario.settings
-    scene = scene_from_settings(settings)
     outputs = scenario.outputs
     n_gates = len(scene.ranges)
     sampling = settings["sampling"]
@@ -104,11 +140,13 @@ def run_scene(scenario, seed):
     engine = propagate(model, error_inputs(settings, scene.n_beams, n_gates),
                        n=sampling.get("n"), digits=sampling.get("digits"),
                        method=sampling["method"], seed=seed, circular=("wind_direction",),
-                       output_dims={"wind_speed": ("range",), "wind_direction": ("range",),
-                                    "vertical_wind": ("range",),
-                                    "radial_velocity": ("beam", "range")},
+                       output_dims={q: _dims(q) for q in OUTPUTS},
                        interval=sampling["interval"], chunk_size=sampling.get("chunk_size"))
     return _scene_dataset(scene, settings, outputs, engine)
+
+
+def _dims(quantity):
+    return ("scene", "beam", "range") if quantity == "radial_velocity" else ("scene", "range")
 
 
 def _scene_dataset(scene, settings, outputs, engine):
@@ -117,21 +155,22 @@ def _scene_dataset(scene, settings, outputs, engine):
     paper = _paper_uncertainty(scene, settings, truth["wind_speed"])
     data = {}
     for q in outputs:
-        dims = ("beam", "range") if q == "radial_velocity" else ("range",)
+        dims = _dims(q)
         data[f"{q}_true"] = (dims, truth[q])
         data[f"{q}_nominal"] = (dims, np.real(nominal[q][0]))
         data[f"{q}_paper_u"] = (dims, paper[q])
-        bias = engine[f"{q}_mc_mean"].values - truth[q]
-        if q == "wind_direction":
-            bias = unwrap(bias, 0.0)
-        data[f"{q}_mc_bias"] = (dims, bias)
+        if f"{q}_mc_mean" in engine:
+            bias = engine[f"{q}_mc_mean"].values - truth[q]
+            if q == "wind_direction":
+                bias = unwrap(bias, 0.0)
+            data[f"{q}_mc_bias"] = (dims, bias)
     ds = engine.assign(data)
     ds = ds.assign_coords(input=[input_label(name) for name in ds["input"].values],
                           range=list(scene.ranges))
     if "beam" in ds.dims:
         azimuths = list(np.rad2deg(scene.azimuths)) + [np.nan] * int(scene.vertical_beam)
         ds = ds.assign_coords(beam=azimuths)
-    ds["mc_n_samples"] = engine.attrs["n_samples"]
+    ds["mc_n_samples"] = ("scene", np.full(scene.shape, engine.attrs["n_samples"]))
     return ds
 
 
@@ -141,12 +180,11 @@ def _paper_uncertainty(scene, settings, gate_speeds):
     u = {key: _standard_uncertainty(ins.get(key)) for key in INS_KEYS}
     u = {key: np.deg2rad(value) if key in ANGULAR_NAVIGATION else value
          for key, value in u.items()}
-    per_gate = [rubio2022_scene_uncertainty(scene, speed, u["heading"], u["pitch"], u["roll"],
-                                            u["sog"], u["cog"]) for speed in gate_speeds]
-    return {"wind_speed": np.array([g["wind_speed"] for g in per_gate]),
-            "wind_direction": np.array([g["wind_direction"] for g in per_gate]),
-            "vertical_wind": np.full(len(gate_speeds), np.nan),
-            "radial_velocity": np.stack([g["radial_velocity"] for g in per_gate], axis=-1)}
+    per_gate = [rubio2022_scene_uncertainty(scene, gate_speeds[..., i], u["heading"],
+                                            u["pitch"], u["roll"], u["sog"], u["cog"])
+                for i in range(gate_speeds.shape[-1])]
+    return {q: np.stack([g[q] for g in per_gate], axis=-1) if q in per_gate[0]
+            else np.full(gate_speeds.shape, np.nan) for q in OUTPUTS}
 
 
 def _standard_uncertainty(spec):
@@ -156,25 +194,31 @@ def _standard_uncertainty(spec):
     return 0.0 if isinstance(dist, float) else float(dist.std())
 
 
-def _combine(scenes, sweep):
-    """Stack scenes along the sweep's dimensions (outer product, values in file order)."""
-    combined = scenes[0]
-    if sweep:
-        names = [key.replace(".", "_") for key, _ in sweep]
-        shape = tuple(len(values) for _, values in sweep)
-        data = {var: (tuple(names) + scenes[0][var].dims,
-                      np.stack([scene[var].values for scene in scenes]).reshape(
-                          shape + scenes[0][var].shape))
-                for var in scenes[0].data_vars}
-        coords = {name: list(values) for name, (_, values) in zip(names, sweep)}
-        coords.update({c: scenes[0][c] for c in scenes[0].coords})
-        combined = xr.Dataset(data, coords=coords)
-    if combined.sizes.get("range", 0) == 1:
-        combined = combined.squeeze("range")
-    return _annotate(combined, sweep)
+def _assemble(scenario, plan, results):
+    """Chunks (flat scenes, group-major) -> the grid, sweep dimensions in file order."""
+    first = results[plan.chunks[0].index]
+    names = {key: key.replace(".", "_") for key, _ in scenario.sweep}
+    grid_dims = tuple(names[k] for k in plan.group_keys + plan.vector_keys)
+    grid_shape = plan.group_shape + plan.vector_shape
+    data = {}
+    for var, template in first.data_vars.items():
+        axis = template.dims.index("scene")
+        values = np.concatenate([results[c.index][var].values for c in plan.chunks], axis=axis)
+        shape = values.shape[:axis] + grid_shape + values.shape[axis + 1:]
+        data[var] = (template.dims[:axis] + grid_dims + template.dims[axis + 1:],
+                     values.reshape(shape))
+    coords = {names[key]: list(values) for key, values in scenario.sweep}
+    coords.update({c: first[c] for c in first.coords})
+    coords.update({follower.replace(".", "_"): (names[leader], list(dict(scenario.sweep)[leader]))
+                   for follower, leader in scenario.links})
+    dataset = xr.Dataset(data, coords=coords)
+    dataset = dataset.transpose(*[names[key] for key, _ in scenario.sweep], ...)
+    if dataset.sizes.get("range", 0) == 1:
+        dataset = dataset.squeeze("range")
+    return _annotate(dataset, scenario)
 
 
-def _annotate(ds, sweep):
+def _annotate(ds, scenario):
     for name in ds.data_vars:
         quantity = next((q for q in QUANTITIES if name.startswith(q + "_")), None)
         if quantity:
@@ -183,8 +227,11 @@ def _annotate(ds, sweep):
     for name, attrs in COORDINATES.items():
         if name in ds.coords:
             ds[name].attrs.update(attrs)
-    for key, _ in sweep:
+    for key, _ in scenario.sweep:
         ds[key.replace(".", "_")].attrs["long_name"] = f"swept scenario key {key}"
+    for follower, leader in scenario.links:
+        ds[follower.replace(".", "_")].attrs["long_name"] = \
+            f"scenario key {follower}, linked to the swept key {leader}"
     return ds
 
 
@@ -195,6 +242,7 @@ def _global_attributes(scenario, seed, dataset, started):
             "uq_version": __version__,
             "sampling_method": scenario.sampling["method"],
             "n_samples": int(np.max(dataset["mc_n_samples"].values)),
+            "scenes": int(dataset["mc_n_samples"].size),
             "seed": seed,
             "correction": scenario.settings["correction"],
             "ins_correlation": scenario.settings["ins"]["correlation"],

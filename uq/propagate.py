@@ -16,7 +16,7 @@ from . import gum
 from .constants import (ADAPTIVE_MAX_SAMPLES, BATCH_SIZE, COVERAGE_PROBABILITY,
                         DEFAULT_BLOCKS_PER_CHUNK, DEFAULT_DIGITS, RNG_BLOCK_SIZE)
 from .inputs import input_set
-from .sampling import SAMPLING_METHODS, new_seed, normal_scores
+from .sampling import PROPAGATION_METHODS, new_seed, normal_scores
 from .statistics import INTERVALS, StreamingStatistics, batch_statistics, tail_capacity
 
 _BATCH_KEYS = ("mean", "u", "low", "high")
@@ -42,8 +42,8 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         Instead of `n`: adaptive sampling until mean, u and both interval endpoints are
         stable to this many significant digits of u (JCGM 101, 7.9). Also the digits of
         the GUM validation (default 2). With neither `n` nor `digits`, adaptive with 2.
-    method : {"mc", "lhs", "sobol"}
-        Sampler (:mod:`uq.sampling`).
+    method : {"mc", "lhs", "sobol", "none"}
+        Sampler (:mod:`uq.sampling`); ``none`` skips Monte Carlo (GUM results only).
     seed : int, numpy.random.Generator or None
         Same seed, same result, whatever `chunk_size`. None draws fresh entropy; the
         seed used is recorded in the result's ``seed`` attribute.
@@ -84,13 +84,16 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     references = {q: _circular_reference(gum_value[q]) if q in circular else None
                   for q in gum_value}
     runner = _Runner(wrapped, inputs_laid, method, seed, references, interval, chunk_size)
-    if n is not None:
+    if method == "none":
+        pass
+    elif n is not None:
         runner.run_fixed(int(n))
     else:
         runner.run_adaptive(digits or DEFAULT_DIGITS)
     validation_digits = digits or DEFAULT_DIGITS
-    dataset = _dataset(runner, gum_value, jacobian, inputs_laid, circular, output_dims or {},
-                       validation_digits)
+    dataset = _gum_dataset(gum_value, jacobian, inputs_laid, output_dims or {})
+    if runner.stats is not None:
+        dataset = dataset.assign(_mc_variables(runner, dataset, circular, validation_digits))
     dataset.attrs.update(n_samples=runner.n_done, seed=seed, sampling_method=method,
                          digits=validation_digits, interval=interval,
                          coverage_probability=COVERAGE_PROBABILITY, gum=gum_note)
@@ -119,8 +122,8 @@ def _check_arguments(n, digits, method, interval):
         raise ValueError(f"n must be >= 2, got {n}")
     if digits is not None and not 1 <= int(digits) <= 6:
         raise ValueError(f"digits must be an integer from 1 to 6, got {digits}")
-    if method not in SAMPLING_METHODS:
-        raise ValueError(f"method must be one of {SAMPLING_METHODS}, got {method!r}")
+    if method not in PROPAGATION_METHODS:
+        raise ValueError(f"method must be one of {PROPAGATION_METHODS}, got {method!r}")
     if interval not in INTERVALS:
         raise ValueError(f"interval must be one of {INTERVALS}, got {interval!r}")
 
@@ -224,28 +227,39 @@ class _Runner:
         return 2 * np.max(spread, axis=0)
 
 
-def _dataset(runner, gum_value, jacobian, inputs, circular, output_dims, digits):
+def _gum_dataset(gum_value, jacobian, inputs, output_dims):
+    """GUM value, u and budget of every output."""
     data = {}
-    coords = {"input": list(inputs.names)}
+    for q, value in gum_value.items():
+        dims = tuple(output_dims.get(q, [f"{q}_dim{i}" for i in range(np.ndim(value))]))
+        data.update({
+            f"{q}_gum_value": (dims, value),
+            f"{q}_gum_u": (dims, gum.combined_uncertainty(jacobian[q], inputs)),
+            f"{q}_budget": (("input",) + dims, gum.variance_budget(jacobian[q], inputs)),
+        })
+    return xr.Dataset(data, coords={"input": list(inputs.names)})
+
+
+def _mc_variables(runner, gum_results, circular, digits):
+    """Monte Carlo statistics of every output, and the clause 8 validation of the GUM."""
+    data = {}
     for q, stats in runner.stats.items():
-        dims = tuple(output_dims.get(q, [f"{q}_dim{i}" for i in range(len(stats.shape))]))
+        dims = gum_results[f"{q}_gum_u"].dims
+        value, u_gum = gum_results[f"{q}_gum_value"].values, gum_results[f"{q}_gum_u"].values
         result = stats.result(kind=runner.interval)
-        u_gum = gum.combined_uncertainty(jacobian[q], inputs)
+        error = runner.numerical_error(q)
         data.update({
             f"{q}_mc_mean": (dims, result["mean"]),
             f"{q}_mc_u": (dims, result["u"]),
             f"{q}_mc_low": (dims, result["low"]),
             f"{q}_mc_high": (dims, result["high"]),
             f"{q}_mc_n_invalid": (dims, runner.n_done - result["n_valid"]),
-            f"{q}_mc_numerical_error": (dims, runner.numerical_error(q)),
-            f"{q}_gum_value": (dims, gum_value[q]),
-            f"{q}_gum_u": (dims, u_gum),
+            f"{q}_mc_numerical_error": (dims, error),
             f"{q}_gum_valid": (dims, gum.gum_interval_valid(
-                gum_value[q], u_gum, result["low"], result["high"], digits, q in circular)),
-            f"{q}_gum_validation_conclusive": (dims, runner.numerical_error(q)
-                                               <= gum.numerical_tolerance(u_gum, digits)),
-            f"{q}_budget": (("input",) + dims, gum.variance_budget(jacobian[q], inputs)),
+                value, u_gum, result["low"], result["high"], digits, q in circular)),
+            f"{q}_gum_validation_conclusive": (dims, error <= gum.numerical_tolerance(u_gum,
+                                                                                     digits)),
         })
         if q in circular:
             data[f"{q}_mc_circular_std"] = (dims, result["circular_std"])
-    return xr.Dataset(data, coords=coords)
+    return data

@@ -175,12 +175,13 @@ def rubio2022_combined_uncertainty(sensitivities, radial_uncertainty):
 
 
 def rubio2022_scene_uncertainty(scene, speed, u_heading, u_pitch, u_roll, u_sog, u_cog):
-    """The paper's model for a :class:`uq.measurement.Scene` at one gate.
+    """The paper's model for a :class:`uq.measurement.Scene` (or a batch of scenes).
 
     Parameters
     ----------
     scene : uq.measurement.Scene
-    speed : float
+        Numeric fields scalars or arrays of the batch shape S.
+    speed : float or ndarray, shape S
         True horizontal wind speed at the gate [m s-1].
     u_heading, u_pitch, u_roll, u_cog : float
         Standard uncertainties of the INS angles [rad].
@@ -190,59 +191,87 @@ def rubio2022_scene_uncertainty(scene, speed, u_heading, u_pitch, u_roll, u_sog,
     Returns
     -------
     dict
-        ``wind_speed`` [m s-1], ``wind_direction`` [deg], ``radial_velocity`` [m s-1],
-        shape (n_beams,) in the scene's beam order (NaN for a vertical beam). All NaN
-        when the scene is outside the model (:func:`rubio2022_domain`).
+        ``wind_speed`` [m s-1], ``wind_direction`` [deg], shape S; ``radial_velocity``
+        [m s-1], shape (*S, n_beams) in the scene's beam order (NaN for a vertical beam).
+        NaN for the scenes outside the model (:func:`rubio2022_domain_mask`).
     """
+    shape = np.broadcast(speed, np.empty(scene.shape)).shape
     order = _beam_order(scene)
-    nan = {"wind_speed": np.nan, "wind_direction": np.nan,
-           "radial_velocity": np.full(scene.n_beams, np.nan)}
-    case = rubio2022_domain(scene)
-    if case is None:
-        return nan
-    args = (speed, scene.wind_direction, scene.sog, scene.cog)
-    if case == "i":
-        yaw = scene.heading + scene.misalignment
-        radial = rubio2022_radial_velocity_case_i(*args, yaw, scene.half_cone, RUBIO2022_AZIMUTHS)
-        u_radial = rubio2022_radial_velocity_uncertainty_case_i(
-            *args, yaw, scene.half_cone, RUBIO2022_AZIMUTHS, u_heading, u_sog, u_cog)
-        sens = rubio2022_wind_sensitivities_case_i(radial, speed, scene.wind_direction,
-                                                   scene.sog, scene.cog, yaw, scene.half_cone)
+    inside = rubio2022_domain_mask(scene) & np.ones(shape, dtype=bool)
+    result = {"wind_speed": np.full(shape, np.nan), "wind_direction": np.full(shape, np.nan),
+              "radial_velocity": np.full(shape + (scene.n_beams,), np.nan)}
+    if not inside.any():
+        return result
+    column = lambda value: np.asarray(value)[..., None]      # noqa: E731  against the beams
+    speed, direction, sog, cog, cone = (column(v) for v in (
+        speed, scene.wind_direction, scene.sog, scene.cog, scene.half_cone))
+    if scene.correction == "yaw":
+        u_radial, sens = _case_i(speed, direction, sog, cog, cone,
+                                 column(scene.heading + scene.misalignment),
+                                 u_heading, u_sog, u_cog)
     else:
         _, delta, beta = rubio2022_angles_from_attitude(0.0, scene.pitch, scene.roll)
-        radial = rubio2022_radial_velocity_case_ii(*args, delta, beta, scene.half_cone,
-                                                   RUBIO2022_AZIMUTHS)
-        u_radial = rubio2022_radial_velocity_uncertainty_case_ii(
-            *args, delta, beta, scene.half_cone, RUBIO2022_AZIMUTHS, u_pitch, u_roll,
-            u_sog, u_cog)
-        north, east = rubio2022_reconstruction(radial, scene.sog, scene.cog, scene.half_cone,
-                                               delta=delta, beta=beta)
-        speed_rec, direction_rec = np.hypot(north, east), np.arctan2(-east, -north)
-        sens = rubio2022_wind_sensitivities_case_ii(radial, speed_rec, direction_rec, scene.sog,
-                                                    scene.cog, delta, beta, scene.half_cone)
-    radial_u = np.full(scene.n_beams, np.nan)
-    radial_u[order] = u_radial
-    return {"wind_speed": rubio2022_combined_uncertainty(sens[0], u_radial),
-            "wind_direction": np.rad2deg(rubio2022_combined_uncertainty(sens[1], u_radial)),
-            "radial_velocity": radial_u}
+        u_radial, sens = _case_ii(speed, direction, sog, cog, cone, column(delta), column(beta),
+                                  u_pitch, u_roll, u_sog, u_cog)
+    mask = lambda value: np.where(inside, np.broadcast_to(value, shape), np.nan)  # noqa: E731
+    result["wind_speed"] = mask(rubio2022_combined_uncertainty(sens[0], u_radial))
+    result["wind_direction"] = mask(np.rad2deg(rubio2022_combined_uncertainty(sens[1], u_radial)))
+    result["radial_velocity"][..., order] = np.where(inside[..., None], u_radial, np.nan)
+    return result
+
+
+def _case_i(speed, direction, sog, cog, cone, yaw, u_heading, u_sog, u_cog):
+    """Radial-velocity u (Eq. 8) and wind sensitivities (A.5-A.8, A.13-A.16), case i."""
+    args = (speed, direction, sog, cog, yaw, cone, RUBIO2022_AZIMUTHS)
+    radial = rubio2022_radial_velocity_case_i(*args)
+    u_radial = rubio2022_radial_velocity_uncertainty_case_i(*args, u_heading, u_sog, u_cog)
+    sens = rubio2022_wind_sensitivities_case_i(radial, speed[..., 0], direction[..., 0],
+                                               sog[..., 0], cog[..., 0], yaw[..., 0],
+                                               cone[..., 0])
+    return u_radial, sens
+
+
+def _case_ii(speed, direction, sog, cog, cone, delta, beta, u_pitch, u_roll, u_sog, u_cog):
+    """Radial-velocity u (Eq. 12) and wind sensitivities (A.9-A.12, A.17-A.20), case ii."""
+    args = (speed, direction, sog, cog, delta, beta, cone, RUBIO2022_AZIMUTHS)
+    radial = rubio2022_radial_velocity_case_ii(*args)
+    u_radial = rubio2022_radial_velocity_uncertainty_case_ii(*args, u_pitch, u_roll, u_sog,
+                                                              u_cog)
+    sog, cog, cone, delta, beta = (v[..., 0] for v in (sog, cog, cone, delta, beta))
+    north, east = rubio2022_reconstruction(radial, sog, cog, cone, delta=delta, beta=beta)
+    speed_rec, direction_rec = np.hypot(north, east), np.arctan2(-east, -north)   # Eq. 17-18
+    sens = rubio2022_wind_sensitivities_case_ii(radial, speed_rec, direction_rec, sog, cog,
+                                                delta, beta, cone)
+    return u_radial, sens
 
 
 def rubio2022_domain(scene):
-    """Which case of the paper covers the scene: "i", "ii" or None (outside).
+    """Which case of the paper covers a single scene: "i", "ii" or None (outside).
 
     Case i: correction ``yaw``, no pitch or roll. Case ii: correction ``tilt2d`` with the
     lidar's reference beam pointing north (heading + misalignment = 0). Both need the
     four N, E, S, W beams (a vertical beam does not change the horizontal DBS wind).
     Vertical wind, heave and shear are ignored, as in the paper (Sec. 2.3).
     """
-    if _beam_order(scene) is None:
+    if not bool(rubio2022_domain_mask(scene)):
         return None
-    if scene.correction == "yaw" and scene.pitch == 0 and scene.roll == 0:
-        return "i"
-    yaw = np.mod(scene.heading + scene.misalignment, 2 * np.pi)
-    if scene.correction == "tilt2d" and np.isclose(np.sin(yaw), 0) and np.cos(yaw) > 0:
-        return "ii"
-    return None
+    return "i" if scene.correction == "yaw" else "ii"
+
+
+def rubio2022_domain_mask(scene):
+    """Per scene of a batch: is it inside the paper's model (:func:`rubio2022_domain`)?
+
+    Returns
+    -------
+    ndarray of bool, shape S
+    """
+    if _beam_order(scene) is None or scene.correction not in ("yaw", "tilt2d"):
+        return np.zeros(scene.shape, dtype=bool)
+    if scene.correction == "yaw":
+        return (np.asarray(scene.pitch) == 0) & (np.asarray(scene.roll) == 0) \
+            & np.ones(scene.shape, dtype=bool)
+    yaw = np.mod(np.asarray(scene.heading + scene.misalignment), 2 * np.pi)
+    return np.isclose(np.sin(yaw), 0) & (np.cos(yaw) > 0) & np.ones(scene.shape, dtype=bool)
 
 
 def _beam_order(scene):

@@ -27,6 +27,8 @@ from scipy.stats import qmc
 from .constants import RNG_BLOCK_SIZE
 
 SAMPLING_METHODS = ("mc", "lhs", "sobol")
+#: ``none``: no sampling, the GUM (and the paper's model) only, for large planning grids.
+PROPAGATION_METHODS = SAMPLING_METHODS + ("none",)
 
 
 def block_generator(seed, block):

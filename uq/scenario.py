@@ -23,8 +23,9 @@ from .correction import CORRECTION_MODELS
 from .distributions import ERROR_DISTRIBUTIONS, validate_error
 from .errors import ScenarioError
 from .measurement import OUTPUTS
-from .sampling import SAMPLING_METHODS
+from .sampling import PROPAGATION_METHODS
 from .statistics import INTERVALS
+from .sweep import VECTOR_KEYS
 
 INS_CORRELATIONS = ("scan", "beam")
 INS_KEYS = ("heading", "pitch", "roll", "sog", "cog", "heave")
@@ -64,6 +65,9 @@ class Scenario:
         Read-only by convention: :meth:`with_values` returns a new scenario.
     sweep : tuple of (str, tuple)
         Dotted key and its values, in file order (outer product).
+    links : tuple of (str, str)
+        ``(follower, leader)``: a key that takes the swept value of another swept key
+        instead of adding a dimension (``sweep: {ship.heading: {same_as: ship.cog}}``).
     source : str
         File path or ``<mapping>``, for messages.
     """
@@ -73,6 +77,7 @@ class Scenario:
     settings: dict
     sweep: tuple
     source: str
+    links: tuple = ()
 
     @property
     def text(self):
@@ -94,7 +99,13 @@ class Scenario:
         settings = _validate(raw, self.source)
         settings["sweep"] = copy.deepcopy(self.settings["sweep"])
         return Scenario(settings["name"], settings["description"], settings, self.sweep,
-                        self.source)
+                        self.source, self.links)
+
+    def assignments(self, point):
+        """``{dotted: value}`` of one grid point (a value per swept key), links included."""
+        values = dict(zip((key for key, _ in self.sweep), point))
+        values.update({follower: values[leader] for follower, leader in self.links})
+        return values
 
     @property
     def outputs(self):
@@ -173,9 +184,10 @@ def _assign(raw, dotted, value, source):
 
 def _build(raw, source):
     settings = _validate(raw, source)
-    sweep = _validate_sweep(raw.get("sweep"), settings, source)
+    sweep, links = _validate_sweep(raw.get("sweep"), settings, source)
     settings["sweep"] = {key: list(values) for key, values in sweep}
-    return Scenario(settings["name"], settings["description"], settings, sweep, source)
+    settings["sweep"].update({follower: {"same_as": leader} for follower, leader in links})
+    return Scenario(settings["name"], settings["description"], settings, sweep, source, links)
 
 
 def _validate(raw, source):
@@ -265,7 +277,7 @@ def _sampling(check, value):
     check.mapping(value, "sampling")
     check.keys(value, "sampling", allowed)
     s = {**DEFAULTS["sampling"], **value}
-    out = {"method": check.choice(s["method"], "sampling.method", SAMPLING_METHODS),
+    out = {"method": check.choice(s["method"], "sampling.method", PROPAGATION_METHODS),
            "interval": check.choice(s["interval"], "sampling.interval", INTERVALS),
            "control_variate": check.boolean(s["control_variate"], "sampling.control_variate")}
     if out["control_variate"]:
@@ -299,16 +311,29 @@ def _validate_sweep(value, settings, source):
     if not isinstance(value, dict):
         raise ScenarioError(source, "sweep", "must be a mapping of dotted keys to a list of "
                             "values or to {start, stop, step}")
-    sweep = []
+    sweep, links = [], []
     for key, spec in value.items():
         _sweep_key_exists(settings, key, source)
-        values = _sweep_values(spec, f"sweep.{key}", source)
+        if isinstance(spec, dict) and set(spec) == {"same_as"}:
+            links.append((key, spec["same_as"]))
+            continue
+        sweep.append((key, tuple(_sweep_values(spec, f"sweep.{key}", source))))
+    swept = dict(sweep)
+    for follower, leader in links:
+        if leader not in swept:
+            raise ScenarioError(source, f"sweep.{follower}.same_as", f"{leader!r} is not a "
+                                f"swept key; allowed: one of {', '.join(swept) or '(none)'}")
+        if (follower in VECTOR_KEYS) != (leader in VECTOR_KEYS):
+            raise ScenarioError(source, f"sweep.{follower}.same_as", f"cannot follow "
+                                f"{leader!r}; allowed: pairs of scene values "
+                                f"({', '.join(VECTOR_KEYS)}) or pairs of other keys")
+        swept[follower] = swept[leader]
+    for key, values in swept.items():
         for item in values:       # each value must make a valid scenario
             raw = copy.deepcopy(settings)
             _assign(raw, key, item, source)
             _validate(raw, source)
-        sweep.append((key, tuple(values)))
-    return tuple(sweep)
+    return tuple(sweep), tuple(links)
 
 
 def _sweep_key_exists(settings, key, source):
@@ -336,7 +361,8 @@ def _sweep_values(spec, key, source):
                                 "step != 0 pointing from start towards stop (stop excluded)")
         count = math.ceil((stop - start) / step - 1e-9)
         return [start + i * step for i in range(count)]
-    raise ScenarioError(source, key, "must be a list of values or {start, stop, step}")
+    raise ScenarioError(source, key, "must be a list of values, {start, stop, step} or "
+                        "{same_as: another swept key}")
 
 
 class _Checker:
