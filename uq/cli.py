@@ -4,6 +4,7 @@ Exit status: 0 success; 2 bad input (one line naming the file, the key and what 
 allowed; no traceback; no output file); 1 anything else.
 """
 import argparse
+import contextlib
 import sys
 from pathlib import Path
 
@@ -13,6 +14,7 @@ from . import __version__
 from .errors import ScenarioError
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
+EXIT_INTERRUPTED = 130          # the shell's code for SIGINT
 
 
 class _Parser(argparse.ArgumentParser):
@@ -33,6 +35,16 @@ def build_parser():
     run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                      help="override a scenario value (dotted key, YAML value); repeatable")
     run.add_argument("--quiet", action="store_true", help="no summary table or progress")
+    run.add_argument("--resume", action="store_true",
+                     help="continue an interrupted run: reuse the finished chunks kept in "
+                     "OUT.nc.partial/ and compute only the missing scenes")
+    scale = run.add_mutually_exclusive_group()
+    scale.add_argument("--workers", type=int, metavar="N",
+                       help="run the sweep on a local dask cluster of N processes "
+                       "(needs the 'dask' extra); same numbers as a single process")
+    scale.add_argument("--scheduler", metavar="ADDRESS",
+                       help="run the sweep on the dask scheduler at ADDRESS "
+                       "(e.g. tcp://host:8786)")
     check = commands.add_parser("check", help="validate a scenario without running it")
     check.add_argument("scenario", help="scenario YAML file")
     check.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
@@ -74,7 +86,9 @@ def _check(args):
 
 
 def _run(args):
+    from .checkpoint import Checkpoint, checkpoint_directory
     from .io import write_results
+    from .progress import ProgressBar
     from .pipeline import run
     from .scenario import load_scenario
     from .summary import summary_table
@@ -82,18 +96,43 @@ def _run(args):
     output = Path(args.output) if args.output else Path("results") / f"{scenario.name}.nc"
     if output.suffix != ".nc":
         raise ScenarioError("-o", str(output), "the output file must end in .nc")
-    progress = None if args.quiet else _progress
-    dataset = run(scenario, progress=progress)
+    progress = None if args.quiet else ProgressBar()
+    checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume)
+    try:
+        with _dask_client(args) as client:
+            dataset = run(scenario, progress=progress, client=client, checkpoint=checkpoint)
+    except KeyboardInterrupt:
+        print(f"\nuq: interrupted; finished chunks are kept in {checkpoint.directory}; "
+              "run the same command with --resume to continue", file=sys.stderr)
+        return EXIT_INTERRUPTED
     write_results(dataset, output)
+    checkpoint.clear()
     if not args.quiet:
         print(summary_table(dataset))
         print(f"wrote {output}")
     return EXIT_OK
 
 
-def _progress(done, total):
-    if total > 1 and sys.stderr.isatty():
-        print(f"\rscene {done}/{total}", end="\n" if done == total else "", file=sys.stderr)
+@contextlib.contextmanager
+def _dask_client(args):
+    """A dask.distributed Client for --workers / --scheduler, else None."""
+    if args.workers is None and args.scheduler is None:
+        yield None
+        return
+    if args.workers is not None and args.workers < 1:
+        raise ScenarioError("--workers", str(args.workers), "allowed: an integer >= 1")
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        raise ScenarioError("--workers/--scheduler", "dask", "dask.distributed is not "
+                            "installed; allowed: pip install 'uq[dask]'") from None
+    if args.scheduler:
+        with Client(args.scheduler) as client:
+            yield client
+        return
+    with LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        yield client
 
 
 _COMMANDS = {"run": _run, "check": _check}

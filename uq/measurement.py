@@ -187,7 +187,15 @@ def measurement_model(scene, outputs=OUTPUTS, **errors):
     operator = least_squares_operator(unit_vectors)
     wind_vector = reconstruct_wind(measured, scene.correction, unit_vectors, operator,
                                    navigation, scene.field("heading", 1))
-    return _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors)
+    result = _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors)
+    return _full_shape(result, (np.shape(wind_vector)[0],) + scene.shape, scene.n_beams)
+
+
+def _full_shape(result, leading, n_beams):
+    """Outputs broadcast to leading + (gates,) or leading + (beams, gates): a scene value
+    an output does not depend on (e.g. heave for the true wind) still gives it the axis."""
+    return {q: np.broadcast_to(v, leading + ((n_beams,) if q == "radial_velocity" else ())
+                               + v.shape[-1:]) for q, v in result.items()}
 
 
 _ERROR_NAMES = tuple(f"ins_{key}" for key in NAVIGATION) + (
@@ -264,7 +272,7 @@ def true_values(scene):
     beams_earth = scene.nominal_unit_vectors() @ np.swapaxes(attitude, -1, -2)
     _, wind_only = true_radial_velocity(scene, beams_earth, np.zeros(scene.shape + (3,)))
     north, east = wind_vector[..., 0], wind_vector[..., 1]
-    return {"wind_speed": wind.wind_speed(north, east),
-            "wind_direction": wind.wind_direction(north, east),
-            "vertical_wind": wind_vector[..., 2],
-            "radial_velocity": wind_only}
+    return _full_shape({"wind_speed": wind.wind_speed(north, east),
+                        "wind_direction": wind.wind_direction(north, east),
+                        "vertical_wind": wind_vector[..., 2],
+                        "radial_velocity": wind_only}, scene.shape, scene.n_beams)
