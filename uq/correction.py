@@ -126,7 +126,8 @@ def _horizontal_rotation(rotation, lidar_wind, ship_velocity):
     """Eq. 13 [1] on the horizontal lidar components; keeps the lidar-frame vertical."""
     horizontal_only = lidar_wind * np.array([1.0, 1.0, 0.0])[:, None]
     earth = rotation @ horizontal_only + ship_velocity[..., :, None]
-    return np.concatenate([earth[..., :2, :], lidar_wind[..., 2:3, :]], axis=-2)
+    vertical = np.broadcast_to(lidar_wind[..., 2:3, :], earth.shape[:-2] + (1, earth.shape[-1]))
+    return np.concatenate([earth[..., :2, :], vertical], axis=-2)
 
 
 def _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship_velocity):

@@ -188,7 +188,7 @@ def measurement_model(scene, outputs=OUTPUTS, **errors):
     wind_vector = reconstruct_wind(measured, scene.correction, unit_vectors, operator,
                                    navigation, scene.field("heading", 1))
     result = _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors)
-    return _full_shape(result, (np.shape(wind_vector)[0],) + scene.shape, scene.n_beams)
+    return _full_shape(result, (n,) + scene.shape, scene.n_beams)
 
 
 def _full_shape(result, leading, n_beams):
@@ -209,11 +209,14 @@ def _sample_count(errors):
 
 def _measure(scene, err, batch):
     """True radial velocities plus noise, and the INS readings (true + error)."""
-    zero = np.zeros(batch)                                                 # (n, *1)
+    # Without geometry errors the true beams, and so the true radial velocities, are the
+    # same for every sample: computed once per scene, shape (*S, b, 3), not (n, *S, b, 3).
+    geometry_errors = np.ndim(err["lidar_half_cone"]) + np.ndim(err["lidar_misalignment"])
+    zero = np.zeros(batch) if geometry_errors else 0.0                     # (n, *1)
     half_cone = scene.half_cone + complexstep.radians(err["lidar_half_cone"]) + zero
     misalignment = scene.misalignment + complexstep.radians(err["lidar_misalignment"]) + zero
     true_beams = beam_unit_vectors(half_cone, np.asarray(scene.azimuths), misalignment,
-                                   scene.vertical_beam)                    # (n, *S, b, 3)
+                                   scene.vertical_beam)                    # ([n], *S, b, 3)
     attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)    # (*S, 3, 3)
     beams_earth = true_beams @ np.swapaxes(attitude, -1, -2)
     radial, _ = true_radial_velocity(scene, beams_earth, _ship_velocity(scene))
