@@ -1,4 +1,4 @@
-"""Command line: ``uq run``, ``uq check``, ``uq --version``.
+"""Command line: ``uq run``, ``uq check``, ``uq plot``, ``uq report``, ``uq --version``.
 
 Exit status: 0 success; 2 bad input (one line naming the file, the key and what is
 allowed; no traceback; no output file); 1 anything else.
@@ -45,6 +45,21 @@ def build_parser():
     scale.add_argument("--scheduler", metavar="ADDRESS",
                        help="run the sweep on the dask scheduler at ADDRESS "
                        "(e.g. tcp://host:8786)")
+    plot = commands.add_parser("plot", help="draw the figures a results file supports "
+                               "(Rubio & Gottschall 2022, Figs. 2-7, and more)")
+    plot.add_argument("results", help="results file of uq run (netCDF)")
+    plot.add_argument("-o", "--output", help="folder for the figures "
+                      "(default: beside the results, <name>_figures/)")
+    plot.add_argument("--format", action="append", choices=("png", "pdf", "svg"),
+                      help="figure format; repeatable (default png)")
+    report = commands.add_parser("report", help="write a self-contained HTML report of a "
+                                 "results file: scenario, figures, tables, planning answers")
+    report.add_argument("results", help="results file of uq run (netCDF)")
+    report.add_argument("-o", "--output", help="report file (default: beside the results, "
+                        "<name>_report.html)")
+    report.add_argument("--target", type=float, action="append", metavar="U",
+                        help="target u(wind speed) [m s-1] for the largest velocity ratio; "
+                        "repeatable (default 0.05, 0.06 and 0.07)")
     check = commands.add_parser("check", help="validate a scenario without running it")
     check.add_argument("scenario", help="scenario YAML file")
     check.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
@@ -59,10 +74,21 @@ def parse_overrides(items, source="--set"):
         if not sep or not key.strip():
             raise ScenarioError(source, item, "expected KEY=VALUE with a dotted key")
         try:
-            overrides[key.strip()] = yaml.safe_load(text)
+            overrides[key.strip()] = _number_or_value(yaml.safe_load(text))
         except yaml.YAMLError:
             raise ScenarioError(source, key, f"value {text!r} is not valid YAML") from None
     return overrides
+
+
+def _number_or_value(value):
+    """YAML 1.1 reads ``1e-9`` (no dot) as a string; a user typing it means a number."""
+    if isinstance(value, str):
+        try:
+            return float(value) if value.strip().lower() not in ("nan", "inf", "-inf",
+                                                                  "infinity") else value
+        except ValueError:
+            return value
+    return value
 
 
 def main(argv=None):
@@ -135,7 +161,49 @@ def _dask_client(args):
         yield client
 
 
-_COMMANDS = {"run": _run, "check": _check}
+def _open_results(path):
+    from .io import read_results
+    path = Path(path)
+    try:
+        dataset = read_results(path)
+    except (OSError, ValueError) as error:
+        raise ScenarioError(str(path), "", f"cannot read it as netCDF results ({error}); "
+                            "allowed: a file written by uq run") from None
+    if "mc_n_samples" not in dataset or "scenario" not in dataset.attrs:
+        raise ScenarioError(str(path), "", "not a uq results file (no mc_n_samples variable "
+                            "or scenario attribute); allowed: a file written by uq run")
+    return path, dataset
+
+
+def _plot(args):
+    from .figures import figure_plan, make_figures
+    path, dataset = _open_results(args.results)
+    directory = Path(args.output) if args.output else path.with_name(f"{path.stem}_figures")
+    if not figure_plan(dataset):
+        raise ScenarioError(str(path), "sweep", "no figure for these sweep dimensions "
+                            f"({', '.join(dataset['mc_n_samples'].dims) or 'none'}); allowed: "
+                            "the sweeps of the rubio2022_* scenarios or any 1-D sweep")
+    for written in make_figures(dataset, directory, formats=tuple(args.format or ["png"])):
+        print(f"wrote {written}")
+    return EXIT_OK
+
+
+def _report(args):
+    from .report import write_report
+    path, dataset = _open_results(args.results)
+    output = Path(args.output) if args.output else path.with_name(f"{path.stem}_report.html")
+    if output.suffix not in (".html", ".htm"):
+        raise ScenarioError("-o", str(output), "the report file must end in .html")
+    for target in args.target or []:
+        if not target > 0:
+            raise ScenarioError("--target", str(target), "allowed: a positive number [m s-1]")
+    write_report(dataset, output, source=path,
+                 **({"targets": tuple(args.target)} if args.target else {}))
+    print(f"wrote {output}")
+    return EXIT_OK
+
+
+_COMMANDS = {"run": _run, "check": _check, "plot": _plot, "report": _report}
 
 if __name__ == "__main__":
     sys.exit(main())
