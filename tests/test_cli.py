@@ -154,3 +154,43 @@ def test_shipped_scenarios_validate():
     for path in sorted((ROOT / "scenarios").glob("*.yaml")):
         result = uq("check", str(path), cwd=ROOT)
         assert result.returncode == 0, result.stderr
+
+
+def test_scale_out_options_are_checked(tmp_path, capsys, monkeypatch):
+    path = write(tmp_path, GOOD, "good.yaml")
+    status, err = uq_in_process(["run", str(path), "--workers", "0"], tmp_path, capsys,
+                                monkeypatch)
+    assert status == 2 and "--workers" in err
+    status, err = uq_in_process(["run", str(path), "--workers", "1", "--scheduler", "x"],
+                                tmp_path, capsys, monkeypatch)
+    assert status == 2 and "not allowed with" in err
+    assert not (tmp_path / "results").exists()
+
+
+def test_set_reads_exponent_numbers_as_numbers():
+    from uq.cli import parse_overrides
+    assert parse_overrides(["ins.sog.u=1e-9", "name=abc", "x=nan"]) == {
+        "ins.sog.u": 1e-9, "name": "abc", "x": "nan"}
+
+
+def test_interrupted_run_keeps_its_checkpoint_and_resumes(tmp_path, capsys, monkeypatch):
+    """Ctrl-C: exit 130, no results file, the finished chunks kept; --resume completes."""
+    import uq.sweep
+    monkeypatch.setattr(uq.sweep, "SWEEP_CHUNK_ELEMENTS", 1)       # one scene per chunk
+    path = write(tmp_path, {**GOOD, "sweep": {"wind.direction": [0, 90, 180]}}, "good.yaml")
+    import uq.checkpoint
+    save = uq.checkpoint.Checkpoint.save
+
+    def save_then_interrupt(self, index, dataset):
+        save(self, index, dataset)
+        raise KeyboardInterrupt
+    monkeypatch.setattr(uq.checkpoint.Checkpoint, "save", save_then_interrupt)
+    status, err = uq_in_process(["run", str(path), "--quiet"], tmp_path, capsys, monkeypatch)
+    assert status == 130 and "--resume" in err
+    assert not (tmp_path / "results" / "tiny.nc").exists()
+    assert len(list((tmp_path / "results" / "tiny.nc.partial").glob("chunk-*.nc"))) == 1
+    monkeypatch.setattr(uq.checkpoint.Checkpoint, "save", save)
+    status, _ = uq_in_process(["run", str(path), "--quiet", "--resume"], tmp_path, capsys,
+                              monkeypatch)
+    assert status == 0 and (tmp_path / "results" / "tiny.nc").exists()
+    assert not (tmp_path / "results" / "tiny.nc.partial").exists()

@@ -81,7 +81,7 @@ def _batch(input_set, means, n):
 def combined_uncertainty(jacobian, input_set):
     """u(y) = sqrt(c^T V c) for every output element; shape output_shape."""
     u = input_set.standard_uncertainties()
-    c = jacobian.reshape(len(u), -1) * u[:, None]                    # sensitivity * u
+    c = _columns(jacobian) * u[:, None]                              # sensitivity * u
     variance = np.einsum("ke,kl,le->e", c, input_set.correlation_matrix(), c)
     return np.sqrt(np.maximum(variance, 0.0)).reshape(jacobian.shape[1:])
 
@@ -89,10 +89,15 @@ def combined_uncertainty(jacobian, input_set):
 def variance_budget(jacobian, input_set):
     """Each input's share c_k^2 u_k^2 summed over its elements; (n_inputs, *output_shape)."""
     u = input_set.standard_uncertainties()
-    share = (jacobian.reshape(len(u), -1) * u[:, None]) ** 2
+    share = (_columns(jacobian) * u[:, None]) ** 2
     columns = np.array(input_set.column_names())
     rows = [share[columns == name].sum(axis=0) for name in input_set.names]
     return np.array(rows).reshape((len(input_set.names),) + jacobian.shape[1:])
+
+
+def _columns(jacobian):
+    """Jacobian (K, *output_shape) as (K, n_elements); works for K = 0 (no inputs)."""
+    return jacobian.reshape(jacobian.shape[0], int(np.prod(jacobian.shape[1:])))
 
 
 def numerical_tolerance(u, digits):
