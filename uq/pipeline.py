@@ -1,9 +1,12 @@
-"""The orchestrator: scenario -> scenes of the sweep -> propagation -> Dataset.
+"""The orchestrator: scenario -> chunks of scenes of the sweep -> propagation -> Dataset.
 
-For every scene of the sweep's outer product: build the nominal :class:`Scene`, the error
-inputs, and run the measurement model through :func:`uq.propagate`; add the true values,
-the error-free reconstruction and the Rubio & Gottschall (2022) model. Every scene uses
-the same seed, and so the same underlying draws (common random numbers).
+The sweep's outer product is cut into chunks (:mod:`uq.sweep`): scenes that differ only
+in scene values are evaluated together as arrays; the measurement model runs through
+:func:`uq.propagate`; the true values, the error-free reconstruction and the Rubio &
+Gottschall (2022) model are added; the chunks are stacked back onto the grid. Every
+scene uses the same seed, and so the same underlying draws (common random numbers).
+Chunks can run on a dask cluster and be kept on disk for ``--resume``; neither changes
+a number.
 """
 import time
 
