@@ -50,10 +50,11 @@ def test_paper_findings_hold_in_the_paper_model():
     runs = [uq.run(scenario("rubio2022_misalignment",
                             **{"sweep.wind.direction": {"start": 0, "stop": 360, "step": 30}})),
             uq.run(scenario("rubio2022_velocity_ratio")),
-            uq.run(scenario("rubio2022_tilt"))]
+            uq.run(scenario("rubio2022_tilt")),
+            uq.run(scenario("rubio2022_half_cone"))]
     rows = [row for ds in runs for row in planning.paper_findings(ds)
             if row["model"].startswith("paper") and "Theta" not in row["finding"]]
-    assert len(rows) == 3 and all(row["holds"] for row in rows), rows
+    assert len(rows) == 4 and all(row["holds"] for row in rows), rows
 
 
 def test_physical_model_does_not_care_about_misalignment_with_one_reading_per_scan():

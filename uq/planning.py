@@ -179,6 +179,23 @@ def paper_findings(dataset):
         rows += _velocity_ratio_findings(dataset)
     if {"ship_pitch", "ship_roll", "wind_direction"} <= dims:
         rows += _tilt_findings(dataset)
+    if {"lidar_half_cone", "wind_direction"} <= dims:
+        rows += _half_cone_findings(dataset)
+    return rows
+
+
+def _half_cone_findings(dataset):
+    """Fig. 7 [1]: u(Vh) falls as the half-cone angle grows."""
+    rows = []
+    for model in models(dataset, "wind_speed"):
+        curve = mean_over(dataset, f"wind_speed_{model}", ("lidar_half_cone",)).values
+        change = curve[-1] / curve[0] - 1
+        cones = dataset["lidar_half_cone"].values
+        rows.append({"finding": "u(Vh) falls as the half-cone angle grows",
+                     "model": MODEL_NAMES[model],
+                     "holds": bool(np.all(np.diff(curve) <= 0) and change < -EQUAL_WITHIN),
+                     "evidence": f"{curve[0]:.4g} m/s at {cones[0]:g} deg, {curve[-1]:.4g} m/s "
+                     f"at {cones[-1]:g} deg ({100 * change:+.1f} %)"})
     return rows
 
 
