@@ -21,6 +21,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
+from .planning import VELOCITY_RATIOS, models, velocity_ratio_line  # noqa: E402
 from .plots import plot_uncertainty_against_direction  # noqa: E402
 
 #: Uncertainty variables: suffix -> (label, line style).
@@ -29,14 +30,12 @@ MODELS = {"paper_u": ("Rubio & Gottschall (2022)", "-"),
           "mc_u": ("Monte Carlo, physical model", ":")}
 UNITS = {"wind_speed": "m s$^{-1}$", "wind_direction": "deg", "radial_velocity": "m s$^{-1}$"}
 SYMBOLS = {"wind_speed": "$V_h$", "wind_direction": r"$\Theta$", "radial_velocity": "$v_r$"}
-VELOCITY_RATIOS = (0.5, 1.0, 2.0)
 BEAM_NAMES = {0.0: "N", 90.0: "E", 180.0: "S", 270.0: "W"}
 
 
 def available_models(dataset, quantity):
     """The uncertainty suffixes of `quantity` that the dataset has and are not all NaN."""
-    return [m for m in MODELS if f"{quantity}_{m}" in dataset
-            and np.isfinite(dataset[f"{quantity}_{m}"].values).any()]
+    return models(dataset, quantity)
 
 
 def direction_mean(dataset, name):
@@ -102,16 +101,6 @@ def fig3_direction_against_misalignment(dataset):
     return figure
 
 
-def velocity_ratio_line(dataset, name, ratio):
-    """Direction-averaged `name` along sog = ratio * Vh (linear interpolation in sog);
-    NaN where the line leaves the swept sog range."""
-    mean = direction_mean(dataset, name)
-    speeds = dataset["wind_speed"].values
-    return np.array([float(mean.sel(wind_speed=v).interp(ship_sog=ratio * v))
-                     if ratio * v <= dataset["ship_sog"].values.max() else np.nan
-                     for v in speeds])
-
-
 def fig4a_speed_against_velocities(dataset):
     """Fig. 4a [1]: direction-averaged u(Vh) over Vh x sog, with the VR = 0.5, 1, 2 lines."""
     models = available_models(dataset, "wind_speed")
@@ -138,12 +127,11 @@ def fig4a_speed_against_velocities(dataset):
 def fig4b_relative_against_speed(dataset):
     """Fig. 4b [1]: relative u(Vh) / Vh [%] against Vh for VR = 0.5, 1, 2."""
     figure, ax = plt.subplots(figsize=(5.5, 3.6), constrained_layout=True)
-    speed = dataset["wind_speed"].values
     colours = ("tab:blue", "tab:orange", "tab:green")
     for ratio, colour in zip(VELOCITY_RATIOS, colours):
         for model in available_models(dataset, "wind_speed"):
-            line = velocity_ratio_line(dataset, f"wind_speed_{model}", ratio)
-            ax.plot(speed, 100 * line / speed, MODELS[model][1], color=colour,
+            at, line = velocity_ratio_line(dataset, f"wind_speed_{model}", ratio)
+            ax.plot(at, 100 * line / at, MODELS[model][1], color=colour,
                     label=f"VR = {ratio:g}, {MODELS[model][0]}")
     ax.set_xlabel("horizontal wind speed $V_h$ [m s$^{-1}$]")
     ax.set_ylabel("u($V_h$) / $V_h$ [%], direction mean")

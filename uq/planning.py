@@ -20,6 +20,8 @@ MODEL_NAMES = {"paper_u": "paper (Rubio & Gottschall 2022)", "gum_u": "GUM, phys
 #: Targets of the velocity-ratio answer when the user gives none [m s-1]: around the
 #: u(Vh) of the paper's Table B2 set-up (0.045-0.07 m/s), so the answer is informative.
 DEFAULT_TARGETS = (0.05, 0.06, 0.07)
+#: Velocity ratios VR = sog / Vh of the paper's Fig. 4 [1].
+VELOCITY_RATIOS = (0.5, 1.0, 2.0)
 #: Relative size under which two uncertainties count as equal in a finding [1]: 0.5 %, far
 #: above the GUM's rounding and below any effect the paper discusses (2 % and more).
 EQUAL_WITHIN = 0.005
@@ -233,16 +235,21 @@ def _extremes_on(curve, minima, maxima):
                 and np.isclose(curve.max(), curve[maxima].max(), rtol=1e-9))
 
 
+def velocity_ratio_line(dataset, name, ratio):
+    """Direction-averaged `name` along sog = ratio * Vh (linear interpolation in sog), at
+    the swept wind speeds whose sog stays inside the swept range: (speeds, values)."""
+    grid = mean_over(dataset, name, ("wind_speed", "ship_sog"))
+    speeds = dataset["wind_speed"].values
+    speeds = speeds[ratio * speeds <= dataset["ship_sog"].values.max()]
+    return speeds, np.array([float(grid.sel(wind_speed=v).interp(ship_sog=ratio * v))
+                             for v in speeds])
+
+
 def _velocity_ratio_findings(dataset):
     rows = []
-    speeds = dataset["wind_speed"].values
     for model in models(dataset, "wind_speed"):
-        grid = mean_over(dataset, f"wind_speed_{model}", ("wind_speed", "ship_sog"))
-        lines = {}
-        for ratio in (0.5, 1.0, 2.0):
-            inside = ratio * speeds <= dataset["ship_sog"].values.max()
-            values = [float(grid.sel(wind_speed=v).interp(ship_sog=ratio * v)) for v in speeds[inside]]
-            lines[ratio] = (speeds[inside], np.array(values))
+        lines = {ratio: velocity_ratio_line(dataset, f"wind_speed_{model}", ratio)
+                 for ratio in VELOCITY_RATIOS}
         common = np.intersect1d(lines[0.5][0], lines[2.0][0])
         pick = lambda r: lines[r][1][np.isin(lines[r][0], common)]   # noqa: E731
         ordered = np.all(pick(0.5) <= pick(1.0)) and np.all(pick(1.0) <= pick(2.0))
