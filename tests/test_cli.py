@@ -82,7 +82,7 @@ MALFORMED = [
     ("negative range", {**GOOD, "lidar": {"ranges": [-10]}}, "lidar.ranges[0]"),
     ("vertical beam text", {**GOOD, "lidar": {"vertical_beam": "yes"}}, "lidar.vertical_beam"),
     ("bad name", {**GOOD, "name": "../escape"}, "name"),
-    ("control variate", {**GOOD, "sampling": {"n": 100, "control_variate": True}},
+    ("control variate not a bool", {**GOOD, "sampling": {"n": 100, "control_variate": "yes"}},
      "sampling.control_variate"),
     ("not a mapping", "- just\n- a list\n", "scenario must be a mapping"),
     ("invalid yaml", "wind: {speed: 5\n", "not valid YAML"),

@@ -144,7 +144,8 @@ def run_scene(scenario, scene, seed):
                        n=sampling.get("n"), digits=sampling.get("digits"),
                        method=sampling["method"], seed=seed, circular=("wind_direction",),
                        output_dims={q: _dims(q) for q in OUTPUTS},
-                       interval=sampling["interval"], chunk_size=sampling.get("chunk_size"))
+                       interval=sampling["interval"], chunk_size=sampling.get("chunk_size"),
+                       control_variate=sampling["control_variate"])
     return _scene_dataset(scene, settings, outputs, engine)
 
 

@@ -12,19 +12,21 @@ References
 import numpy as np
 import xarray as xr
 
-from . import gum
+from . import controlvariate, gum
 from .constants import (ADAPTIVE_MAX_SAMPLES, BATCH_SIZE, COVERAGE_PROBABILITY,
-                        DEFAULT_BLOCKS_PER_CHUNK, DEFAULT_DIGITS, RNG_BLOCK_SIZE)
+                        DEFAULT_BLOCKS_PER_CHUNK, DEFAULT_DIGITS, FULL_CIRCLE_DEG,
+                        RNG_BLOCK_SIZE)
 from .inputs import input_set
 from .sampling import PROPAGATION_METHODS, new_seed, normal_scores
-from .statistics import INTERVALS, StreamingStatistics, batch_statistics, tail_capacity
+from .statistics import (INTERVALS, Moments, StreamingStatistics, batch_statistics,
+                         tail_capacity)
 
 _BATCH_KEYS = ("mean", "u", "low", "high")
 
 
 def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
               correlation=None, circular=(), output_dims=None, interval="symmetric",
-              chunk_size=None):
+              chunk_size=None, control_variate=False):
     """Propagate input distributions through `model` by Monte Carlo and by the GUM.
 
     Parameters
@@ -57,6 +59,9 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         Probabilistically symmetric (default) or shortest 95 % coverage interval.
     chunk_size : int, optional
         Samples evaluated at once (rounded up to whole RNG blocks); bounds memory.
+    control_variate : bool
+        Use the GUM linearisation as a control variate for the mean and u
+        (:mod:`uq.controlvariate`); the coverage interval stays plain Monte Carlo.
 
     Returns
     -------
@@ -68,7 +73,10 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         input means), ``q_gum_u``, ``q_gum_valid`` (clause 8), ``q_gum_validation_conclusive`` (the Monte Carlo
         numerical error is within the tolerance of clause 8, so the verdict is not
         decided by sampling noise), ``q_budget`` (dimension
-        ``input``); circular outputs also ``q_mc_circular_std``.
+        ``input``), ``q_mc_u_standard_error`` (standard error of ``q_mc_u`` from its
+        spread over independent batches: 2^14 trials for mc, whole RNG blocks, i.e.
+        independent randomisations, for lhs and sobol); circular outputs also
+        ``q_mc_circular_std``.
     """
     _check_arguments(n, digits, method, interval)
     seed = _entropy(seed)
@@ -84,6 +92,9 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     references = {q: _circular_reference(gum_value[q]) if q in circular else None
                   for q in gum_value}
     runner = _Runner(wrapped, inputs_laid, method, seed, references, interval, chunk_size)
+    if control_variate:
+        runner.control = {q: (jacobian[q], gum.combined_uncertainty(jacobian[q], inputs_laid))
+                          for q in jacobian}
     if method == "none":
         pass
     elif n is not None:
@@ -96,7 +107,8 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         dataset = dataset.assign(_mc_variables(runner, dataset, circular, validation_digits))
     dataset.attrs.update(n_samples=runner.n_done, seed=seed, sampling_method=method,
                          digits=validation_digits, interval=interval,
-                         coverage_probability=COVERAGE_PROBABILITY, gum=gum_note)
+                         coverage_probability=COVERAGE_PROBABILITY, gum=gum_note,
+                         control_variate=int(bool(runner.control)))
     return dataset
 
 
@@ -151,57 +163,96 @@ class _Runner:
         self.references, self.interval = references, interval
         blocks = DEFAULT_BLOCKS_PER_CHUNK if chunk_size is None else -(-int(chunk_size) // RNG_BLOCK_SIZE)
         self.blocks_per_chunk = max(1, blocks)
+        # independent batches: within an lhs or sobol block the points are not independent
+        self.batch_size = BATCH_SIZE if method == "mc" else RNG_BLOCK_SIZE
         self.stats, self.batches, self.n_done = None, {}, 0
+        self.control, self.linear = None, {}
 
     def _start(self, capacity, shapes):
         self.stats = {q: StreamingStatistics(shape, capacity, self.references[q])
                       for q, shape in shapes.items()}
         self.batches = {q: {key: [] for key in _BATCH_KEYS} for q in shapes}
+        self.linear = {q: Moments(shape) for q, shape in shapes.items()}
 
     def _evaluate(self, first_block, n_blocks, n_samples):
         scores = np.concatenate([normal_scores(self.method, self.seed, b, self.inputs.dimension)
                                  for b in range(first_block, first_block + n_blocks)])
+        values = self.inputs.values(scores[:n_samples])
         with np.errstate(all="ignore"):           # out-of-domain trials become NaN, counted
-            outputs = self.model(**self.inputs.values(scores[:n_samples]),
-                                 **self.inputs.constants)
+            outputs = self.model(**values, **self.inputs.constants)
         # outputs that do not depend on any random input may come back with one row
-        return {q: np.broadcast_to(np.real(np.asarray(v, dtype=float)),
-                                   (n_samples,) + np.shape(v)[1:])
-                for q, v in outputs.items()}
+        outputs = {q: np.broadcast_to(np.real(np.asarray(v, dtype=float)),
+                                      (n_samples,) + np.shape(v)[1:])
+                   for q, v in outputs.items()}
+        if not self.control:
+            return outputs, None
+        columns = controlvariate.input_columns(values, self.inputs)
+        return outputs, {q: controlvariate.linear_deviation(self.control[q][0], columns)
+                         for q in outputs}
 
-    def _accumulate(self, outputs):
+    def _accumulate(self, outputs, linear):
         """Statistics batch by batch; chunks start on block boundaries, so the sequence of
         floating-point merges, and the result, is the same for every chunk size."""
         for q, values in outputs.items():
-            for start in range(0, len(values), BATCH_SIZE):
-                batch = values[start:start + BATCH_SIZE]
+            for start in range(0, len(values), self.batch_size):
+                batch = values[start:start + self.batch_size]
                 self.stats[q].update(batch)
-                if len(batch) < BATCH_SIZE:
+                lin = None if linear is None else linear[q][start:start + self.batch_size]
+                if lin is not None:
+                    self.linear[q].update(lin, np.isfinite(batch))
+                if len(batch) < self.batch_size:
                     continue
                 summary = batch_statistics(batch, self.references[q], kind=self.interval)
+                if lin is not None:
+                    summary.update(self._controlled(q, summary, batch, lin))
                 for key in _BATCH_KEYS:
                     self.batches[q][key].append(summary[key])
         self.n_done += len(next(iter(outputs.values())))
+
+    def _controlled(self, q, summary, batch, lin):
+        """Control-variate mean and u of one batch (:mod:`uq.controlvariate`)."""
+        variance, mean = controlvariate.masked_variance(lin, np.isfinite(batch))
+        return {"mean": summary["mean"] - mean,
+                "u": controlvariate.controlled_u(self.control[q][1], summary["u"] ** 2, variance)}
+
+    def result(self, q):
+        """Final statistics of output q, with the control variate applied to mean and u."""
+        result = self.stats[q].result(kind=self.interval)
+        if self.control:
+            moments = self.linear[q]
+            result["u"] = controlvariate.controlled_u(self.control[q][1], result["u"] ** 2,
+                                                      moments.variance())
+            result["mean"] = result["mean"] - moments.mean
+            if self.references[q] is not None:
+                result["mean"] = np.mod(result["mean"], FULL_CIRCLE_DEG)
+        return result
+
+    def u_standard_error(self, q):
+        """Standard error of u from its spread over the h independent batches (NaN < 2)."""
+        h = len(self.batches[q]["u"])
+        if h < 2:
+            return np.full(self.stats[q].shape, np.nan)
+        return np.std(np.array(self.batches[q]["u"]), axis=0, ddof=1) / np.sqrt(h)
 
     def run_fixed(self, n):
         total_blocks = -(-n // RNG_BLOCK_SIZE)
         for first in range(0, total_blocks, self.blocks_per_chunk):
             blocks = min(self.blocks_per_chunk, total_blocks - first)
-            outputs = self._evaluate(first, blocks, min(n - first * RNG_BLOCK_SIZE,
-                                                       blocks * RNG_BLOCK_SIZE))
+            outputs, linear = self._evaluate(first, blocks, min(n - first * RNG_BLOCK_SIZE,
+                                                               blocks * RNG_BLOCK_SIZE))
             if self.stats is None:
                 self._start(tail_capacity(n) + 1, {q: v.shape[1:] for q, v in outputs.items()})
-            self._accumulate(outputs)
+            self._accumulate(outputs, linear)
 
     def run_adaptive(self, digits):
         """JCGM 101:2008, 7.9.4: batches of M = 2^14 >= 10^4 trials, one RNG block per step."""
         block = 0
         while True:
-            outputs = self._evaluate(block, 1, RNG_BLOCK_SIZE)
+            outputs, linear = self._evaluate(block, 1, RNG_BLOCK_SIZE)
             if self.stats is None:
                 self._start(tail_capacity(ADAPTIVE_MAX_SAMPLES) + 1,
                             {q: v.shape[1:] for q, v in outputs.items()})
-            self._accumulate(outputs)
+            self._accumulate(outputs, linear)
             block += 1
             if block >= 2 and (self._stable(digits)
                                or self.n_done + RNG_BLOCK_SIZE > ADAPTIVE_MAX_SAMPLES):
@@ -209,9 +260,8 @@ class _Runner:
 
     def _stable(self, digits):
         """7.9.4 i): 2 s <= delta for the average of the batch means, u and endpoints."""
-        for q, stats in self.stats.items():
-            result = stats.result(kind=self.interval)
-            delta = gum.numerical_tolerance(result["u"], digits)
+        for q in self.stats:
+            delta = gum.numerical_tolerance(self.result(q)["u"], digits)
             if np.any(self.numerical_error(q) > delta):
                 return False
         return True
@@ -246,7 +296,7 @@ def _mc_variables(runner, gum_results, circular, digits):
     for q, stats in runner.stats.items():
         dims = gum_results[f"{q}_gum_u"].dims
         value, u_gum = gum_results[f"{q}_gum_value"].values, gum_results[f"{q}_gum_u"].values
-        result = stats.result(kind=runner.interval)
+        result = runner.result(q)
         error = runner.numerical_error(q)
         data.update({
             f"{q}_mc_mean": (dims, result["mean"]),
@@ -255,6 +305,7 @@ def _mc_variables(runner, gum_results, circular, digits):
             f"{q}_mc_high": (dims, result["high"]),
             f"{q}_mc_n_invalid": (dims, runner.n_done - result["n_valid"]),
             f"{q}_mc_numerical_error": (dims, error),
+            f"{q}_mc_u_standard_error": (dims, runner.u_standard_error(q)),
             f"{q}_gum_valid": (dims, gum.gum_interval_valid(
                 value, u_gum, result["low"], result["high"], digits, q in circular)),
             f"{q}_gum_validation_conclusive": (dims, error <= gum.numerical_tolerance(u_gum,

@@ -12,8 +12,10 @@ Methods
 ``lhs``
     Latin hypercube (scipy.stats.qmc.LatinHypercube), stratified within each block.
 ``sobol``
-    One scrambled Sobol' sequence (scipy.stats.qmc.Sobol), block b being its points
-    b*B ... (b+1)*B - 1; the scrambling is seeded from the run's seed.
+    Scrambled Sobol' points (scipy.stats.qmc.Sobol), a new independent scrambling for
+    each block of 2^16 points (a power of two, so each block is a balanced net). Blocks
+    are independent randomised-QMC replicates: their spread is an honest estimate of the
+    error (Owen 1997), which a single long sequence cannot give.
 
 Every method returns standard normal scores ``z`` of shape (block_size, dimension);
 inputs are obtained from them by inverse CDFs (:mod:`uq.inputs`), so each works with
@@ -57,10 +59,7 @@ def normal_scores(method, seed, block, dimension, block_size=RNG_BLOCK_SIZE):
         engine = qmc.LatinHypercube(dimension, rng=block_generator(seed, block))
         return ndtri(engine.random(block_size))
     if method == "sobol":
-        scramble = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(2**31,)))
-        engine = qmc.Sobol(dimension, scramble=True, rng=scramble)
-        if block:
-            engine.fast_forward(block * block_size)
+        engine = qmc.Sobol(dimension, scramble=True, rng=block_generator(seed, block))
         return ndtri(engine.random(block_size))
     raise ValueError(f"unknown sampling method {method!r}; allowed: {SAMPLING_METHODS}")
 

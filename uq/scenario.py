@@ -280,9 +280,6 @@ def _sampling(check, value):
     out = {"method": check.choice(s["method"], "sampling.method", PROPAGATION_METHODS),
            "interval": check.choice(s["interval"], "sampling.interval", INTERVALS),
            "control_variate": check.boolean(s["control_variate"], "sampling.control_variate")}
-    if out["control_variate"]:
-        raise ScenarioError(check.source, "sampling.control_variate", "the control variate is "
-                            "not available in this version; allowed: false")
     if "n" in value and "digits" in value:
         raise ScenarioError(check.source, "sampling", "give either n or digits, not both")
     if "digits" in value:

@@ -78,6 +78,34 @@ def coverage_interval(smallest, largest, m, probability=COVERAGE_PROBABILITY,
     return lows[best], highs[best]
 
 
+class Moments:
+    """Streaming count, mean and sum of squared deviations per element (Chan et al.)."""
+
+    def __init__(self, shape):
+        self.shape = tuple(shape)
+        self.count = np.zeros(shape, dtype=np.int64)
+        self.mean = np.zeros(shape)
+        self.m2 = np.zeros(shape)
+
+    def update(self, values, valid):
+        """Add the entries of `values` (m, *shape) where `valid`."""
+        count = valid.sum(axis=0)
+        safe = np.where(valid, values, 0.0)
+        mean = np.divide(safe.sum(axis=0), count, out=np.zeros(self.shape), where=count > 0)
+        m2 = np.sum(np.where(valid, values - mean, 0.0) ** 2, axis=0)
+        total = self.count + count
+        delta = mean - self.mean
+        weight = np.divide(count, total, out=np.zeros(self.shape), where=total > 0)
+        self.mean = self.mean + delta * weight
+        self.m2 = self.m2 + m2 + delta**2 * self.count * weight
+        self.count = total
+
+    def variance(self):
+        """Sample variance (ddof 1); NaN below two values."""
+        return np.divide(self.m2, self.count - 1, out=np.full(self.shape, np.nan),
+                         where=self.count > 1)
+
+
 class StreamingStatistics:
     """Mean, standard deviation and coverage intervals of an array-valued output.
 
@@ -96,9 +124,7 @@ class StreamingStatistics:
         self.shape = tuple(shape)
         self.capacity = int(capacity)
         self.reference = None if reference is None else np.broadcast_to(reference, shape)
-        self.count = np.zeros(shape, dtype=np.int64)
-        self.mean = np.zeros(shape)
-        self.m2 = np.zeros(shape)
+        self.moments = Moments(shape)
         self.resultant = np.zeros(shape, dtype=complex)
         size = int(np.prod(shape))
         self._low = [np.empty(0) for _ in range(size)]
@@ -110,39 +136,26 @@ class StreamingStatistics:
         if self.reference is not None:
             self.resultant += np.nansum(np.exp(1j * np.deg2rad(values)), axis=0)
             values = unwrap(values, self.reference)
-        finite = np.isfinite(values)
-        count = finite.sum(axis=0)
-        safe = np.where(finite, values, 0.0)
-        mean = np.divide(safe.sum(axis=0), count, out=np.zeros(self.shape), where=count > 0)
-        m2 = np.sum(np.where(finite, values - mean, 0.0) ** 2, axis=0)
-        self._merge_moments(count, mean, m2)
+        self.moments.update(values, np.isfinite(values))
         flat = values.reshape(len(values), -1)
         for j in range(flat.shape[1]):
             column = flat[:, j][np.isfinite(flat[:, j])]
             self._low[j] = _keep_smallest(self._low[j], column, self.capacity)
             self._high[j] = -_keep_smallest(-self._high[j], -column, self.capacity)
 
-    def _merge_moments(self, count, mean, m2):
-        total = self.count + count
-        delta = mean - self.mean
-        weight = np.divide(count, total, out=np.zeros(self.shape), where=total > 0)
-        self.mean = self.mean + delta * weight
-        self.m2 = self.m2 + m2 + delta**2 * self.count * weight
-        self.count = total
-
     def result(self, probability=COVERAGE_PROBABILITY, kind="symmetric"):
         """dict of arrays of `shape`: mean, u, low, high, n_valid (and circular_std)."""
-        u = np.sqrt(np.divide(self.m2, self.count - 1, out=np.full(self.shape, np.nan),
-                              where=self.count > 1))
-        mean = np.where(self.count > 0, self.mean, np.nan)
+        count = self.moments.count
+        u = np.sqrt(self.moments.variance())
+        mean = np.where(count > 0, self.moments.mean, np.nan)
         low, high = np.full(self.shape, np.nan), np.full(self.shape, np.nan)
-        for j, m in enumerate(self.count.reshape(-1)):
+        for j, m in enumerate(count.reshape(-1)):
             bounds = coverage_interval(np.sort(self._low[j]), np.sort(self._high[j]), int(m),
                                        probability, kind)
             low.reshape(-1)[j], high.reshape(-1)[j] = bounds
-        out = {"mean": mean, "u": u, "low": low, "high": high, "n_valid": self.count}
+        out = {"mean": mean, "u": u, "low": low, "high": high, "n_valid": count}
         if self.reference is not None:
-            length = np.abs(self.resultant) / np.maximum(self.count, 1)
+            length = np.abs(self.resultant) / np.maximum(count, 1)
             with np.errstate(divide="ignore"):
                 out["circular_std"] = np.rad2deg(np.sqrt(-2 * np.log(np.minimum(length, 1.0))))
             for key in ("mean", "low", "high"):
