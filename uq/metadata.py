@@ -28,6 +28,8 @@ STATISTICS = {
     "mc_circular_std": ("Monte Carlo circular standard deviation sqrt(-2 ln R)", None),
     "mc_numerical_error": ("numerical error of the Monte Carlo results: twice the standard "
                            "deviation of batch averages (JCGM 101 7.9)", None),
+    "mc_numerical_tolerance": ("numerical tolerance of the requested significant digits "
+                               "(JCGM 101 7.9.2)", None),
     "mc_u_standard_error": ("standard error of the Monte Carlo standard uncertainty, from "
                             "its spread over independent batches", None),
     "mc_n_invalid": ("Monte Carlo trials outside the model's domain (non-finite, excluded)", None),

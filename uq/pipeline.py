@@ -145,7 +145,8 @@ def run_scene(scenario, scene, seed):
                        method=sampling["method"], seed=seed, circular=("wind_direction",),
                        output_dims={q: _dims(q) for q in OUTPUTS},
                        interval=sampling["interval"], chunk_size=sampling.get("chunk_size"),
-                       control_variate=sampling["control_variate"])
+                       control_variate=sampling["control_variate"],
+                       stopping=sampling["stopping"])
     return _scene_dataset(scene, settings, outputs, engine)
 
 

@@ -18,6 +18,7 @@ from .constants import (ADAPTIVE_MAX_SAMPLES, BATCH_SIZE, COVERAGE_PROBABILITY,
                         RNG_BLOCK_SIZE)
 from .inputs import input_set
 from .sampling import PROPAGATION_METHODS, new_seed, normal_scores
+from .stopping import STOPPING_RULES, may_stop
 from .statistics import (INTERVALS, Moments, StreamingStatistics, batch_statistics,
                          tail_capacity)
 
@@ -26,7 +27,7 @@ _BATCH_KEYS = ("mean", "u", "low", "high")
 
 def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
               correlation=None, circular=(), output_dims=None, interval="symmetric",
-              chunk_size=None, control_variate=False):
+              chunk_size=None, control_variate=False, stopping="jcgm101"):
     """Propagate input distributions through `model` by Monte Carlo and by the GUM.
 
     Parameters
@@ -59,6 +60,9 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         Probabilistically symmetric (default) or shortest 95 % coverage interval.
     chunk_size : int, optional
         Samples evaluated at once (rounded up to whole RNG blocks); bounds memory.
+    stopping : {"jcgm101", "confident"}
+        Stopping rule of adaptive sampling (:mod:`uq.stopping`): JCGM 101 7.9, or a
+        rule that stops too early with probability at most 5 %.
     control_variate : bool
         Use the GUM linearisation as a control variate for the mean and u
         (:mod:`uq.controlvariate`); the coverage interval stays plain Monte Carlo.
@@ -79,6 +83,8 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         ``q_mc_circular_std``.
     """
     _check_arguments(n, digits, method, interval)
+    if stopping not in STOPPING_RULES:
+        raise ValueError(f"stopping must be one of {STOPPING_RULES}, got {stopping!r}")
     seed = _entropy(seed)
     inputs_laid = input_set(inputs, correlation)
     circular = set(circular)
@@ -100,7 +106,7 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     elif n is not None:
         runner.run_fixed(int(n))
     else:
-        runner.run_adaptive(digits or DEFAULT_DIGITS)
+        runner.run_adaptive(digits or DEFAULT_DIGITS, stopping)
     validation_digits = digits or DEFAULT_DIGITS
     dataset = _gum_dataset(gum_value, jacobian, inputs_laid, output_dims or {})
     if runner.stats is not None:
@@ -108,7 +114,8 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     dataset.attrs.update(n_samples=runner.n_done, seed=seed, sampling_method=method,
                          digits=validation_digits, interval=interval,
                          coverage_probability=COVERAGE_PROBABILITY, gum=gum_note,
-                         control_variate=int(bool(runner.control)))
+                         control_variate=int(bool(runner.control)),
+                         stopping_rule=stopping if n is None and method != "none" else "fixed n")
     return dataset
 
 
@@ -244,8 +251,9 @@ class _Runner:
                 self._start(tail_capacity(n) + 1, {q: v.shape[1:] for q, v in outputs.items()})
             self._accumulate(outputs, linear)
 
-    def run_adaptive(self, digits):
-        """JCGM 101:2008, 7.9.4: batches of M = 2^14 >= 10^4 trials, one RNG block per step."""
+    def run_adaptive(self, digits, stopping="jcgm101"):
+        """JCGM 101:2008, 7.9.4: batches of M >= 10^4 trials, one RNG block per step, until
+        the stopping rule (:mod:`uq.stopping`) is met or ADAPTIVE_MAX_SAMPLES is reached."""
         block = 0
         while True:
             outputs, linear = self._evaluate(block, 1, RNG_BLOCK_SIZE)
@@ -254,17 +262,15 @@ class _Runner:
                             {q: v.shape[1:] for q, v in outputs.items()})
             self._accumulate(outputs, linear)
             block += 1
-            if block >= 2 and (self._stable(digits)
-                               or self.n_done + RNG_BLOCK_SIZE > ADAPTIVE_MAX_SAMPLES):
+            if self._stable(digits, stopping, check=block) \
+                    or self.n_done + RNG_BLOCK_SIZE > ADAPTIVE_MAX_SAMPLES:
                 return
 
-    def _stable(self, digits):
-        """7.9.4 i): 2 s <= delta for the average of the batch means, u and endpoints."""
-        for q in self.stats:
-            delta = gum.numerical_tolerance(self.result(q)["u"], digits)
-            if np.any(self.numerical_error(q) > delta):
-                return False
-        return True
+    def _stable(self, digits, stopping, check):
+        """Every output's mean, u and endpoints stable to `digits` under the rule."""
+        return all(may_stop(stopping, [np.array(self.batches[q][key]) for key in _BATCH_KEYS],
+                            gum.numerical_tolerance(self.result(q)["u"], digits), check)
+                   for q in self.stats)
 
     def numerical_error(self, q):
         """2 s of JCGM 101 7.9.4 f), the largest over mean, u and endpoints (NaN < 2 batches)."""
@@ -306,6 +312,7 @@ def _mc_variables(runner, gum_results, circular, digits):
             f"{q}_mc_n_invalid": (dims, runner.n_done - result["n_valid"]),
             f"{q}_mc_numerical_error": (dims, error),
             f"{q}_mc_u_standard_error": (dims, runner.u_standard_error(q)),
+            f"{q}_mc_numerical_tolerance": (dims, gum.numerical_tolerance(result["u"], digits)),
             f"{q}_gum_valid": (dims, gum.gum_interval_valid(
                 value, u_gum, result["low"], result["high"], digits, q in circular)),
             f"{q}_gum_validation_conclusive": (dims, error <= gum.numerical_tolerance(u_gum,

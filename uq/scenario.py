@@ -25,6 +25,7 @@ from .errors import ScenarioError
 from .measurement import OUTPUTS
 from .sampling import PROPAGATION_METHODS
 from .statistics import INTERVALS
+from .stopping import STOPPING_RULES
 from .sweep import VECTOR_KEYS
 
 INS_CORRELATIONS = ("scan", "beam")
@@ -46,7 +47,7 @@ DEFAULTS = {
               "misalignment": 0.0, "errors": {}},
     "correction": "full",
     "sampling": {"method": "mc", "seed": None, "control_variate": False,
-                 "interval": "symmetric"},
+                 "interval": "symmetric", "stopping": "jcgm101"},
     "sweep": {},
     "outputs": ["wind_speed", "wind_direction", "vertical_wind"],
 }
@@ -272,14 +273,16 @@ def _lidar(check, value):
 
 
 def _sampling(check, value):
-    allowed = ("method", "n", "digits", "seed", "control_variate", "interval", "chunk_size")
+    allowed = ("method", "n", "digits", "seed", "control_variate", "interval", "chunk_size",
+               "stopping")
     value = {} if value is None else value
     check.mapping(value, "sampling")
     check.keys(value, "sampling", allowed)
     s = {**DEFAULTS["sampling"], **value}
     out = {"method": check.choice(s["method"], "sampling.method", PROPAGATION_METHODS),
            "interval": check.choice(s["interval"], "sampling.interval", INTERVALS),
-           "control_variate": check.boolean(s["control_variate"], "sampling.control_variate")}
+           "control_variate": check.boolean(s["control_variate"], "sampling.control_variate"),
+           "stopping": check.choice(s["stopping"], "sampling.stopping", STOPPING_RULES)}
     if "n" in value and "digits" in value:
         raise ScenarioError(check.source, "sampling", "give either n or digits, not both")
     if "digits" in value:
