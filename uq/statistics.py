@@ -127,8 +127,8 @@ class StreamingStatistics:
         self.moments = Moments(shape)
         self.resultant = np.zeros(shape, dtype=complex)
         size = int(np.prod(shape))
-        self._low = [np.empty(0) for _ in range(size)]
-        self._high = [np.empty(0) for _ in range(size)]
+        self._low = [_Tail(self.capacity) for _ in range(size)]
+        self._high = [_Tail(self.capacity) for _ in range(size)]      # holds -values
 
     def update(self, values):
         """Add samples of shape (m, *shape)."""
@@ -138,10 +138,13 @@ class StreamingStatistics:
             values = unwrap(values, self.reference)
         self.moments.update(values, np.isfinite(values))
         flat = values.reshape(len(values), -1)
-        for j in range(flat.shape[1]):
-            column = flat[:, j][np.isfinite(flat[:, j])]
-            self._low[j] = _keep_smallest(self._low[j], column, self.capacity)
-            self._high[j] = -_keep_smallest(-self._high[j], -column, self.capacity)
+        low_bound = np.array([tail.threshold for tail in self._low])
+        high_bound = np.array([-tail.threshold for tail in self._high])
+        below, above = flat < low_bound, flat > high_bound      # NaN is neither
+        for j in np.flatnonzero(below.any(axis=0)):
+            self._low[j].add(flat[below[:, j], j])
+        for j in np.flatnonzero(above.any(axis=0)):
+            self._high[j].add(-flat[above[:, j], j])
 
     def result(self, probability=COVERAGE_PROBABILITY, kind="symmetric"):
         """dict of arrays of `shape`: mean, u, low, high, n_valid (and circular_std)."""
@@ -150,7 +153,8 @@ class StreamingStatistics:
         mean = np.where(count > 0, self.moments.mean, np.nan)
         low, high = np.full(self.shape, np.nan), np.full(self.shape, np.nan)
         for j, m in enumerate(count.reshape(-1)):
-            bounds = coverage_interval(np.sort(self._low[j]), np.sort(self._high[j]), int(m),
+            bounds = coverage_interval(np.sort(self._low[j].values()),
+                                       np.sort(-self._high[j].values()), int(m),
                                        probability, kind)
             low.reshape(-1)[j], high.reshape(-1)[j] = bounds
         out = {"mean": mean, "u": u, "low": low, "high": high, "n_valid": count}
@@ -163,22 +167,81 @@ class StreamingStatistics:
         return out
 
 
-def _keep_smallest(kept, new, capacity):
-    """The `capacity` smallest of `kept` and `new` (unordered)."""
-    if len(kept) >= capacity:
-        new = new[new < kept.max()]
-        if not len(new):
-            return kept
-    merged = np.concatenate([kept, new])
-    if len(merged) <= capacity:
-        return merged
-    return np.partition(merged, capacity - 1)[:capacity]
+class _Tail:
+    """The `capacity` smallest values seen, kept lazily.
+
+    Once `capacity` values are kept, their maximum is a threshold no later value at or
+    above can pass (there are already `capacity` values below it). Candidates below it
+    wait in a pending list, and the buffer is compacted (``np.partition``) only when the
+    list has grown to `capacity`: a partition per ~capacity candidates instead of one per
+    batch. After the first batches few values pass, so the cost per trial falls to a
+    comparison.
+    """
+
+    def __init__(self, capacity):
+        self.capacity = capacity
+        self.kept = np.empty(0)
+        self.pending, self.pending_size = [], 0
+        self.threshold = np.inf
+
+    def add(self, values):
+        self.pending.append(values)
+        self.pending_size += len(values)
+        if self.pending_size >= max(self.capacity, 1):
+            self._compact()
+
+    def values(self):
+        self._compact()
+        return self.kept
+
+    def _compact(self):
+        if not self.pending:
+            return
+        merged = np.concatenate([self.kept] + self.pending)
+        self.pending, self.pending_size = [], 0
+        if len(merged) > self.capacity:
+            merged = np.partition(merged, self.capacity - 1)[:self.capacity]
+        self.kept = merged
+        if len(merged) == self.capacity:
+            self.threshold = merged.max()
+
+
+def _symmetric_ranks(m, probability):
+    """0-based ranks of the probabilistically symmetric endpoints among M sorted values
+    (those :func:`coverage_interval` picks); () when M is too small for an interval."""
+    q = _coverage_count(m, probability)
+    if m * (1 - probability) < 1 - 1e-9:
+        return ()
+    r = (m - q) // 2 if (m - q) % 2 == 0 else (m - q + 1) // 2
+    return (r - 1, r + q - 1)
 
 
 def batch_statistics(values, reference=None, probability=COVERAGE_PROBABILITY,
                      kind="symmetric"):
-    """Mean, u, low, high of one batch of shape (m, *shape) (for JCGM 101, 7.9)."""
-    stats = StreamingStatistics(values.shape[1:], tail_capacity(len(values), probability),
-                                reference)
-    stats.update(values)
-    return stats.result(probability, kind)
+    """Mean, u, low, high of one batch of shape (m, *shape) (for JCGM 101, 7.9).
+
+    One sort of the whole batch (vectorised over elements). Circular outputs are
+    unwrapped about `reference` and *not* wrapped back: batch values are only compared
+    with each other, and a wrap at 0/360 deg between batches would fake a huge spread.
+    """
+    values = np.asarray(values, dtype=float)
+    if reference is not None:
+        values = unwrap(values, reference)
+    shape = values.shape[1:]
+    flat = values.reshape(len(values), -1)
+    moments = Moments(flat.shape[1:])
+    moments.update(flat, np.isfinite(flat))
+    low, high = np.full(flat.shape[1], np.nan), np.full(flat.shape[1], np.nan)
+    ranks = _symmetric_ranks(len(flat), probability)
+    if kind == "symmetric" and ranks and np.all(moments.count == len(flat)):
+        # all values finite: the two order statistics by one partition (JCGM 101 7.7.2)
+        picked = np.partition(flat, ranks, axis=0)
+        low, high = picked[ranks[0]], picked[ranks[1]]
+    else:
+        ordered = np.sort(flat, axis=0)             # non-finite values sort last
+        for j, m in enumerate(moments.count):
+            column = ordered[:m, j]
+            low[j], high[j] = coverage_interval(column, column, int(m), probability, kind)
+    mean = np.where(moments.count > 0, moments.mean, np.nan)
+    return {"mean": mean.reshape(shape), "u": np.sqrt(moments.variance()).reshape(shape),
+            "low": low.reshape(shape), "high": high.reshape(shape)}
