@@ -48,7 +48,7 @@ References
 """
 import numpy as np
 
-from .rotation import attitude_matrix, rotation_about_vertical
+from .rotation import apply_matrix, attitude_matrix, rotation_about_vertical
 
 CORRECTION_MODELS = ("none", "yaw", "tilt2d", "full")
 
@@ -116,16 +116,16 @@ def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navig
 
 def _scan_correction(radial_velocity, model, operator, rotation, ship_velocity):
     """Eq. 13 [1]: u = R P u_lidar + s, with one navigation reading per scan."""
-    lidar_wind = operator @ radial_velocity                     # Eqs. 14-15, (..., 3, g)
+    lidar_wind = apply_matrix(operator, radial_velocity)        # Eqs. 14-15, (..., 3, g)
     if model == "full":
-        return rotation @ lidar_wind + ship_velocity[..., :, None]
+        return apply_matrix(rotation, lidar_wind) + ship_velocity[..., :, None]
     return _horizontal_rotation(rotation, lidar_wind, ship_velocity)
 
 
 def _horizontal_rotation(rotation, lidar_wind, ship_velocity):
     """Eq. 13 [1] on the horizontal lidar components; keeps the lidar-frame vertical."""
     horizontal_only = lidar_wind * np.array([1.0, 1.0, 0.0])[:, None]
-    earth = rotation @ horizontal_only + ship_velocity[..., :, None]
+    earth = apply_matrix(rotation, horizontal_only) + ship_velocity[..., :, None]
     vertical = np.broadcast_to(lidar_wind[..., 2:3, :], earth.shape[:-2] + (1, earth.shape[-1]))
     return np.concatenate([earth[..., :2, :], vertical], axis=-2)
 

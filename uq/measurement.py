@@ -178,8 +178,9 @@ def measurement_model(scene, outputs=OUTPUTS, **errors):
     err = {}
     for name in _ERROR_NAMES:
         value = np.asarray(errors.get(name, 0.0))
-        if name.startswith("ins_"):                  # INS errors to shape (n, *1, k)
-            value = value[:, None] if value.ndim == 1 else value + np.zeros((n, 1))
+        if name.startswith("ins_"):                  # INS errors to shape (n|1, *1, k)
+            # a missing (scalar) error stays one row: no per-sample rotation matrices
+            value = value[:, None] if value.ndim == 1 else value + np.zeros((1, 1))
         err[name] = value.reshape(value.shape[:1] + scenes + value.shape[1:]) \
             if value.ndim else value
     measured, navigation = _measure(scene, err, (n,) + scenes)
