@@ -89,3 +89,24 @@ def test_numerical_error_of_a_direction_at_north_is_not_a_wrap_artefact():
                        circular=("y",))
     # 2 s of 8 batch means of 2^14 trials: about 2 * 0.5 / sqrt(2^17) = 0.003 deg
     assert float(out["y_mc_numerical_error"]) < 0.02
+
+
+def test_batch_statistics_do_not_keep_the_batch_alive():
+    """Endpoints returned as views would keep every 2^14-trial batch in memory (8 bytes
+    per trial: 800 MB at 10^8 trials); they must own their data."""
+    from uq.statistics import batch_statistics
+    result = batch_statistics(np.random.default_rng(1).standard_normal((2**14, 3)))
+    assert all(result[key].base is None or result[key].base.size <= 3
+               for key in ("low", "high"))
+
+
+def test_tail_buffer_keeps_exactly_the_smallest():
+    from uq.statistics import _Tail
+    rng = np.random.default_rng(4)
+    tail, seen = _Tail(500), []
+    for size in (100, 3000, 10, 7000, 1):
+        values = rng.standard_normal(size)
+        seen.append(values)
+        tail.add(values[values < tail.threshold])
+    expected = np.sort(np.concatenate(seen))[:500]
+    np.testing.assert_array_equal(np.sort(tail.values()), expected)

@@ -60,6 +60,10 @@ def build_parser():
     report.add_argument("--target", type=float, action="append", metavar="U",
                         help="target u(wind speed) [m s-1] for the largest velocity ratio; "
                         "repeatable (default 0.05, 0.06 and 0.07)")
+    bench = commands.add_parser("bench", help="benchmark: error in u(wind speed) against "
+                                "wall time for every sampling method (results/bench.nc)")
+    bench.add_argument("-o", "--output", default="results/bench.nc", help="results file")
+    bench.add_argument("--quick", action="store_true", help="fewer sizes and repeats (~1 min)")
     check = commands.add_parser("check", help="validate a scenario without running it")
     check.add_argument("scenario", help="scenario YAML file")
     check.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
@@ -203,7 +207,49 @@ def _report(args):
     return EXIT_OK
 
 
-_COMMANDS = {"run": _run, "check": _check, "plot": _plot, "report": _report}
+def _bench(args):
+    from . import bench
+    from .io import write_results
+    from .plots import plot_bench
+    output = Path(args.output)
+    if output.suffix != ".nc":
+        raise ScenarioError("-o", str(output), "the output file must end in .nc")
+    sizes = [2**k for k in ((10, 13, 16, 18) if args.quick else (10, 12, 14, 16, 18, 19))]
+    repeats = 3 if args.quick else 8
+    dataset = bench.measure(sizes, repeats,
+                            progress=lambda text: print(f"  {text}", file=sys.stderr))
+    floors = {name: bench.draw_floor(name, sizes[-1]) for name in bench.SCENES}
+    median = dataset["time_s"].median("repeat")
+    for name, (floor, dimension) in floors.items():
+        plain = float(median.sel({"scene": name, "method": "mc", "n": sizes[-1]}))
+        dataset.attrs[f"{name}_mc_over_draw_floor"] = plain / floor
+        print(f"{name}: plain mc at n = {sizes[-1]} takes {plain:.3f} s, drawing its "
+              f"{dimension} normals per trial {floor:.3f} s: {plain / floor:.1f}x the floor")
+    targets = bench.time_to_target(dataset)
+    for name in bench.SCENES:
+        plain = targets[name, "mc"][0]
+        for method in bench.METHODS:
+            seconds, extrapolated = targets[name, method]
+            dataset.attrs[f"{name}_{method}_time_to_1e-3_s"] = seconds
+            print(f"{name:22s} {method:9s} time to 1e-3 in 95 % of runs: {seconds:9.3f} s"
+                  f"{' (extrapolated)' if extrapolated else ''}  speed-up vs mc "
+                  f"{plain / seconds:7.1f}x")
+    scans = bench.scan_throughput()
+    dataset.attrs["scans_1e6_s"] = scans
+    print(f"10^6 four-beam scans with radial noise: {scans:.3f} s")
+    if not args.quick:
+        seconds, megabytes = bench.scale()
+        dataset.attrs.update(scale_1e8_s=seconds, scale_1e8_peak_rss_mb=megabytes)
+        print(f"10^8 trials of the same scene: {seconds:.1f} s, peak resident memory "
+              f"{megabytes:.0f} MB")
+    write_results(dataset, output)
+    figure = plot_bench(dataset)
+    figure.savefig(output.with_suffix(".png"), dpi=120)
+    print(f"wrote {output} and {output.with_suffix('.png')}")
+    return EXIT_OK
+
+
+_COMMANDS = {"run": _run, "check": _check, "plot": _plot, "report": _report, "bench": _bench}
 
 if __name__ == "__main__":
     sys.exit(main())

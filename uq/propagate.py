@@ -248,7 +248,8 @@ class _Runner:
             outputs, linear = self._evaluate(first, blocks, min(n - first * RNG_BLOCK_SIZE,
                                                                blocks * RNG_BLOCK_SIZE))
             if self.stats is None:
-                self._start(tail_capacity(n) + 1, {q: v.shape[1:] for q, v in outputs.items()})
+                self._start(tail_capacity(n, kind=self.interval) + 1,
+                            {q: v.shape[1:] for q, v in outputs.items()})
             self._accumulate(outputs, linear)
 
     def run_adaptive(self, digits, stopping="jcgm101"):
@@ -258,7 +259,7 @@ class _Runner:
         while True:
             outputs, linear = self._evaluate(block, 1, RNG_BLOCK_SIZE)
             if self.stats is None:
-                self._start(tail_capacity(ADAPTIVE_MAX_SAMPLES) + 1,
+                self._start(tail_capacity(ADAPTIVE_MAX_SAMPLES, kind=self.interval) + 1,
                             {q: v.shape[1:] for q, v in outputs.items()})
             self._accumulate(outputs, linear)
             block += 1

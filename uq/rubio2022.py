@@ -197,7 +197,8 @@ def rubio2022_scene_uncertainty(scene, speed, u_heading, u_pitch, u_roll, u_sog,
     """
     shape = np.broadcast(speed, np.empty(scene.shape)).shape
     order = _beam_order(scene)
-    inside = rubio2022_domain_mask(scene) & np.ones(shape, dtype=bool)
+    # Eqs. A.5-A.20 divide by Vh: the model has no value for a calm (Vh = 0)
+    inside = rubio2022_domain_mask(scene) & (np.asarray(speed) > 0) & np.ones(shape, dtype=bool)
     result = {"wind_speed": np.full(shape, np.nan), "wind_direction": np.full(shape, np.nan),
               "radial_velocity": np.full(shape + (scene.n_beams,), np.nan)}
     if not inside.any():
@@ -205,19 +206,26 @@ def rubio2022_scene_uncertainty(scene, speed, u_heading, u_pitch, u_roll, u_sog,
     column = lambda value: np.asarray(value)[..., None]      # noqa: E731  against the beams
     speed, direction, sog, cog, cone = (column(v) for v in (
         speed, scene.wind_direction, scene.sog, scene.cog, scene.half_cone))
-    if scene.correction == "yaw":
-        u_radial, sens = _case_i(speed, direction, sog, cog, cone,
-                                 column(scene.heading + scene.misalignment),
-                                 u_heading, u_sog, u_cog)
-    else:
-        _, delta, beta = rubio2022_angles_from_attitude(0.0, scene.pitch, scene.roll)
-        u_radial, sens = _case_ii(speed, direction, sog, cog, cone, column(delta), column(beta),
-                                  u_pitch, u_roll, u_sog, u_cog)
+    with np.errstate(divide="ignore", invalid="ignore"):      # masked out below
+        u_radial, sens = _paper_case(scene, speed, direction, sog, cog, cone, column,
+                                     u_heading, u_pitch, u_roll, u_sog, u_cog)
     mask = lambda value: np.where(inside, np.broadcast_to(value, shape), np.nan)  # noqa: E731
     result["wind_speed"] = mask(rubio2022_combined_uncertainty(sens[0], u_radial))
     result["wind_direction"] = mask(np.rad2deg(rubio2022_combined_uncertainty(sens[1], u_radial)))
     result["radial_velocity"][..., order] = np.where(inside[..., None], u_radial, np.nan)
     return result
+
+
+def _paper_case(scene, speed, direction, sog, cog, cone, column, u_heading, u_pitch,
+                u_roll, u_sog, u_cog):
+    """Case i or ii of the paper for the scene's correction."""
+    if scene.correction == "yaw":
+        return _case_i(speed, direction, sog, cog, cone,
+                                 column(scene.heading + scene.misalignment),
+                                 u_heading, u_sog, u_cog)
+    _, delta, beta = rubio2022_angles_from_attitude(0.0, scene.pitch, scene.roll)
+    return _case_ii(speed, direction, sog, cog, cone, column(delta), column(beta),
+                    u_pitch, u_roll, u_sog, u_cog)
 
 
 def _case_i(speed, direction, sog, cog, cone, yaw, u_heading, u_sog, u_cog):
