@@ -200,6 +200,8 @@ class _Tail:
     def add(self, values):
         if len(values) > self.capacity:
             values = np.partition(values, self.capacity - 1)[:self.capacity]
+        if self.size + len(values) > 2 * self.capacity:
+            self._compact()                     # size <= capacity: the values now fit
         end = self.size + len(values)
         if end > len(self.buffer):
             grown = np.empty(min(max(end, 2 * len(self.buffer)), 2 * self.capacity))
