@@ -144,3 +144,14 @@ def test_floating_lidar_full_runs_with_ranges_and_every_error():
     heights = 3.0 + ds["range"].values
     np.testing.assert_allclose(ds.wind_speed_true, 8.0 * (heights / 100.0) ** 0.12, rtol=1e-12)
     assert int(ds.wind_speed_mc_n_invalid.sum()) == 0
+
+
+def test_result_says_what_was_skipped():
+    case = uq.run(uq.load_scenario(ROOT / "scenarios" / "rubio2022_case_i.yaml",
+                                   {"sampling.n": 1000, "sweep": {}}))
+    full = uq.run(uq.load_scenario(ROOT / "scenarios" / "floating_lidar_full.yaml",
+                                   {"sampling.n": 1000}))
+    assert "computed once per scene" in case.attrs["skipped"]
+    assert "input not sampled (no error declared): ins.pitch" in case.attrs["skipped"]
+    assert "output not requested, not computed: radial_velocity" in case.attrs["skipped"]
+    assert full.attrs["skipped"] == "nothing"      # every error declared, every output

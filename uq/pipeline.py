@@ -240,8 +240,26 @@ def _annotate(ds, scenario):
     return ds
 
 
+def skipped_work(settings, outputs):
+    """What the model did not compute for this scenario, in words (the ``skipped``
+    attribute): each line names a shortcut the measurement model took."""
+    lidar, ins = settings["lidar"], settings["ins"]
+    lines = [f"input not sampled (no error declared): {key}" for key in
+             [f"ins.{k}" for k in INS_KEYS if k not in ins]
+             + [f"lidar.errors.{k}" for k in ("half_cone", "misalignment", "radial_velocity")
+                if k not in lidar["errors"]]]
+    if not ({"half_cone", "misalignment"} & set(lidar["errors"])):
+        lines.append("true beams and true radial velocities computed once per scene, not "
+                     "per trial (no geometry errors)")
+    if settings["correction"] in ("none", "yaw"):
+        lines.append(f"correction '{settings['correction']}': no pitch/roll rotation")
+    lines += [f"output not requested, not computed: {q}" for q in OUTPUTS if q not in outputs]
+    return "; ".join(lines) or "nothing"
+
+
 def _global_attributes(scenario, seed, dataset, started):
     return {"title": f"uq results: {scenario.name}",
+            "skipped": skipped_work(scenario.settings, scenario.outputs),
             "Conventions": "CF-1.10",
             "scenario": scenario.text,
             "uq_version": __version__,
