@@ -92,3 +92,15 @@ def test_rubio2022_rotation_reproduces_eq7_beam():
             + np.sin(beta) * np.cos(delta) * np.cos(theta))
     np.testing.assert_allclose((rubio2022_rotation(delta, beta) @ beam)[:2], [north, east],
                                atol=1e-15)
+
+
+@pytest.mark.parametrize("matrix_shape, vector_shape", [
+    ((3, 3), (5, 3, 2)), ((1, 3, 3), (5, 3, 1)), ((1, 1, 3, 3), (5, 4, 3, 2)),
+    ((3, 4), (7, 4, 1)), ((2, 3, 3), (5, 2, 3, 1)), ((6, 1, 3, 3), (6, 2, 3, 1))])
+def test_apply_matrix_equals_matmul(matrix_shape, vector_shape):
+    """Both paths (one BLAS product for a single matrix, einsum for stacks) are matmul,
+    up to the order of three additions (a few ulps)."""
+    from uq.rotation import apply_matrix
+    rng = np.random.default_rng(3)
+    matrix, vectors = rng.random(matrix_shape), rng.random(vector_shape)
+    np.testing.assert_allclose(apply_matrix(matrix, vectors), matrix @ vectors, rtol=1e-14)
