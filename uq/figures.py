@@ -21,7 +21,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
-from .planning import VELOCITY_RATIOS, models, velocity_ratio_line  # noqa: E402
+from .planning import VELOCITY_RATIOS, velocity_ratio_line  # noqa: E402
+from .planning import models as available_models  # noqa: E402
 from .plots import plot_uncertainty_against_direction  # noqa: E402
 
 #: Uncertainty variables: suffix -> (label, line style).
@@ -45,7 +46,7 @@ def _label(quantity):
 def fig2_speed_maps(dataset):
     """Fig. 2 [1]: u(Vh) over wind direction x misalignment, one row per cog, one column
     per model; the red line (right axis) is the direction average."""
-    models = models(dataset, "wind_speed")
+    models = available_models(dataset, "wind_speed")
     cogs = dataset["ship_cog"].values
     figure, axes = plt.subplots(len(cogs), len(models), figsize=(4.2 * len(models), 2.8 * len(cogs)),
                                 sharex=True, sharey=True, constrained_layout=True, squeeze=False)
@@ -78,7 +79,7 @@ def fig2_speed_maps(dataset):
 def fig3_direction_against_misalignment(dataset):
     """Fig. 3 [1]: direction-averaged u(Theta) against misalignment, a line per cog
     (blue to green) and the mean over cog (red); one panel per model."""
-    models = models(dataset, "wind_direction")
+    models = available_models(dataset, "wind_direction")
     figure, axes = plt.subplots(1, len(models), figsize=(4.2 * len(models), 3.4), sharey=True,
                                 constrained_layout=True, squeeze=False)
     colours = plt.cm.winter(np.linspace(0, 1, dataset.sizes["ship_cog"]))
@@ -98,7 +99,7 @@ def fig3_direction_against_misalignment(dataset):
 
 def fig4a_speed_against_velocities(dataset):
     """Fig. 4a [1]: direction-averaged u(Vh) over Vh x sog, with the VR = 0.5, 1, 2 lines."""
-    models = models(dataset, "wind_speed")
+    models = available_models(dataset, "wind_speed")
     figure, axes = plt.subplots(1, len(models), figsize=(4.2 * len(models), 3.6), sharey=True,
                                 constrained_layout=True, squeeze=False)
     means = {m: direction_mean(dataset, f"wind_speed_{m}") for m in models}
@@ -124,7 +125,7 @@ def fig4b_relative_against_speed(dataset):
     figure, ax = plt.subplots(figsize=(5.5, 3.6), constrained_layout=True)
     colours = ("tab:blue", "tab:orange", "tab:green")
     for ratio, colour in zip(VELOCITY_RATIOS, colours):
-        for model in models(dataset, "wind_speed"):
+        for model in available_models(dataset, "wind_speed"):
             at, line = velocity_ratio_line(dataset, f"wind_speed_{model}", ratio)
             ax.plot(at, 100 * line / at, MODELS[model][1], color=colour,
                     label=f"VR = {ratio:g}, {MODELS[model][0]}")
@@ -141,7 +142,7 @@ def fig5_radial_against_direction(dataset):
     beams = dataset["beam"].values
     figure, axes = plt.subplots(2, len(beams), figsize=(3.3 * len(beams) + 1.5, 6), sharex=True,
                                 sharey=True, constrained_layout=True, squeeze=False)
-    models = models(dataset, "radial_velocity")
+    models = available_models(dataset, "radial_velocity")
     for row, (tilt, other) in enumerate((("ship_pitch", "ship_roll"), ("ship_roll", "ship_pitch"))):
         level = dataset.sel({other: 0.0})
         values = level[tilt].values
@@ -169,7 +170,7 @@ def fig5_radial_against_direction(dataset):
 def fig6_tilt_maps(dataset):
     """Fig. 6 [1]: direction-averaged u(Vh) (top) and u(Theta) (bottom) over pitch x roll,
     one column per model."""
-    models = models(dataset, "wind_speed")
+    models = available_models(dataset, "wind_speed")
     figure, axes = plt.subplots(2, len(models), figsize=(4 * len(models), 6.4),
                                 constrained_layout=True, squeeze=False)
     for row, quantity in enumerate(("wind_speed", "wind_direction")):
@@ -192,7 +193,7 @@ def fig7_half_cone(dataset):
     """Fig. 7 [1]: direction-averaged u(Vh) and u(Theta) against the half-cone angle."""
     figure, axes = plt.subplots(1, 2, figsize=(10, 3.6), constrained_layout=True)
     for ax, quantity in zip(axes, ("wind_speed", "wind_direction")):
-        for model in models(dataset, quantity):
+        for model in available_models(dataset, quantity):
             ax.plot(dataset["lidar_half_cone"], direction_mean(dataset, f"{quantity}_{model}"),
                     MODELS[model][1], marker="o", ms=3, label=MODELS[model][0])
         ax.set_xlabel("half-cone angle [deg]")
@@ -211,9 +212,9 @@ def plot_against_sweep(dataset):
     figure, axes = plt.subplots(1, len(quantities), figsize=(4.5 * len(quantities), 3.4),
                                 constrained_layout=True, squeeze=False)
     for ax, quantity in zip(axes[0], quantities):
-        data = dataset[[f"{quantity}_{m}" for m in models(dataset, quantity)]]
+        data = dataset[[f"{quantity}_{m}" for m in available_models(dataset, quantity)]]
         extra = [d for d in data.dims if d != dim]
-        for model in models(dataset, quantity):
+        for model in available_models(dataset, quantity):
             line = data[f"{quantity}_{model}"]
             line = line.isel({d: 0 for d in extra}) if extra else line
             ax.plot(dataset[dim], line, MODELS[model][1], marker="o", ms=3, label=MODELS[model][0])
