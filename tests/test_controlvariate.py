@@ -79,3 +79,12 @@ def test_pipeline_accepts_the_control_variate():
     # both estimate the same u: within 4 combined standard errors
     difference = float(result["wind_speed_mc_u"] - plain["wind_speed_mc_u"])
     assert abs(difference) < 4 * float(plain["wind_speed_mc_u_standard_error"])
+
+
+def test_control_variate_without_a_jacobian_is_refused():
+    """A model that rejects complex input has no GUM, so no control variate: a clear error,
+    not NaN results."""
+    def not_complex_safe(x1, x2):
+        return np.floor(x1) + x1 * x2          # floor rejects complex input
+    with pytest.raises(ValueError, match="control variate needs the GUM Jacobian"):
+        uq.propagate(not_complex_safe, INPUTS, n=2**10, seed=1, control_variate=True)

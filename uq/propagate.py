@@ -79,12 +79,11 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         decided by sampling noise), ``q_budget`` (dimension
         ``input``), ``q_mc_u_standard_error`` (standard error of ``q_mc_u`` from its
         spread over independent batches: 2^14 trials for mc, whole RNG blocks, i.e.
-        independent randomisations, for lhs and sobol); circular outputs also
+        independent randomisations, for lhs and sobol), ``q_mc_numerical_tolerance``
+        (delta of the requested digits, JCGM 101 7.9.2); circular outputs also
         ``q_mc_circular_std``.
     """
-    _check_arguments(n, digits, method, interval)
-    if stopping not in STOPPING_RULES:
-        raise ValueError(f"stopping must be one of {STOPPING_RULES}, got {stopping!r}")
+    _check_arguments(n, digits, method, interval, stopping)
     seed = _entropy(seed)
     inputs_laid = input_set(inputs, correlation)
     circular = set(circular)
@@ -99,13 +98,13 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
                   for q in gum_value}
     runner = _Runner(wrapped, inputs_laid, method, seed, references, interval, chunk_size)
     if control_variate:
+        if gum_note.startswith("no GUM"):
+            raise ValueError(f"the control variate needs the GUM Jacobian, and there is {gum_note}")
         runner.control = {q: (jacobian[q], gum.combined_uncertainty(jacobian[q], inputs_laid))
                           for q in jacobian}
-    if method == "none":
-        pass
-    elif n is not None:
+    if method != "none" and n is not None:
         runner.run_fixed(int(n))
-    else:
+    elif method != "none":
         runner.run_adaptive(digits or DEFAULT_DIGITS, stopping)
     validation_digits = digits or DEFAULT_DIGITS
     dataset = _gum_dataset(gum_value, jacobian, inputs_laid, output_dims or {})
@@ -134,7 +133,7 @@ def _circular_reference(value):
     return np.where(np.isfinite(value), value, 0.0)
 
 
-def _check_arguments(n, digits, method, interval):
+def _check_arguments(n, digits, method, interval, stopping):
     if n is not None and digits is not None:
         raise ValueError("give either n or digits, not both")
     if n is not None and int(n) < 2:
@@ -145,6 +144,8 @@ def _check_arguments(n, digits, method, interval):
         raise ValueError(f"method must be one of {PROPAGATION_METHODS}, got {method!r}")
     if interval not in INTERVALS:
         raise ValueError(f"interval must be one of {INTERVALS}, got {interval!r}")
+    if stopping not in STOPPING_RULES:
+        raise ValueError(f"stopping must be one of {STOPPING_RULES}, got {stopping!r}")
 
 
 def _entropy(seed):
