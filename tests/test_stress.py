@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
 import uq
@@ -106,7 +106,10 @@ def test_directions_straddling_north(direction):
     assert width == pytest.approx(2 * 1.96 * 2.0, rel=0.05)      # not 360 - width
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@example(speed=1.0, direction=0.0, half_cone=65.0, pitch=0.0, roll=30.0, heading=0.0,
+         error=0.03125)            # found by hypothesis in CI: the east beam points down
+@settings(max_examples=40, deadline=None, derandomize=True,   # same examples on every CI run
+          suppress_health_check=[HealthCheck.too_slow])
 @given(speed=st.floats(0.5, 30.0), direction=st.floats(0.0, 359.99),
        half_cone=st.floats(5.0, 70.0), pitch=st.floats(-30.0, 30.0),
        roll=st.floats(-30.0, 30.0), heading=st.floats(0.0, 359.99),
@@ -116,13 +119,20 @@ def test_property_small_errors_gum_equals_monte_carlo(speed, direction, half_con
     """Any scene, small errors: the model is locally linear, so Monte Carlo's u equals the
     GUM's within K standard errors, nothing is NaN and no warning is raised. "Small" is
     judged by the result: the wind-vector error below 10 % of the speed, where the
-    second-order term of |v|, (u/V)^2 / 4 relative, is < 0.3 %, far inside K/sqrt(2N)."""
+    second-order term of |v|, (u/V)^2 / 4 relative, is < 0.3 %, far inside K/sqrt(2N).
+    Scenes whose beams point into the sea are outside the model: all NaN, all counted."""
     result = run(**{"wind.speed": speed, "wind.direction": direction,
                     "lidar.half_cone": half_cone, "ship.pitch": pitch, "ship.roll": roll,
                     "ship.heading": heading, "sampling.n": 2**14,
                     "ins.heading": {"dist": "normal", "u": error},
                     "ins.pitch": {"dist": "normal", "u": error},
                     "lidar.errors.radial_velocity": {"dist": "normal", "u": error}})
+    if np.isnan(float(result["wind_speed_nominal"])):
+        # a beam tilted below the horizontal (half-cone + tilt > 90 deg) measures in the
+        # sea: the scene is outside the model; every trial is NaN, counted, and no warning
+        assert int(result["wind_speed_mc_n_invalid"]) == 2**14
+        assert np.isnan(float(result["wind_speed_gum_u"]))
+        return
     for q in ("wind_speed", "vertical_wind"):
         assert int(result[f"{q}_mc_n_invalid"]) == 0
     assume(float(result["wind_speed_gum_u"]) < 0.1 * speed)
