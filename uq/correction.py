@@ -123,11 +123,14 @@ def _scan_correction(radial_velocity, model, operator, rotation, ship_velocity):
 
 
 def _horizontal_rotation(rotation, lidar_wind, ship_velocity):
-    """Eq. 13 [1] on the horizontal lidar components; keeps the lidar-frame vertical."""
-    horizontal_only = lidar_wind * np.array([1.0, 1.0, 0.0])[:, None]
-    earth = apply_matrix(rotation, horizontal_only) + ship_velocity[..., :, None]
+    """Eq. 13 [1] on the horizontal lidar components; keeps the lidar-frame vertical.
+
+    ``[R P u]_h = R[:2, :2] u_h`` since P = diag(1, 1, 0) drops the third column of R.
+    """
+    earth = apply_matrix(rotation[..., :2, :2], lidar_wind[..., :2, :]) \
+        + ship_velocity[..., :2, None]
     vertical = np.broadcast_to(lidar_wind[..., 2:3, :], earth.shape[:-2] + (1, earth.shape[-1]))
-    return np.concatenate([earth[..., :2, :], vertical], axis=-2)
+    return np.concatenate([earth, vertical], axis=-2)
 
 
 def _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship_velocity):

@@ -70,7 +70,9 @@ class InputSet:
 
         Returns dict name -> array of shape (n, *shape) of the random inputs only.
         """
-        correlated = scores @ self.cholesky.T if self.dimension else scores
+        # independent inputs (identity Cholesky factor): no product needed
+        independent = not self.dimension or np.array_equal(self.cholesky, np.eye(self.dimension))
+        correlated = scores if independent else scores @ self.cholesky.T
         arrays = {}
         for name in self.names:
             start = self.offsets[name]
