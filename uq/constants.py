@@ -45,3 +45,7 @@ HALF_CIRCLE_DEG = 180.0
 #: 2^20 keeps one evaluation near 200 MB, and large enough that the per-call overhead
 #: (~1 ms) is small against the arithmetic.
 SWEEP_CHUNK_ELEMENTS = 2**20
+
+#: von Karman constant [1]: 0.40, the value of Hogstrom (1996), Boundary-Layer
+#: Meteorol. 78, 215-246 (0.40 +- 0.01 from his review of surface-layer experiments).
+VON_KARMAN = 0.40
