@@ -5,7 +5,8 @@ gives the parameters and their covariance; the bands follow from the delta metho
 ``var f(z) = g(z)^T C g(z)`` with g the exact (complex-step) gradient of the profile with
 respect to the parameters:
 
-* confidence band of the mean profile: ``f +- t_{(1+p)/2, n-k} sqrt(g^T C g)``;
+* confidence band of the mean profile: ``f +- t_{(1+p)/2, n-k} sqrt(g^T C g)`` (the
+  normal quantile when the speeds' uncertainties are given, i.e. known);
 * prediction band of a new measurement: ``f +- t sqrt(g^T C g + s^2)``, s^2 the residual
   variance (or the given measurement variance when ``sigma`` is absolute).
 
@@ -77,8 +78,10 @@ def least_squares_profile(name, heights, speeds, sigma=None, fixed=None, confide
     mean_variance = np.einsum("gk,kl,gl->g", gradient, covariance, gradient)
     noise = np.interp(grid, heights, np.asarray(sigma, float) ** 2) if absolute \
         else residual_variance
-    t_confidence = student_t.ppf((1 + confidence) / 2, dof)
-    t_prediction = student_t.ppf((1 + prediction) / 2, dof)
+    # known (absolute) variances: normal quantiles; estimated scatter: Student t, n - k dof
+    quantile_dof = np.inf if absolute else dof
+    t_confidence = student_t.ppf((1 + confidence) / 2, quantile_dof)
+    t_prediction = student_t.ppf((1 + prediction) / 2, quantile_dof)
     errors = np.sqrt(np.diag(covariance))
     fit = model(grid, *parameters)
     return {"names": names, "units": units, "parameters": parameters, "standard_errors": errors,

@@ -1,0 +1,251 @@
+"""Bayesian wind-profile fit with emcee: posterior of the profile parameters.
+
+Likelihood. The measured speeds y (n gates) are Gaussian about the profile f(z; theta)
+with covariance
+
+    Sigma = Sigma_meas + diag(f'(z)^2) . Sigma_z + sigma^2 I
+
+* ``Sigma_meas``: the measurement covariance of the speeds; full when errors are common
+  to the gates (INS or mounting errors), not only its diagonal;
+* ``Sigma_z``: the covariance of the gates' true heights, carried into speed to first
+  order through the profile's slope f'(z) (``diag(f') Sigma_z diag(f')``);
+* ``sigma = exp(ln_sigma)``: a free extra scatter (turbulence), optional.
+
+Priors are uniform within bounds (:data:`DEFAULT_PRIORS`, documented there), or
+log-uniform where marked. The posterior is sampled by emcee's affine-invariant ensemble
+(Foreman-Mackey et al. 2013) in several independent ensembles, each started in a small
+ball about the maximum a posteriori and seeded through emcee's State random_state.
+Convergence is decided, and failure raised, from the integrated autocorrelation time
+(each chain longer than 50 tau; burn-in 2 tau and thinning tau/2 derived from it) and
+the rank-normalised split R-hat across ensembles (Vehtari et al. 2021, < 1.01).
+
+References
+----------
+.. [1] Foreman-Mackey, D. et al. (2013). emcee: The MCMC Hammer. PASP 125, 306.
+.. [2] Vehtari, A. et al. (2021). Rank-normalization, folding, and localization: an
+   improved R-hat. Bayesian Analysis 16(2), 667-718.
+"""
+from dataclasses import dataclass
+
+import emcee
+import numpy as np
+from scipy.optimize import minimize
+from scipy.special import ndtri
+from scipy.stats import rankdata
+
+from .constants import COMPLEX_STEP
+from .profilefit import least_squares_profile
+from .profiles import PROFILES
+
+#: Prior bounds per parameter: (low, high, "uniform" | "log-uniform"). Wide enough for any
+#: atmospheric profile over sea (shear -0.5 ... 1; u* up to 3 m/s; z0 from 1 um to 1 m);
+#: ln_sigma from e^-10 (no scatter) to e^2 = 7.4 m/s (more than any 10-min scatter).
+DEFAULT_PRIORS = {
+    "reference_speed": (0.0, 60.0, "uniform"),
+    "shear": (-0.5, 1.0, "uniform"),
+    "friction_velocity": (0.0, 3.0, "uniform"),
+    "roughness_length": (1e-6, 1.0, "log-uniform"),
+    "ln_sigma": (-10.0, 2.0, "uniform"),
+}
+#: Chains must be longer than this many autocorrelation times [2].
+TAU_FACTOR = 50
+#: Largest acceptable rank-normalised split R-hat [2].
+RHAT_LIMIT = 1.01
+MIN_WALKERS = 32
+#: Relative radius of the starting ball about the MAP [1]: small against any posterior
+#: width here, large enough that the walkers are not degenerate.
+BALL = 1e-4
+
+
+class NotConverged(RuntimeError):
+    """The chains did not converge within the allowed number of steps."""
+
+
+@dataclass(frozen=True)
+class ProfileData:
+    """What is fitted: heights [m], speeds [m s-1] and their covariances."""
+
+    heights: np.ndarray
+    speeds: np.ndarray
+    speed_covariance: np.ndarray       # (n, n) [m2 s-2]
+    height_covariance: np.ndarray      # (n, n) [m2]
+
+
+def profile_data(heights, speeds, speed_covariance=None, height_covariance=None):
+    """ProfileData with zero covariances where none are given (1-D input = std devs)."""
+    heights, speeds = np.asarray(heights, float), np.asarray(speeds, float)
+    return ProfileData(heights, speeds, _covariance(speed_covariance, len(heights)),
+                       _covariance(height_covariance, len(heights)))
+
+
+def _covariance(value, n):
+    if value is None:
+        return np.zeros((n, n))
+    value = np.asarray(value, float)
+    return np.diag(value**2) if value.ndim == 1 else value
+
+
+class ProfilePosterior:
+    """log posterior of (profile parameters, [ln_sigma]) given ProfileData."""
+
+    def __init__(self, name, data, fixed=None, scatter=True, priors=None):
+        self.function, self.names, _, _ = PROFILES[name]
+        self.name, self.data, self.fixed = name, data, dict(fixed or {})
+        self.scatter = scatter
+        self.parameter_names = tuple(self.names) + (("ln_sigma",) if scatter else ())
+        self.priors = {**DEFAULT_PRIORS, **(priors or {})}
+
+    def model(self, heights, *parameters):
+        return self.function(heights, *parameters, **self.fixed)
+
+    def log_prior(self, theta):
+        total = 0.0
+        for value, name in zip(theta, self.parameter_names):
+            low, high, kind = self.priors[name]
+            if not low <= value <= high:
+                return -np.inf
+            total += -np.log(value) if kind == "log-uniform" else 0.0
+        return total
+
+    def covariance(self, theta):
+        """Total covariance of the speeds at theta [m2 s-2]."""
+        k = len(self.names)
+        slope = self._slope(theta[:k])
+        total = self.data.speed_covariance + slope[:, None] * self.data.height_covariance \
+            * slope[None, :]
+        if self.scatter:
+            total = total + np.exp(2 * theta[k]) * np.eye(len(self.data.heights))
+        return total
+
+    def _slope(self, parameters):
+        """dU/dz at the gate heights, by complex step [s-1]."""
+        step = COMPLEX_STEP
+        return np.imag(self.model(self.data.heights + 1j * step, *parameters)) / step
+
+    def log_likelihood(self, theta):
+        k = len(self.names)
+        residual = self.data.speeds - self.model(self.data.heights, *theta[:k])
+        try:
+            factor = np.linalg.cholesky(self.covariance(theta))
+        except np.linalg.LinAlgError:
+            return -np.inf
+        if not np.all(np.isfinite(residual)):
+            return -np.inf
+        whitened = np.linalg.solve(factor, residual)
+        return -0.5 * (whitened @ whitened) - np.sum(np.log(np.diag(factor))) \
+            - 0.5 * len(residual) * np.log(2 * np.pi)
+
+    def __call__(self, theta):
+        prior = self.log_prior(theta)
+        return prior + self.log_likelihood(theta) if np.isfinite(prior) else -np.inf
+
+
+def maximum_a_posteriori(posterior):
+    """MAP by Nelder-Mead from the least-squares fit (and the residual scatter)."""
+    data = posterior.data
+    start = least_squares_profile(posterior.name, data.heights, data.speeds,
+                                  fixed=posterior.fixed)
+    theta = list(start["parameters"])
+    if posterior.scatter:
+        theta.append(np.log(max(start["residual_std"], np.exp(posterior.priors["ln_sigma"][0] + 1))))
+    result = minimize(lambda t: -posterior(t), np.array(theta), method="Nelder-Mead",
+                      options={"xatol": 1e-10, "fatol": 1e-10, "maxiter": 20000})
+    return result.x
+
+
+def rank_rhat(chains):
+    """Rank-normalised split R-hat [2] of one parameter; chains shape (m, n) -> float.
+
+    The larger of the bulk (rank-normalised draws) and tail (rank-normalised folded
+    draws |x - median|) split R-hat.
+    """
+    def split_rhat(values):
+        half = values.shape[1] // 2
+        split = np.concatenate([values[:, :half], values[:, half:2 * half]])
+        n = split.shape[1]
+        within = np.mean(np.var(split, axis=1, ddof=1))
+        between = n * np.var(np.mean(split, axis=1), ddof=1)
+        return np.sqrt(((n - 1) / n * within + between / n) / within)
+
+    def normalised(values):
+        ranks = rankdata(values, method="average").reshape(values.shape)
+        return ndtri((ranks - 3 / 8) / (values.size + 1 / 4))
+
+    chains = np.asarray(chains, float)
+    folded = np.abs(chains - np.median(chains))
+    return max(split_rhat(normalised(chains)), split_rhat(normalised(folded)))
+
+
+def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=2000,
+                     max_steps=50000):
+    """Sample with several independent emcee ensembles until converged.
+
+    Each ensemble runs in rounds of `steps` until its chain is longer than TAU_FACTOR
+    times its largest autocorrelation time (or `max_steps`); then burn-in (2 tau) is
+    dropped, the chains are thinned (tau / 2) and R-hat is taken across ensembles.
+
+    Parameters
+    ----------
+    posterior : ProfilePosterior
+    seed : int or numpy.random.Generator
+        Same seed, same chains.
+
+    Returns
+    -------
+    dict
+        ``samples`` (ensembles, draws, parameters) after burn-in and thinning, ``chain``
+        (ensembles, steps, walkers, parameters) in full, ``tau``, ``burn``, ``thin``,
+        ``rhat`` per parameter, ``map``, ``names``.
+
+    Raises
+    ------
+    NotConverged
+        With tau, the chain length and R-hat, when either criterion fails.
+    """
+    if walkers < MIN_WALKERS:
+        raise ValueError(f"walkers must be >= {MIN_WALKERS}, got {walkers}")
+    entropy = seed.integers(2**63) if isinstance(seed, np.random.Generator) else seed
+    streams = np.random.SeedSequence(entropy).spawn(ensembles + 1)
+    centre = maximum_a_posteriori(posterior)
+    ball = np.random.default_rng(streams[-1])
+    chains, taus = [], []
+    for stream in streams[:-1]:
+        start = centre * (1 + BALL * ball.standard_normal((walkers, centre.size))) \
+            + BALL * ball.standard_normal((walkers, centre.size)) * (centre == 0)
+        state = emcee.State(start, random_state=np.random.RandomState(
+            np.random.MT19937(stream)).get_state())
+        sampler = emcee.EnsembleSampler(walkers, centre.size, posterior)
+        chain, tau = _run_until_converged(sampler, state, steps, max_steps)
+        chains.append(chain)
+        taus.append(tau)
+    tau = np.max(taus, axis=0)
+    burn, thin = int(np.ceil(2 * tau.max())), max(1, int(tau.min() / 2))
+    samples = np.array([c[burn::thin].reshape(-1, centre.size) for c in chains])
+    rhat = np.array([rank_rhat(samples[:, :, k]) for k in range(centre.size)])
+    length = min(len(c) for c in chains)
+    if length < TAU_FACTOR * tau.max() or np.any(rhat > RHAT_LIMIT):
+        raise NotConverged(
+            f"the chains did not converge: length {length} steps against {TAU_FACTOR} x tau "
+            f"= {TAU_FACTOR * tau.max():.0f} (tau {np.round(tau, 1).tolist()}), rank R-hat "
+            f"{np.round(rhat, 4).tolist()} (limit {RHAT_LIMIT}); allowed: more steps "
+            "(max_steps), more walkers, or narrower priors")
+    return {"samples": samples, "chain": np.array([c[:length] for c in chains]), "tau": tau,
+            "burn": burn, "thin": thin, "rhat": rhat, "map": centre,
+            "names": posterior.parameter_names}
+
+
+def _run_until_converged(sampler, state, steps, max_steps):
+    """Run in rounds; stop once longer than TAU_FACTOR x tau (tau estimate settled)."""
+    while True:
+        state = sampler.run_mcmc(state, steps, progress=False)
+        tau = sampler.get_autocorr_time(tol=0)
+        if sampler.iteration > TAU_FACTOR * np.max(tau) or sampler.iteration >= max_steps:
+            return sampler.get_chain(), tau
+
+
+def posterior_summary(samples, names):
+    """Median and the 68 % and 95 % central credible intervals of each parameter."""
+    flat = samples.reshape(-1, samples.shape[-1])
+    quantiles = np.quantile(flat, [0.025, 0.16, 0.5, 0.84, 0.975], axis=0)
+    return {name: dict(zip(("low95", "low68", "median", "high68", "high95"), quantiles[:, k]))
+            for k, name in enumerate(names)}
