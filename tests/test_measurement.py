@@ -124,3 +124,25 @@ def test_shear_with_tilt_uses_true_beam_heights():
     east_height = slant * np.cos(d(28)) * np.cos(d(10))  # pitch tilts the east beam's up component
     assert radial[1] == pytest.approx(-5.0 * (east_height / 100.0) ** 0.2 * np.sin(d(28)),
                                       rel=1e-12)
+
+
+@pytest.mark.parametrize("pitch, roll", [(0.0, 0.0), (10.0, 0.0), (0.0, -7.0), (6.0, 4.0)])
+def test_gate_height_of_a_tilted_lidar(pitch, roll):
+    """Four beams at 0/90/180/270 deg, half-cone theta, tilt by pitch p (bow up): the fore
+    and aft beams point cos(theta -+ p) up and the side beams cos(theta) cos(p), so the
+    mean gate height is H + r cos(p) (and with roll r_o too, H + r cos(p) cos(r_o),
+    because the mean of the four beams is the cone axis times cos(theta)). Level: H + r."""
+    scene = make_scene(**{"ship.pitch": pitch, "ship.roll": roll, "lidar.height": 3.0,
+                          "lidar.ranges": [40.0, 100.0]})
+    height = reconstruct(scene)["gate_height"]
+    expected = 3.0 + np.array([40.0, 100.0]) * np.cos(d(pitch)) * np.cos(d(roll))
+    np.testing.assert_allclose(height, expected, rtol=1e-12)
+    np.testing.assert_allclose(true_values(scene)["gate_height"], 3.0 + np.array([40.0, 100.0]))
+
+
+def test_half_cone_error_moves_the_gates():
+    """The gate is placed at r / cos(theta) along the configured cone; a true cone
+    theta + e puts it at r cos(theta + e) / cos(theta)."""
+    scene = make_scene(**{"lidar.height": 0.0, "lidar.ranges": [100.0]})
+    height = reconstruct(scene, lidar_half_cone=np.array([1.0]))["gate_height"]
+    assert height[0] == pytest.approx(100.0 * np.cos(d(29)) / np.cos(d(28)), rel=1e-12)

@@ -49,7 +49,7 @@ def test_eq6_equals_physical_model(p):
                           "wind.reference_height": 100.0, "lidar.height": 0.0,
                           "lidar.ranges": [100.0], "correction": "yaw"})
     from uq.measurement import _measure, _ERROR_NAMES
-    measured, _ = _measure(scene, {n: np.zeros(1) if not n.startswith("ins_") else np.zeros((1, 1))
+    measured, _, _ = _measure(scene, {n: np.zeros(1) if not n.startswith("ins_") else np.zeros((1, 1))
                                    for n in _ERROR_NAMES}, 1)
     np.testing.assert_allclose(measured[0, :, 0], radial_i(p), rtol=1e-13, atol=1e-13)
 
@@ -80,7 +80,7 @@ def test_eq7_equals_physical_model(p, tilt):
                           "ship.heading": np.rad2deg(heading), "ship.pitch": np.rad2deg(pitch), "ship.roll": np.rad2deg(roll),
                           "lidar.half_cone": np.rad2deg(p["cone"]), "correction": "tilt2d"})
     from uq.measurement import _measure, _ERROR_NAMES
-    measured, _ = _measure(scene, {n: np.zeros(1) if not n.startswith("ins_") else np.zeros((1, 1))
+    measured, _, _ = _measure(scene, {n: np.zeros(1) if not n.startswith("ins_") else np.zeros((1, 1))
                                    for n in _ERROR_NAMES}, 1)
     np.testing.assert_allclose(measured[0, :, 0], radial_ii(p, *tilt), rtol=1e-12, atol=1e-13)
 

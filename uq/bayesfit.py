@@ -99,45 +99,73 @@ class ProfilePosterior:
         return self.function(heights, *parameters, **self.fixed)
 
     def log_prior(self, theta):
-        total = 0.0
-        for value, name in zip(theta, self.parameter_names):
+        """log prior of parameter vectors theta (..., k) (0 or -inf for uniform bounds)."""
+        theta = np.asarray(theta, float)
+        total = np.zeros(theta.shape[:-1])
+        for k, name in enumerate(self.parameter_names):
             low, high, kind = self.priors[name]
-            if not low <= value <= high:
-                return -np.inf
-            total += -np.log(value) if kind == "log-uniform" else 0.0
+            value = theta[..., k]
+            inside = (low <= value) & (value <= high)
+            log_density = -np.log(np.where(inside, value, 1.0)) if kind == "log-uniform" else 0.0
+            total = np.where(inside, total + log_density, -np.inf)
         return total
 
     def covariance(self, theta):
-        """Total covariance of the speeds at theta [m2 s-2]."""
+        """Total covariance of the speeds at theta (..., k) [m2 s-2], shape (..., n, n)."""
+        theta = np.asarray(theta, float)
         k = len(self.names)
-        slope = self._slope(theta[:k])
-        total = self.data.speed_covariance + slope[:, None] * self.data.height_covariance \
-            * slope[None, :]
+        slope = self._slope(theta[..., :k])
+        total = self.data.speed_covariance + slope[..., :, None] * self.data.height_covariance \
+            * slope[..., None, :]
         if self.scatter:
-            total = total + np.exp(2 * theta[k]) * np.eye(len(self.data.heights))
+            total = total + np.exp(2 * theta[..., k])[..., None, None] * np.eye(
+                len(self.data.heights))
         return total
 
     def _slope(self, parameters):
-        """dU/dz at the gate heights, by complex step [s-1]."""
+        """dU/dz at the gate heights, by complex step [s-1], shape (..., n)."""
         step = COMPLEX_STEP
-        return np.imag(self.model(self.data.heights + 1j * step, *parameters)) / step
+        return np.imag(self._profile(self.data.heights + 1j * step, parameters)) / step
+
+    def _profile(self, heights, parameters):
+        """Profile at `heights` (n,) for parameter vectors (..., k): shape (..., n)."""
+        columns = [parameters[..., j, None] for j in range(parameters.shape[-1])]
+        return self.model(heights, *columns)
 
     def log_likelihood(self, theta):
+        """Gaussian log likelihood of parameter vectors theta (..., k); -inf where the
+        covariance is not positive definite or the profile is undefined."""
+        theta = np.atleast_1d(np.asarray(theta, float))
         k = len(self.names)
-        residual = self.data.speeds - self.model(self.data.heights, *theta[:k])
-        try:
-            factor = np.linalg.cholesky(self.covariance(theta))
-        except np.linalg.LinAlgError:
-            return -np.inf
-        if not np.all(np.isfinite(residual)):
-            return -np.inf
-        whitened = np.linalg.solve(factor, residual)
-        return -0.5 * (whitened @ whitened) - np.sum(np.log(np.diag(factor))) \
-            - 0.5 * len(residual) * np.log(2 * np.pi)
+        residual = self.data.speeds - self._profile(self.data.heights, theta[..., :k])
+        covariance = self.covariance(theta)
+        result = np.full(theta.shape[:-1], -np.inf)
+        usable = np.all(np.isfinite(residual), axis=-1) & np.all(np.isfinite(covariance),
+                                                                   axis=(-2, -1))
+        if not np.any(usable):
+            return result
+        eigenvalues = np.linalg.eigvalsh(covariance[usable])
+        positive = np.all(eigenvalues > 0, axis=-1)
+        index = np.flatnonzero(usable)[positive]
+        factor = np.linalg.cholesky(covariance[index])
+        whitened = np.linalg.solve(factor, residual[index][..., None])[..., 0]
+        result[index] = -0.5 * np.sum(whitened**2, axis=-1) \
+            - np.sum(np.log(np.diagonal(factor, axis1=-2, axis2=-1)), axis=-1) \
+            - 0.5 * residual.shape[-1] * np.log(2 * np.pi)
+        return result
+
+    def log_probability(self, thetas):
+        """log posterior of walkers (W, k), for emcee's ``vectorize=True``; shape (W,)."""
+        thetas = np.asarray(thetas, float)
+        prior = self.log_prior(thetas)
+        result = np.full(thetas.shape[:-1], -np.inf)
+        inside = np.isfinite(prior)
+        if np.any(inside):
+            result[inside] = prior[inside] + self.log_likelihood(thetas[inside])
+        return result
 
     def __call__(self, theta):
-        prior = self.log_prior(theta)
-        return prior + self.log_likelihood(theta) if np.isfinite(prior) else -np.inf
+        return float(self.log_probability(np.asarray(theta, float)[None, :])[0])
 
 
 def maximum_a_posteriori(posterior):
@@ -214,7 +242,8 @@ def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=20
             + BALL * ball.standard_normal((walkers, centre.size)) * (centre == 0)
         state = emcee.State(start, random_state=np.random.RandomState(
             np.random.MT19937(stream)).get_state())
-        sampler = emcee.EnsembleSampler(walkers, centre.size, posterior)
+        sampler = emcee.EnsembleSampler(walkers, centre.size, posterior.log_probability,
+                                        vectorize=True)
         chain, tau = _run_until_converged(sampler, state, steps, max_steps)
         chains.append(chain)
         taus.append(tau)

@@ -87,6 +87,24 @@ def combined_uncertainty(jacobian, input_set):
     return np.sqrt(np.maximum(variance, 0.0)).reshape(jacobian.shape[1:])
 
 
+def output_covariance(jacobian, input_set):
+    """First-order covariance along the outputs' last axis, C = J V J^T.
+
+    Parameters
+    ----------
+    jacobian : ndarray, shape (K, *S, g)
+    input_set : uq.inputs.InputSet
+
+    Returns
+    -------
+    ndarray, shape (*S, g, g)
+        Its diagonal is ``combined_uncertainty(...)**2``.
+    """
+    u = input_set.standard_uncertainties()
+    c = jacobian * u.reshape((-1,) + (1,) * (jacobian.ndim - 1))
+    return np.einsum("k...i,kl,l...j->...ij", c, input_set.correlation_matrix(), c)
+
+
 def variance_budget(jacobian, input_set):
     """Each input's share c_k^2 u_k^2 summed over its elements; (n_inputs, *output_shape)."""
     u = input_set.standard_uncertainties()

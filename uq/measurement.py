@@ -31,6 +31,10 @@ structure: beams, gates, correction). Outputs then have shape (n, *S, ...), and 
 scene sees the same error draws (common random numbers). Quantities that do not depend
 on the errors (nominal beam vectors, least-squares operator, slant distances) are
 computed once per scene, not per sample.
+
+The output ``gate_height`` is the mean true height of the slanted beams at each range
+gate [m]: the height the reconstructed horizontal wind belongs to, which a tilted lidar
+or a half-cone error moves away from the nominal ``lidar_height + range``.
 """
 from dataclasses import dataclass
 
@@ -44,7 +48,7 @@ from .rotation import attitude_matrix
 SCENE_FIELDS = ("wind_speed", "wind_direction", "vertical_wind", "shear", "reference_height",
                 "sog", "cog", "heading", "pitch", "roll", "heave", "lidar_height",
                 "half_cone", "misalignment")
-OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity")
+OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity", "gate_height")
 NAVIGATION = ("heading", "pitch", "roll", "sog", "cog", "heave")
 ANGULAR_NAVIGATION = ("heading", "pitch", "roll", "cog")
 
@@ -136,6 +140,25 @@ def true_wind(scene, heights, trailing=1):
     return np.stack([north, east, up], axis=-1)
 
 
+def beam_heights(scene, beams_earth):
+    """True height above sea level of every beam's range gates [m].
+
+    The lidar places gate g at the slant distance ``range_g / cos(half_cone)`` along its
+    (configured) cone; the true height follows from the true earth-frame beam.
+
+    Parameters
+    ----------
+    beams_earth : ndarray, shape (..., *S, n_beams, 3)
+
+    Returns
+    -------
+    ndarray, shape (..., *S, n_beams, n_gates)
+    """
+    slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
+                            scene.vertical_beam)                        # (*S, b, g)
+    return scene.field("lidar_height", 2) + slant * beams_earth[..., 2:3]
+
+
 def true_radial_velocity(scene, beams_earth, ship_velocity):
     """Radial velocities of the true wind seen from the moving lidar [m s-1].
 
@@ -154,9 +177,7 @@ def true_radial_velocity(scene, beams_earth, ship_velocity):
     wind_only : ndarray, shape (..., n_beams, n_gates)
         ``n . u_wind(z)``, the motion-free radial wind.
     """
-    slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
-                            scene.vertical_beam)                        # (*S, b, g)
-    heights = scene.field("lidar_height", 2) + slant * beams_earth[..., 2:3]  # (..., *S, b, g)
+    heights = beam_heights(scene, beams_earth)                          # (..., *S, b, g)
     wind_vector = true_wind(scene, heights, trailing=2)                 # (..., *S, b, g, 3)
     wind_only = np.sum(beams_earth[..., None, :] * wind_vector, axis=-1)
     ship_along = np.sum(beams_earth * np.asarray(ship_velocity)[..., None, :], axis=-1)
@@ -183,12 +204,14 @@ def measurement_model(scene, outputs=OUTPUTS, **errors):
             value = value[:, None] if value.ndim == 1 else value + np.zeros((1, 1))
         err[name] = value.reshape(value.shape[:1] + scenes + value.shape[1:]) \
             if value.ndim else value
-    measured, navigation = _measure(scene, err, (n,) + scenes)
+    measured, navigation, beams_earth = _measure(scene, err, (n,) + scenes)
     unit_vectors = scene.nominal_unit_vectors()
     operator = least_squares_operator(unit_vectors)
     wind_vector = reconstruct_wind(measured, scene.correction, unit_vectors, operator,
                                    navigation, scene.field("heading", 1))
     result = _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors)
+    if "gate_height" in outputs:
+        result["gate_height"] = _gate_height(scene, beams_earth)
     return _full_shape(result, (n,) + scene.shape, scene.n_beams)
 
 
@@ -227,7 +250,13 @@ def _measure(scene, err, batch):
         error = err[f"ins_{key}"]
         error = complexstep.radians(error) if key in ANGULAR_NAVIGATION else error
         navigation[key] = scene.field(key, 1) + error                     # (n, *S, k)
-    return measured, navigation
+    return measured, navigation, beams_earth
+
+
+def _gate_height(scene, beams_earth):
+    """Mean true height of the slanted beams per gate [m], shape ([n], *S, n_gates)."""
+    slanted = len(scene.azimuths)
+    return np.mean(beam_heights(scene, beams_earth)[..., :slanted, :], axis=-2)
 
 
 def _ship_velocity(scene):
@@ -269,14 +298,16 @@ def true_values(scene):
     dict
         ``wind_speed``, ``wind_direction`` [deg], ``vertical_wind``, shape (*S, n_gates);
         ``radial_velocity`` (*S, n_beams, n_gates): the motion-free radial wind along the
-        true beams at their true heights.
+        true beams at their true heights; ``gate_height`` [m], the nominal gate heights
+        ``lidar_height + range`` at which the true wind is given.
     """
     wind_vector = true_wind(scene, scene.gate_heights())
     attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
     beams_earth = scene.nominal_unit_vectors() @ np.swapaxes(attitude, -1, -2)
     _, wind_only = true_radial_velocity(scene, beams_earth, np.zeros(scene.shape + (3,)))
     north, east = wind_vector[..., 0], wind_vector[..., 1]
-    return _full_shape({"wind_speed": wind.wind_speed(north, east),
+    return _full_shape({"gate_height": scene.gate_heights() + 0.0 * north,
+                        "wind_speed": wind.wind_speed(north, east),
                         "wind_direction": wind.wind_direction(north, east),
                         "vertical_wind": wind_vector[..., 2],
                         "radial_velocity": wind_only}, scene.shape, scene.n_beams)

@@ -14,6 +14,8 @@ QUANTITIES = {
     "radial_velocity": {"units": "m s-1",
                         "long_name": "motion-corrected radial velocity (positive away from the lidar)",
                         "standard_name": "radial_velocity_of_scatterers_away_from_instrument"},
+    "gate_height": {"units": "m", "long_name": "height above sea level of the range gate "
+                    "(mean of the slanted beams' true heights)", "standard_name": "height_above_mean_sea_level"},
 }
 
 STATISTICS = {
@@ -39,7 +41,11 @@ STATISTICS = {
                                   "validation, so gum_valid is conclusive", None),
     "paper_u": ("Rubio and Gottschall (2022) analytic standard uncertainty", "standard_error"),
     "budget": ("contribution of each input to the GUM variance, c_i^2 u_i^2", None),
+    "mc_covariance": ("Monte Carlo covariance between range gates", None),
+    "gum_covariance": ("first-order GUM covariance between range gates, J V J^T", None),
 }
+
+SQUARED_UNITS = {"m s-1": "m2 s-2", "degree": "degree2", "m": "m2"}
 
 
 def variable_attributes(quantity, statistic):
@@ -49,8 +55,8 @@ def variable_attributes(quantity, statistic):
     attrs = {"long_name": f"{base['long_name']}: {long_name}"}
     if statistic == "mc_n_invalid":
         attrs["units"] = "1"
-    elif statistic == "budget":
-        attrs["units"] = "m2 s-2" if base["units"] == "m s-1" else "degree2"
+    elif statistic in ("budget", "mc_covariance", "gum_covariance"):
+        attrs["units"] = SQUARED_UNITS[base["units"]]
     elif statistic not in ("gum_valid", "gum_validation_conclusive"):
         attrs["units"] = base["units"]
     if statistic in ("true", "nominal", "gum_value", "mc_mean"):
@@ -62,6 +68,8 @@ def variable_attributes(quantity, statistic):
 
 COORDINATES = {
     "range": {"units": "m", "long_name": "range-gate height above a level lidar"},
+    "range_other": {"units": "m", "long_name": "range-gate height above a level lidar "
+                    "(second index of a covariance)"},
     "beam": {"units": "degree", "long_name": "beam azimuth from the reference beam "
              "(clockwise; vertical beam: NaN)"},
     "input": {"long_name": "uncertain input (dotted scenario key)"},

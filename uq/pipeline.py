@@ -146,8 +146,17 @@ def run_scene(scenario, scene, seed):
                        output_dims={q: _dims(q) for q in OUTPUTS},
                        interval=sampling["interval"], chunk_size=sampling.get("chunk_size"),
                        control_variate=sampling["control_variate"],
-                       stopping=sampling["stopping"])
+                       stopping=sampling["stopping"],
+                       covariance=profile_covariances(outputs, n_gates))
     return _scene_dataset(scene, settings, outputs, engine)
+
+
+def profile_covariances(outputs, n_gates):
+    """Outputs whose gate-to-gate covariance is kept: wind speed and gate height, when
+    ``gate_height`` is requested (the inputs of ``uq fit``) and there are several gates."""
+    if "gate_height" not in outputs or n_gates < 2:
+        return ()
+    return tuple(q for q in ("wind_speed", "gate_height") if q in outputs)
 
 
 def _dims(quantity):
@@ -172,6 +181,8 @@ def _scene_dataset(scene, settings, outputs, engine):
     ds = engine.assign(data)
     ds = ds.assign_coords(input=[input_label(name) for name in ds["input"].values],
                           range=list(scene.ranges))
+    if "range_other" in ds.dims:
+        ds = ds.assign_coords(range_other=list(scene.ranges))
     if "beam" in ds.dims:
         azimuths = list(np.rad2deg(scene.azimuths)) + [np.nan] * int(scene.vertical_beam)
         ds = ds.assign_coords(beam=azimuths)

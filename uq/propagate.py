@@ -19,7 +19,7 @@ from .constants import (ADAPTIVE_MAX_SAMPLES, BATCH_SIZE, COVERAGE_PROBABILITY,
 from .inputs import input_set
 from .sampling import PROPAGATION_METHODS, new_seed, normal_scores
 from .stopping import STOPPING_RULES, may_stop
-from .statistics import (INTERVALS, Moments, StreamingStatistics, batch_statistics,
+from .statistics import (INTERVALS, CoMoments, Moments, StreamingStatistics, batch_statistics,
                          tail_capacity)
 
 _BATCH_KEYS = ("mean", "u", "low", "high")
@@ -27,7 +27,7 @@ _BATCH_KEYS = ("mean", "u", "low", "high")
 
 def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
               correlation=None, circular=(), output_dims=None, interval="symmetric",
-              chunk_size=None, control_variate=False, stopping="jcgm101"):
+              chunk_size=None, control_variate=False, stopping="jcgm101", covariance=()):
     """Propagate input distributions through `model` by Monte Carlo and by the GUM.
 
     Parameters
@@ -66,6 +66,10 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     control_variate : bool
         Use the GUM linearisation as a control variate for the mean and u
         (:mod:`uq.controlvariate`); the coverage interval stays plain Monte Carlo.
+    covariance : iterable of str
+        Outputs whose covariance along their last axis (e.g. between range gates) is
+        kept: ``q_mc_covariance`` (complete trials; plain Monte Carlo, no control
+        variate) and ``q_gum_covariance`` (J V J^T), last dimension ``<dim>_other``.
 
     Returns
     -------
@@ -97,6 +101,9 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     references = {q: _circular_reference(gum_value[q]) if q in circular else None
                   for q in gum_value}
     runner = _Runner(wrapped, inputs_laid, method, seed, references, interval, chunk_size)
+    runner.covariance = tuple(covariance)
+    if set(covariance) & circular:
+        raise ValueError(f"no covariance of circular outputs: {sorted(set(covariance) & circular)}")
     if control_variate:
         if gum_note.startswith("no GUM"):
             raise ValueError(f"the control variate needs the GUM Jacobian, and there is {gum_note}")
@@ -108,8 +115,10 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         runner.run_adaptive(digits or DEFAULT_DIGITS, stopping)
     validation_digits = digits or DEFAULT_DIGITS
     dataset = _gum_dataset(gum_value, jacobian, inputs_laid, output_dims or {})
+    dataset = dataset.assign(_gum_covariances(jacobian, inputs_laid, dataset, covariance))
     if runner.stats is not None:
         dataset = dataset.assign(_mc_variables(runner, dataset, circular, validation_digits))
+        dataset = dataset.assign(_mc_covariances(runner, dataset))
     dataset.attrs.update(n_samples=runner.n_done, seed=seed, sampling_method=method,
                          digits=validation_digits, interval=interval,
                          coverage_probability=COVERAGE_PROBABILITY, gum=gum_note,
@@ -175,12 +184,14 @@ class _Runner:
         self.batch_size = BATCH_SIZE if method == "mc" else RNG_BLOCK_SIZE
         self.stats, self.batches, self.n_done = None, {}, 0
         self.control, self.linear = None, {}
+        self.covariance, self.comoments = (), {}
 
     def _start(self, capacity, shapes):
         self.stats = {q: StreamingStatistics(shape, capacity, self.references[q])
                       for q, shape in shapes.items()}
         self.batches = {q: {key: [] for key in _BATCH_KEYS} for q in shapes}
         self.linear = {q: Moments(shape) for q, shape in shapes.items()}
+        self.comoments = {q: CoMoments(shapes[q]) for q in self.covariance}
 
     def _evaluate(self, first_block, n_blocks, n_samples):
         scores = np.concatenate([normal_scores(self.method, self.seed, b, self.inputs.dimension)
@@ -205,6 +216,8 @@ class _Runner:
             for start in range(0, len(values), self.batch_size):
                 batch = values[start:start + self.batch_size]
                 self.stats[q].update(batch)
+                if q in self.comoments:
+                    self.comoments[q].update(batch)
                 lin = None if linear is None else linear[q][start:start + self.batch_size]
                 if lin is not None:
                     self.linear[q].update(lin, np.isfinite(batch))
@@ -323,3 +336,18 @@ def _mc_variables(runner, gum_results, circular, digits):
         if q in circular:
             data[f"{q}_mc_circular_std"] = (dims, result["circular_std"])
     return data
+
+
+def _other(dims):
+    """Dimensions of a covariance along the last of `dims`."""
+    return tuple(dims) + (f"{dims[-1]}_other",)
+
+
+def _gum_covariances(jacobian, inputs, dataset, names):
+    return {f"{q}_gum_covariance": (_other(dataset[f"{q}_gum_u"].dims),
+                                    gum.output_covariance(jacobian[q], inputs)) for q in names}
+
+
+def _mc_covariances(runner, dataset):
+    return {f"{q}_mc_covariance": (_other(dataset[f"{q}_gum_u"].dims), moments.covariance())
+            for q, moments in runner.comoments.items()}

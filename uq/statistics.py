@@ -118,6 +118,44 @@ class Moments:
                          where=self.count > 1)
 
 
+class CoMoments:
+    """Streaming covariance along the last axis: count, mean and co-moment matrix.
+
+    For values of shape (m, *S, g) it keeps, per leading element, the mean (*S, g) and
+    the sum of products of deviations (*S, g, g), merged chunk by chunk with the pairwise
+    update of Chan et al. [2] (C = C_a + C_b + d d^T n_a n_b / n). A trial counts only
+    when all g of its values are finite (complete cases).
+    """
+
+    def __init__(self, shape):
+        self.shape = tuple(shape)
+        self.count = np.zeros(shape[:-1], dtype=np.int64)
+        self.mean = np.zeros(shape)
+        self.comoment = np.zeros(self.shape + self.shape[-1:])
+
+    def update(self, values):
+        """Add the trials of `values` (m, *shape) whose g values are all finite."""
+        valid = np.all(np.isfinite(values), axis=-1, keepdims=True)
+        count = valid[..., 0].sum(axis=0)
+        safe = np.where(valid, values, 0.0)
+        mean = np.divide(safe.sum(axis=0), count[..., None], out=np.zeros(self.shape),
+                         where=count[..., None] > 0)
+        deviation = np.where(valid, values - mean, 0.0)
+        comoment = np.einsum("m...i,m...j->...ij", deviation, deviation)
+        total = self.count + count
+        weight = np.divide(count, total, out=np.zeros(count.shape), where=total > 0)
+        delta = mean - self.mean
+        self.comoment = self.comoment + comoment + (self.count * weight)[..., None, None] \
+            * delta[..., :, None] * delta[..., None, :]
+        self.mean = self.mean + delta * weight[..., None]
+        self.count = total
+
+    def covariance(self):
+        """Sample covariance (ddof 1), shape (*S, g, g); NaN below two complete trials."""
+        scale = np.where(self.count > 1, self.count - 1, np.nan)
+        return self.comoment / scale[..., None, None]
+
+
 class StreamingStatistics:
     """Mean, standard deviation and coverage intervals of an array-valued output.
 
