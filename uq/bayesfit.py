@@ -11,8 +11,8 @@ with covariance
   order through the profile's slope f'(z) (``diag(f') Sigma_z diag(f')``);
 * ``sigma = exp(ln_sigma)``: a free extra scatter (turbulence), optional.
 
-Priors are uniform within bounds (:data:`DEFAULT_PRIORS`, documented there), or
-log-uniform where marked. The posterior is sampled by emcee's affine-invariant ensemble
+Priors are uniform within bounds (:data:`DEFAULT_PRIORS`, documented there),
+log-uniform where marked, or normal ``(mean, u, "normal")`` when configured. The posterior is sampled by emcee's affine-invariant ensemble
 (Foreman-Mackey et al. 2013) in several independent ensembles, each started in a small
 ball about the maximum a posteriori and seeded through emcee's State random_state.
 Convergence is decided, and failure raised, from the integrated autocorrelation time
@@ -33,25 +33,24 @@ from scipy.optimize import minimize
 from scipy.special import ndtri
 from scipy.stats import rankdata
 
-from .constants import COMPLEX_STEP
+from .constants import COMPLEX_STEP, MIN_WALKERS
 from .profilefit import least_squares_profile
 from .profiles import PROFILES
 
-#: Prior bounds per parameter: (low, high, "uniform" | "log-uniform"). Wide enough for any
+#: Prior bounds per parameter: (low, high, "uniform" | "log_uniform"). Wide enough for any
 #: atmospheric profile over sea (shear -0.5 ... 1; u* up to 3 m/s; z0 from 1 um to 1 m);
 #: ln_sigma from e^-10 (no scatter) to e^2 = 7.4 m/s (more than any 10-min scatter).
 DEFAULT_PRIORS = {
     "reference_speed": (0.0, 60.0, "uniform"),
     "shear": (-0.5, 1.0, "uniform"),
     "friction_velocity": (0.0, 3.0, "uniform"),
-    "roughness_length": (1e-6, 1.0, "log-uniform"),
+    "roughness_length": (1e-6, 1.0, "log_uniform"),
     "ln_sigma": (-10.0, 2.0, "uniform"),
 }
 #: Chains must be longer than this many autocorrelation times [2].
 TAU_FACTOR = 50
 #: Largest acceptable rank-normalised split R-hat [2].
 RHAT_LIMIT = 1.01
-MIN_WALKERS = 32
 #: Relative radius of the starting ball about the MAP [1]: small against any posterior
 #: width here, large enough that the walkers are not degenerate.
 BALL = 1e-4
@@ -103,11 +102,7 @@ class ProfilePosterior:
         theta = np.asarray(theta, float)
         total = np.zeros(theta.shape[:-1])
         for k, name in enumerate(self.parameter_names):
-            low, high, kind = self.priors[name]
-            value = theta[..., k]
-            inside = (low <= value) & (value <= high)
-            log_density = -np.log(np.where(inside, value, 1.0)) if kind == "log-uniform" else 0.0
-            total = np.where(inside, total + log_density, -np.inf)
+            total = total + _log_prior_density(theta[..., k], *self.priors[name])
         return total
 
     def covariance(self, theta):
@@ -168,6 +163,16 @@ class ProfilePosterior:
         return float(self.log_probability(np.asarray(theta, float)[None, :])[0])
 
 
+def _log_prior_density(value, a, b, kind):
+    """Unnormalised log density of one prior: uniform / log_uniform on [a, b] (-inf
+    outside), or normal with mean a and standard deviation b."""
+    if kind == "normal":
+        return -0.5 * ((value - a) / b) ** 2
+    inside = (a <= value) & (value <= b)
+    log_density = -np.log(np.where(inside, value, 1.0)) if kind == "log_uniform" else 0.0
+    return np.where(inside, log_density, -np.inf)
+
+
 def maximum_a_posteriori(posterior):
     """MAP by Nelder-Mead from the least-squares fit (and the residual scatter)."""
     data = posterior.data
@@ -175,7 +180,9 @@ def maximum_a_posteriori(posterior):
                                   fixed=posterior.fixed)
     theta = list(start["parameters"])
     if posterior.scatter:
-        theta.append(np.log(max(start["residual_std"], np.exp(posterior.priors["ln_sigma"][0] + 1))))
+        low, _, kind = posterior.priors["ln_sigma"]
+        floor = np.exp(low + 1) if kind != "normal" else np.exp(low)   # inside the prior
+        theta.append(np.log(max(start["residual_std"], floor)))
     result = minimize(lambda t: -posterior(t), np.array(theta), method="Nelder-Mead",
                       options={"xatol": 1e-10, "fatol": 1e-10, "maxiter": 20000})
     return result.x
@@ -208,9 +215,10 @@ def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=20
                      max_steps=50000):
     """Sample with several independent emcee ensembles until converged.
 
-    Each ensemble runs in rounds of `steps` until its chain is longer than TAU_FACTOR
-    times its largest autocorrelation time (or `max_steps`); then burn-in (2 tau) is
-    dropped, the chains are thinned (tau / 2) and R-hat is taken across ensembles.
+    The ensembles run in rounds of `steps`, all to the same length, until that length is
+    above TAU_FACTOR times the largest autocorrelation time (or `max_steps`); then
+    burn-in (2 tau) is dropped, the chains are thinned (tau / 2) and R-hat is taken
+    across ensembles.
 
     Parameters
     ----------
@@ -236,17 +244,14 @@ def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=20
     streams = np.random.SeedSequence(entropy).spawn(ensembles + 1)
     centre = maximum_a_posteriori(posterior)
     ball = np.random.default_rng(streams[-1])
-    chains, taus = [], []
+    samplers, states = [], []
     for stream in streams[:-1]:
-        start = centre * (1 + BALL * ball.standard_normal((walkers, centre.size))) \
-            + BALL * ball.standard_normal((walkers, centre.size)) * (centre == 0)
-        state = emcee.State(start, random_state=np.random.RandomState(
-            np.random.MT19937(stream)).get_state())
-        sampler = emcee.EnsembleSampler(walkers, centre.size, posterior.log_probability,
-                                        vectorize=True)
-        chain, tau = _run_until_converged(sampler, state, steps, max_steps)
-        chains.append(chain)
-        taus.append(tau)
+        start = _starting_ball(posterior, centre, ball, walkers)
+        states.append(emcee.State(start, random_state=np.random.RandomState(
+            np.random.MT19937(stream)).get_state()))
+        samplers.append(emcee.EnsembleSampler(walkers, centre.size, posterior.log_probability,
+                                              vectorize=True))
+    chains, taus = _run_until_converged(samplers, states, steps, max_steps)
     tau = np.max(taus, axis=0)
     burn, thin = int(np.ceil(2 * tau.max())), max(1, int(tau.min() / 2))
     samples = np.array([c[burn::thin].reshape(-1, centre.size) for c in chains])
@@ -263,13 +268,32 @@ def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=20
             "names": posterior.parameter_names}
 
 
-def _run_until_converged(sampler, state, steps, max_steps):
-    """Run in rounds; stop once longer than TAU_FACTOR x tau (tau estimate settled)."""
+def _starting_ball(posterior, centre, rng, walkers):
+    """Walkers in a small ball about the MAP, pulled towards it until each lies inside
+    the prior's support (the MAP may sit on a bound, e.g. no scatter: ln_sigma low)."""
+    if not np.isfinite(posterior(centre)):
+        raise NotConverged(f"the maximum a posteriori {np.round(centre, 6).tolist()} has zero "
+                           "posterior density; allowed: priors that contain the data's fit")
+    offsets = BALL * rng.standard_normal((walkers, centre.size)) * np.where(centre == 0, 1.0,
+                                                                            np.abs(centre))
+    for _ in range(60):
+        bad = ~np.isfinite(posterior.log_probability(centre + offsets))
+        if not np.any(bad):
+            break
+        offsets[bad] *= 0.5
+    return centre + offsets
+
+
+def _run_until_converged(samplers, states, steps, max_steps):
+    """Run every ensemble in rounds of `steps`, all to the same length, until that length
+    is above TAU_FACTOR x the largest tau of any ensemble (or `max_steps`)."""
     while True:
-        state = sampler.run_mcmc(state, steps, progress=False)
-        tau = sampler.get_autocorr_time(tol=0)
-        if sampler.iteration > TAU_FACTOR * np.max(tau) or sampler.iteration >= max_steps:
-            return sampler.get_chain(), tau
+        states = [sampler.run_mcmc(state, steps, progress=False)
+                  for sampler, state in zip(samplers, states)]
+        taus = [sampler.get_autocorr_time(tol=0) for sampler in samplers]
+        iteration = samplers[0].iteration
+        if iteration > TAU_FACTOR * np.max(taus) or iteration >= max_steps:
+            return [sampler.get_chain() for sampler in samplers], taus
 
 
 def posterior_summary(samples, names):

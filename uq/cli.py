@@ -1,4 +1,5 @@
-"""Command line: ``uq run``, ``uq check``, ``uq plot``, ``uq report``, ``uq --version``.
+"""Command line: ``uq run``, ``uq check``, ``uq plot``, ``uq report``, ``uq bench``,
+``uq fit``, ``uq --version``.
 
 Exit status: 0 success; 2 bad input (one line naming the file, the key and what is
 allowed; no traceback; no output file); 1 anything else.
@@ -64,6 +65,16 @@ def build_parser():
                                 "wall time for every sampling method (results/bench.nc)")
     bench.add_argument("-o", "--output", default="results/bench.nc", help="results file")
     bench.add_argument("--quick", action="store_true", help="fewer sizes and repeats (~1 min)")
+    fit = commands.add_parser("fit", help="fit a wind profile with emcee, beside least "
+                              "squares: posterior summary, predictive band, corner plot, chain")
+    fit.add_argument("input", help="results of uq run (.nc) with range gates and the "
+                     "gate_height output, or a CSV of heights and speeds (.csv)")
+    fit.add_argument("-c", "--config", help="YAML file with a 'fit' section (default: the "
+                     "results' scenario's fit section, else the defaults)")
+    fit.add_argument("-o", "--output", help="fit results (.nc; default beside the input, "
+                     "<name>_fit.nc); figures beside it")
+    fit.add_argument("--set", action="append", default=[], metavar="fit.KEY=VALUE",
+                     help="override a fit setting (dotted key, YAML value); repeatable")
     check = commands.add_parser("check", help="validate a scenario without running it")
     check.add_argument("scenario", help="scenario YAML file")
     check.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
@@ -249,7 +260,13 @@ def _bench(args):
     return EXIT_OK
 
 
-_COMMANDS = {"run": _run, "check": _check, "plot": _plot, "report": _report, "bench": _bench}
+def _fit(args):
+    from .fitcommand import run_fit
+    return run_fit(args.input, args.config, args.output, parse_overrides(args.set))
+
+
+_COMMANDS = {"run": _run, "check": _check, "plot": _plot, "report": _report, "bench": _bench,
+             "fit": _fit}
 
 if __name__ == "__main__":
     sys.exit(main())

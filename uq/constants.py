@@ -49,3 +49,7 @@ SWEEP_CHUNK_ELEMENTS = 2**20
 #: von Karman constant [1]: 0.40, the value of Hogstrom (1996), Boundary-Layer
 #: Meteorol. 78, 215-246 (0.40 +- 0.01 from his review of surface-layer experiments).
 VON_KARMAN = 0.40
+
+#: Fewest emcee walkers of a profile fit [1]: issue 5 asks for at least 32; the
+#: affine-invariant ensemble needs more than twice the parameters (here <= 3).
+MIN_WALKERS = 32

@@ -40,9 +40,10 @@ def least_squares_profile(name, heights, speeds, sigma=None, fixed=None, confide
     name : str
     heights, speeds : array_like, shape (n,)
         [m], [m s-1].
-    sigma : array_like, shape (n,), optional
-        Standard uncertainties of the speeds [m s-1], taken as absolute; without them the
-        scatter is estimated from the residuals.
+    sigma : array_like, shape (n,) or (n, n), optional
+        Standard uncertainties of the speeds [m s-1], or their covariance matrix
+        [m2 s-2] (generalised least squares, as ``curve_fit`` takes it), taken as
+        absolute; without them the scatter is estimated from the residuals.
     fixed : dict, optional
         Fixed keyword arguments of the profile (e.g. ``reference_height``).
     confidence, prediction : float
@@ -76,8 +77,7 @@ def least_squares_profile(name, heights, speeds, sigma=None, fixed=None, confide
     grid = heights if grid is None else np.asarray(grid, float)
     gradient = parameter_gradient(model, grid, parameters)
     mean_variance = np.einsum("gk,kl,gl->g", gradient, covariance, gradient)
-    noise = np.interp(grid, heights, np.asarray(sigma, float) ** 2) if absolute \
-        else residual_variance
+    noise = np.interp(grid, heights, _variances(sigma)) if absolute else residual_variance
     # known (absolute) variances: normal quantiles; estimated scatter: Student t, n - k dof
     quantile_dof = np.inf if absolute else dof
     t_confidence = student_t.ppf((1 + confidence) / 2, quantile_dof)
@@ -93,6 +93,12 @@ def least_squares_profile(name, heights, speeds, sigma=None, fixed=None, confide
             "confidence_high": fit + t_confidence * np.sqrt(mean_variance),
             "prediction_low": fit - t_prediction * np.sqrt(mean_variance + noise),
             "prediction_high": fit + t_prediction * np.sqrt(mean_variance + noise)}
+
+
+def _variances(sigma):
+    """Variances of the speeds from standard uncertainties (n,) or a covariance (n, n)."""
+    sigma = np.asarray(sigma, float)
+    return np.diag(sigma) if sigma.ndim == 2 else sigma**2
 
 
 def parameter_gradient(model, heights, parameters):

@@ -2,7 +2,7 @@
 
 A scenario is YAML (or a mapping) with the top-level keys of ``CONTRACT.md``: ``name``,
 ``description``, ``wind``, ``ship``, ``ins``, ``lidar``, ``correction``, ``sampling``,
-``sweep``, ``outputs``. Every key is optional and defaults to :data:`DEFAULTS`. Unknown
+``sweep``, ``outputs``, and the optional ``fit`` (:mod:`uq.fitconfig`). Every key is optional and defaults to :data:`DEFAULTS`. Unknown
 keys, wrong types and out-of-range values raise :class:`uq.errors.ScenarioError`, whose
 message names the file, the dotted key and what is allowed.
 
@@ -22,6 +22,7 @@ from .constants import FULL_CIRCLE_DEG
 from .correction import CORRECTION_MODELS
 from .distributions import ERROR_DISTRIBUTIONS, validate_error
 from .errors import ScenarioError
+from .fitconfig import validate_fit
 from .measurement import OUTPUTS
 from .sampling import PROPAGATION_METHODS
 from .statistics import INTERVALS
@@ -50,6 +51,7 @@ DEFAULTS = {
                  "interval": "symmetric", "stopping": "jcgm101"},
     "sweep": {},
     "outputs": ["wind_speed", "wind_direction", "vertical_wind"],
+    "fit": {},
 }
 DEFAULT_SAMPLES = 100_000
 
@@ -96,7 +98,7 @@ class Scenario:
         """A new scenario with ``{dotted: value}`` set and validated (sweep kept)."""
         raw = copy.deepcopy(self.settings)
         for dotted, value in assignments.items():
-            _assign(raw, dotted, value, self.source)
+            assign_dotted(raw, dotted, value, self.source)
         settings = _validate(raw, self.source)
         settings["sweep"] = copy.deepcopy(self.settings["sweep"])
         return Scenario(settings["name"], settings["description"], settings, self.sweep,
@@ -147,7 +149,7 @@ def load_scenario(path_or_mapping, overrides=None):
         raise ScenarioError(source, "", "a scenario must be a mapping of the top-level keys "
                             f"{', '.join(DEFAULTS)}")
     for dotted, value in (overrides or {}).items():
-        _assign(raw, dotted, value, source)
+        assign_dotted(raw, dotted, value, source)
     return _build(raw, source)
 
 
@@ -164,7 +166,7 @@ def _read_yaml(path):
         raise ScenarioError(str(path), "", f"not valid YAML{where}") from None
 
 
-def _assign(raw, dotted, value, source):
+def assign_dotted(raw, dotted, value, source):
     """Set raw[a][b]... = value for 'a.b...', creating mappings on the way.
 
     ``sweep.<dotted key>`` sets the sweep of that (dotted) key.
@@ -191,6 +193,11 @@ def _build(raw, source):
     return Scenario(settings["name"], settings["description"], settings, sweep, source, links)
 
 
+def load_fit_settings(raw_fit, source):
+    """A :class:`uq.fitconfig.FitConfig` from a ``fit`` mapping; errors name `source`."""
+    return validate_fit(_Checker(source), raw_fit)
+
+
 def _validate(raw, source):
     check = _Checker(source)
     check.keys(raw, "", DEFAULTS)
@@ -206,6 +213,8 @@ def _validate(raw, source):
         "sampling": _sampling(check, raw.get("sampling")),
         "outputs": _outputs(check, raw.get("outputs", DEFAULTS["outputs"])),
     }
+    if raw.get("fit") is not None:                   # optional: settings of uq fit
+        settings["fit"] = validate_fit(check, raw["fit"]).to_dict()
     return settings
 
 
@@ -331,7 +340,7 @@ def _validate_sweep(value, settings, source):
     for key, values in swept.items():
         for item in values:       # each value must make a valid scenario
             raw = copy.deepcopy(settings)
-            _assign(raw, key, item, source)
+            assign_dotted(raw, key, item, source)
             _validate(raw, source)
     return tuple(sweep), tuple(links)
 

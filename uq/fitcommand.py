@@ -1,0 +1,125 @@
+"""``uq fit``: read the input and the fit settings, fit, write netCDF and figures.
+
+I/O and orchestration only; the fit is :mod:`uq.fitting`, the figures
+:mod:`uq.fitplots`.
+"""
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from .bayesfit import NotConverged
+from .errors import ScenarioError
+from .fitting import (combine_fits, fit_profile, profile_from_results, profile_from_table,
+                      true_parameters)
+from .io import write_results
+from .scenario import assign_dotted, load_fit_settings
+
+EXIT_OK, EXIT_FAILURE = 0, 1
+
+
+def run_fit(input_path, config_path=None, output=None, overrides=None):
+    """Fit `input_path` (.nc results or .csv table); returns the exit status."""
+    path = Path(input_path)
+    if path.suffix not in (".nc", ".csv"):
+        raise ScenarioError(str(path), "", "allowed: results of uq run (.nc) or a CSV table "
+                            "(.csv)")
+    output = Path(output) if output else path.with_name(f"{path.stem}_fit.nc")
+    if output.suffix != ".nc":
+        raise ScenarioError("-o", str(output), "the output file must end in .nc")
+    results = _read_results(path) if path.suffix == ".nc" else None
+    config = fit_settings(config_path, results, overrides or {})
+    try:
+        dataset = _fit_input(path, results, config)
+    except NotConverged as error:
+        print(f"uq: fit failed: {error}")
+        return EXIT_FAILURE
+    write_results(dataset, output)
+    from .fitplots import plot_corner, plot_profile_fit
+    figures = [output.with_name(f"{output.stem}_profile.png"),
+               output.with_name(f"{output.stem}_corner.png")]
+    plot_profile_fit(dataset).savefig(figures[0], dpi=120)
+    plot_corner(dataset).savefig(figures[1], dpi=100)
+    print(fit_table(dataset))
+    print(f"wrote {output}, {figures[0].name}, {figures[1].name}")
+    return EXIT_OK
+
+
+def _read_results(path):
+    from .io import read_results
+    try:
+        dataset = read_results(path)
+    except (OSError, ValueError) as error:
+        raise ScenarioError(str(path), "", f"cannot read it as netCDF ({error}); allowed: "
+                            "results of uq run") from None
+    if "scenario" not in dataset.attrs:
+        raise ScenarioError(str(path), "", "not a uq results file (no scenario attribute)")
+    return dataset
+
+
+def fit_settings(config_path, results, overrides):
+    """FitConfig from -c FILE's fit section, else the results' scenario's, then --set."""
+    source, raw = "defaults", {}
+    if config_path:
+        source = str(config_path)
+        try:
+            document = yaml.safe_load(Path(config_path).read_text()) or {}
+        except (OSError, yaml.YAMLError) as error:
+            raise ScenarioError(source, "", f"cannot read it as YAML ({error})") from None
+        if not isinstance(document, dict) or "fit" not in document:
+            raise ScenarioError(source, "fit", "no 'fit' section; allowed: a YAML mapping "
+                                "with a top-level 'fit' key")
+        raw = document["fit"] or {}
+    elif results is not None:
+        source = "scenario of the results"
+        raw = (yaml.safe_load(results.attrs["scenario"]) or {}).get("fit") or {}
+    raw = {"fit": dict(raw)}
+    for key, value in overrides.items():
+        if not key.startswith("fit."):
+            raise ScenarioError("--set", key, "allowed: fit.<key>=<value>")
+        assign_dotted(raw, key, value, "--set")
+    return load_fit_settings(raw["fit"], source)
+
+
+def _fit_input(path, results, config):
+    if results is None:
+        import pandas
+        try:
+            table = pandas.read_csv(path)
+        except (OSError, ValueError) as error:
+            raise ScenarioError(str(path), "", f"cannot read it as CSV ({error})") from None
+        data, dropped = profile_from_table(table, config.columns, source=str(path))
+        dataset = combine_fits({"data": fit_profile(data, config)})
+        dataset.attrs["rows_dropped_not_finite"] = dropped
+        if dropped:
+            print(f"uq: {dropped} row(s) with a missing value not fitted")
+    else:
+        fits = {kind: fit_profile(profile_from_results(results, kind, str(path)), config)
+                for kind in ("propagated", "naive")}
+        scenario = yaml.safe_load(results.attrs["scenario"])
+        dataset = combine_fits(fits, true_parameters(scenario, config))
+    dataset.attrs.update(source=str(path), fit_settings=yaml.safe_dump(config.to_dict()))
+    return dataset
+
+
+def fit_table(dataset):
+    """Posterior median [95 % interval] beside least squares, per fit and parameter."""
+    lines = [f"{'fit':<12}{'parameter':<18}{'median':>10}{'95 % credible':>24}"
+             f"{'least squares':>14}{'95 % confidence':>24}{'true':>9}"]
+    for fit in dataset["fit"].values:
+        row = dataset.sel(fit=fit)
+        for name in dataset["parameter"].values:
+            p = row.sel(parameter=name)
+            truth = float(dataset["true_value"].sel(parameter=name)) \
+                if "true_value" in dataset else np.nan
+            lines.append(
+                f"{fit:<12}{name:<18}{float(p.posterior_median):>10.4g}"
+                f"{_interval(p.posterior_low95, p.posterior_high95):>24}"
+                f"{float(p.least_squares_value):>14.4g}"
+                f"{_interval(p.least_squares_low95, p.least_squares_high95):>24}"
+                f"{truth:>9.4g}")
+    return "\n".join(lines)
+
+
+def _interval(low, high):
+    return f"[{float(low):.4g}, {float(high):.4g}]"
