@@ -98,3 +98,18 @@ def test_rank_rhat_separates_mixed_from_stuck_chains():
     stuck = mixed + np.array([0.0, 0.0, 0.0, 1.0])[:, None]
     assert rank_rhat(mixed) < 1.01
     assert rank_rhat(stuck) > 1.05
+
+
+def test_diagonal_shortcut_equals_the_full_factorisation():
+    """Independent errors take an O(n) path; it must give the Cholesky path's numbers."""
+    rng = np.random.default_rng(8)
+    speeds = power_law_profile(HEIGHTS, 9.0, 0.12) + rng.normal(0, SIGMA, HEIGHTS.size)
+    data = profile_data(HEIGHTS, speeds, speed_covariance=np.full(HEIGHTS.size, SIGMA),
+                        height_covariance=np.full(HEIGHTS.size, 2.0))
+    posterior = ProfilePosterior("power_law", data, fixed=FIXED, scatter=True)
+    thetas = np.column_stack([rng.uniform(8, 10, 50), rng.uniform(0, 0.3, 50),
+                              rng.uniform(-4, 0, 50)])
+    assert posterior.diagonal
+    fast = posterior.log_probability(thetas)
+    posterior.diagonal = False
+    np.testing.assert_allclose(fast, posterior.log_probability(thetas), rtol=1e-12)

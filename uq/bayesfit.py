@@ -93,6 +93,8 @@ class ProfilePosterior:
         self.scatter = scatter
         self.parameter_names = tuple(self.names) + (("ln_sigma",) if scatter else ())
         self.priors = {**DEFAULT_PRIORS, **(priors or {})}
+        self.diagonal = all(np.count_nonzero(c - np.diag(np.diag(c))) == 0
+                            for c in (data.speed_covariance, data.height_covariance))
 
     def model(self, heights, *parameters):
         return self.function(heights, *parameters, **self.fixed)
@@ -133,6 +135,8 @@ class ProfilePosterior:
         theta = np.atleast_1d(np.asarray(theta, float))
         k = len(self.names)
         residual = self.data.speeds - self._profile(self.data.heights, theta[..., :k])
+        if self.diagonal:
+            return self._independent_log_likelihood(theta, residual)
         covariance = self.covariance(theta)
         result = np.full(theta.shape[:-1], -np.inf)
         usable = np.all(np.isfinite(residual), axis=-1) & np.all(np.isfinite(covariance),
@@ -148,6 +152,18 @@ class ProfilePosterior:
             - np.sum(np.log(np.diagonal(factor, axis1=-2, axis2=-1)), axis=-1) \
             - 0.5 * residual.shape[-1] * np.log(2 * np.pi)
         return result
+
+    def _independent_log_likelihood(self, theta, residual):
+        """The same for diagonal covariances: no factorisation, O(n) per walker."""
+        k = len(self.names)
+        variance = np.diag(self.data.speed_covariance) + self._slope(theta[..., :k]) ** 2 \
+            * np.diag(self.data.height_covariance)
+        if self.scatter:
+            variance = variance + np.exp(2 * theta[..., k, None])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            result = -0.5 * np.sum(residual**2 / variance + np.log(2 * np.pi * variance),
+                                   axis=-1)
+        return np.where(np.isfinite(result), result, -np.inf)
 
     def log_probability(self, thetas):
         """log posterior of walkers (W, k), for emcee's ``vectorize=True``; shape (W,)."""
