@@ -113,3 +113,17 @@ def test_diagonal_shortcut_equals_the_full_factorisation():
     fast = posterior.log_probability(thetas)
     posterior.diagonal = False
     np.testing.assert_allclose(fast, posterior.log_probability(thetas), rtol=1e-12)
+
+
+def test_relative_covariance_scales_with_the_profile():
+    """Sigma(theta) = diag(f) R diag(f): at any theta the relative path's covariance is
+    the absolute one built by hand from the profile values."""
+    rng = np.random.default_rng(4)
+    speeds = power_law_profile(HEIGHTS, 9.0, 0.12) + rng.normal(0, SIGMA, HEIGHTS.size)
+    relative = 0.01**2 * (0.5 * np.eye(HEIGHTS.size) + 0.5)
+    data = profile_data(HEIGHTS, speeds, speed_covariance=relative)
+    posterior = ProfilePosterior("power_law", data, fixed=FIXED, scatter=False, relative=True)
+    theta = np.array([8.5, 0.2])
+    f = power_law_profile(HEIGHTS, *theta)
+    np.testing.assert_allclose(posterior.covariance(theta), np.outer(f, f) * relative,
+                               rtol=1e-12)

@@ -24,6 +24,8 @@ References
 .. [1] Foreman-Mackey, D. et al. (2013). emcee: The MCMC Hammer. PASP 125, 306.
 .. [2] Vehtari, A. et al. (2021). Rank-normalization, folding, and localization: an
    improved R-hat. Bayesian Analysis 16(2), 667-718.
+.. [3] Peelle, R. W. (1987). Peelle's pertinent puzzle. Informal memorandum, Oak Ridge
+   National Laboratory; see Zhao, Z. and Perey, F. G. (1992), ORNL/TM-12106.
 """
 from dataclasses import dataclass
 
@@ -87,12 +89,16 @@ def _covariance(value, n):
 class ProfilePosterior:
     """log posterior of (profile parameters, [ln_sigma]) given ProfileData."""
 
-    def __init__(self, name, data, fixed=None, scatter=True, priors=None):
+    def __init__(self, name, data, fixed=None, scatter=True, priors=None, relative=False):
         self.function, self.names, _, _ = PROFILES[name]
         self.name, self.data, self.fixed = name, data, dict(fixed or {})
         self.scatter = scatter
         self.parameter_names = tuple(self.names) + (("ln_sigma",) if scatter else ())
         self.priors = {**DEFAULT_PRIORS, **(priors or {})}
+        # relative: speed_covariance is of U / f (multiplicative errors), scaled by the
+        # profile at theta: Sigma = diag(f) R diag(f); an absolute covariance estimated
+        # from data with multiplicative errors biases the fit low (Peelle's puzzle [3])
+        self.relative = relative
         self.diagonal = all(np.count_nonzero(c - np.diag(np.diag(c))) == 0
                             for c in (data.speed_covariance, data.height_covariance))
 
@@ -112,8 +118,11 @@ class ProfilePosterior:
         theta = np.asarray(theta, float)
         k = len(self.names)
         slope = self._slope(theta[..., :k])
-        total = self.data.speed_covariance + slope[..., :, None] * self.data.height_covariance \
-            * slope[..., None, :]
+        speed = self.data.speed_covariance
+        if self.relative:
+            profile = self._profile(self.data.heights, theta[..., :k])
+            speed = profile[..., :, None] * speed * profile[..., None, :]
+        total = speed + slope[..., :, None] * self.data.height_covariance * slope[..., None, :]
         if self.scatter:
             total = total + np.exp(2 * theta[..., k])[..., None, None] * np.eye(
                 len(self.data.heights))
@@ -135,7 +144,7 @@ class ProfilePosterior:
         theta = np.atleast_1d(np.asarray(theta, float))
         k = len(self.names)
         residual = self.data.speeds - self._profile(self.data.heights, theta[..., :k])
-        if self.diagonal:
+        if self.diagonal and not self.relative:
             return self._independent_log_likelihood(theta, residual)
         covariance = self.covariance(theta)
         result = np.full(theta.shape[:-1], -np.inf)
