@@ -3,6 +3,7 @@
 I/O and orchestration only; the fit is :mod:`uq.fitting`, the figures
 :mod:`uq.fitplots`.
 """
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +33,7 @@ def run_fit(input_path, config_path=None, output=None, overrides=None):
     try:
         dataset = _fit_input(path, results, config)
     except NotConverged as error:
-        print(f"uq: fit failed: {error}")
+        print(f"uq: fit failed: {error}", file=sys.stderr)
         return EXIT_FAILURE
     write_results(dataset, output)
     from .fitplots import plot_corner, plot_profile_fit
@@ -92,7 +93,7 @@ def _fit_input(path, results, config):
         dataset = combine_fits({"data": fit_profile(data, config)})
         dataset.attrs["rows_dropped_not_finite"] = dropped
         if dropped:
-            print(f"uq: {dropped} row(s) with a missing value not fitted")
+            print(f"uq: {dropped} row(s) with a missing value not fitted", file=sys.stderr)
     else:
         fits = {kind: fit_profile(profile_from_results(results, kind, str(path)), config)
                 for kind in ("propagated", "naive")}
