@@ -40,7 +40,7 @@ def run_fit(input_path, config_path=None, output=None, overrides=None):
     figures = [output.with_name(f"{output.stem}_profile.png"),
                output.with_name(f"{output.stem}_corner.png")]
     plot_profile_fit(dataset).savefig(figures[0], dpi=120)
-    plot_corner(dataset).savefig(figures[1], dpi=100)
+    plot_corner(dataset).savefig(figures[1], dpi=100, bbox_inches="tight")
     print(fit_table(dataset))
     print(f"wrote {output}, {figures[0].name}, {figures[1].name}")
     return EXIT_OK

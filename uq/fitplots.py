@@ -65,5 +65,5 @@ def plot_corner(dataset, fit=None):
     figure = corner.corner(samples, labels=[LABELS.get(n, n) for n in names],
                            quantiles=[0.025, 0.5, 0.975], show_titles=True,
                            title_fmt=".3g", truths=truths, truth_color="C3")
-    figure.suptitle(f"posterior: {name}", fontsize=10)
+    figure.suptitle(f"posterior: {name}", fontsize=10, y=1.04)
     return figure
