@@ -162,11 +162,18 @@ class ProfilePosterior:
             - 0.5 * residual.shape[-1] * np.log(2 * np.pi)
         return result
 
+    def gate_variances(self, parameters):
+        """Variances of the speeds at the gates without the scatter [m2 s-2]: the diagonal
+        of :meth:`covariance` for profile parameters (..., k), shape (..., n)."""
+        speed = np.diag(self.data.speed_covariance)
+        if self.relative:
+            speed = speed * self._profile(self.data.heights, parameters) ** 2
+        return speed + self._slope(parameters) ** 2 * np.diag(self.data.height_covariance)
+
     def _independent_log_likelihood(self, theta, residual):
         """The same for diagonal covariances: no factorisation, O(n) per walker."""
         k = len(self.names)
-        variance = np.diag(self.data.speed_covariance) + self._slope(theta[..., :k]) ** 2 \
-            * np.diag(self.data.height_covariance)
+        variance = self.gate_variances(theta[..., :k])
         if self.scatter:
             variance = variance + np.exp(2 * theta[..., k, None])
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -279,16 +286,17 @@ def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=20
     chains, taus = _run_until_converged(samplers, states, steps, max_steps)
     tau = np.max(taus, axis=0)
     burn, thin = int(np.ceil(2 * tau.max())), max(1, int(tau.min() / 2))
-    samples = np.array([c[burn::thin].reshape(-1, centre.size) for c in chains])
+    chains = np.array(chains)                           # (ensembles, steps, walkers, k)
+    samples = chains[:, burn::thin].reshape(len(chains), -1, centre.size)
     rhat = np.array([rank_rhat(samples[:, :, k]) for k in range(centre.size)])
-    length = min(len(c) for c in chains)
+    length = chains.shape[1]
     if length < TAU_FACTOR * tau.max() or np.any(rhat > RHAT_LIMIT):
         raise NotConverged(
             f"the chains did not converge: length {length} steps against {TAU_FACTOR} x tau "
             f"= {TAU_FACTOR * tau.max():.0f} (tau {np.round(tau, 1).tolist()}), rank R-hat "
             f"{np.round(rhat, 4).tolist()} (limit {RHAT_LIMIT}); allowed: more steps "
             "(max_steps), more walkers, or narrower priors")
-    return {"samples": samples, "chain": np.array([c[:length] for c in chains]), "tau": tau,
+    return {"samples": samples, "chain": chains, "tau": tau,
             "burn": burn, "thin": thin, "rhat": rhat, "map": centre,
             "names": posterior.parameter_names}
 

@@ -177,17 +177,8 @@ def _dask_client(args):
 
 
 def _open_results(path):
-    from .io import read_results
-    path = Path(path)
-    try:
-        dataset = read_results(path)
-    except (OSError, ValueError) as error:
-        raise ScenarioError(str(path), "", f"cannot read it as netCDF results ({error}); "
-                            "allowed: a file written by uq run") from None
-    if "mc_n_samples" not in dataset or "scenario" not in dataset.attrs:
-        raise ScenarioError(str(path), "", "not a uq results file (no mc_n_samples variable "
-                            "or scenario attribute); allowed: a file written by uq run")
-    return path, dataset
+    from .io import open_results
+    return Path(path), open_results(Path(path))
 
 
 def _plot(args):

@@ -13,7 +13,7 @@ from .bayesfit import NotConverged
 from .errors import ScenarioError
 from .fitting import (combine_fits, fit_profile, profile_from_results, profile_from_table,
                       true_parameters)
-from .io import write_results
+from .io import open_results, write_results
 from .scenario import assign_dotted, load_fit_settings
 
 EXIT_OK, EXIT_FAILURE = 0, 1
@@ -28,10 +28,11 @@ def run_fit(input_path, config_path=None, output=None, overrides=None):
     output = Path(output) if output else path.with_name(f"{path.stem}_fit.nc")
     if output.suffix != ".nc":
         raise ScenarioError("-o", str(output), "the output file must end in .nc")
-    results = _read_results(path) if path.suffix == ".nc" else None
-    config = fit_settings(config_path, results, overrides or {})
+    results = open_results(path) if path.suffix == ".nc" else None
+    scenario = None if results is None else yaml.safe_load(results.attrs["scenario"]) or {}
+    config = fit_settings(config_path, scenario, overrides or {})
     try:
-        dataset = _fit_input(path, results, config)
+        dataset = _fit_input(path, results, scenario, config)
     except NotConverged as error:
         print(f"uq: fit failed: {error}", file=sys.stderr)
         return EXIT_FAILURE
@@ -46,20 +47,9 @@ def run_fit(input_path, config_path=None, output=None, overrides=None):
     return EXIT_OK
 
 
-def _read_results(path):
-    from .io import read_results
-    try:
-        dataset = read_results(path)
-    except (OSError, ValueError) as error:
-        raise ScenarioError(str(path), "", f"cannot read it as netCDF ({error}); allowed: "
-                            "results of uq run") from None
-    if "scenario" not in dataset.attrs:
-        raise ScenarioError(str(path), "", "not a uq results file (no scenario attribute)")
-    return dataset
-
-
-def fit_settings(config_path, results, overrides):
-    """FitConfig from -c FILE's fit section, else the results' scenario's, then --set."""
+def fit_settings(config_path, scenario, overrides):
+    """FitConfig from -c FILE's fit section, else the results' scenario's (a mapping),
+    then --set."""
     source, raw = "defaults", {}
     if config_path:
         source = str(config_path)
@@ -71,9 +61,9 @@ def fit_settings(config_path, results, overrides):
             raise ScenarioError(source, "fit", "no 'fit' section; allowed: a YAML mapping "
                                 "with a top-level 'fit' key")
         raw = document["fit"] or {}
-    elif results is not None:
+    elif scenario is not None:
         source = "scenario of the results"
-        raw = (yaml.safe_load(results.attrs["scenario"]) or {}).get("fit") or {}
+        raw = scenario.get("fit") or {}
     raw = {"fit": dict(raw)}
     for key, value in overrides.items():
         if not key.startswith("fit."):
@@ -82,7 +72,7 @@ def fit_settings(config_path, results, overrides):
     return load_fit_settings(raw["fit"], source)
 
 
-def _fit_input(path, results, config):
+def _fit_input(path, results, scenario, config):
     if results is None:
         import pandas
         try:
@@ -97,7 +87,6 @@ def _fit_input(path, results, config):
     else:
         fits = {kind: fit_profile(profile_from_results(results, kind, str(path)), config)
                 for kind in ("propagated", "naive")}
-        scenario = yaml.safe_load(results.attrs["scenario"])
         dataset = combine_fits(fits, true_parameters(scenario, config))
     dataset.attrs.update(source=str(path), fit_settings=yaml.safe_dump(config.to_dict()))
     return dataset

@@ -148,7 +148,7 @@ def predictive_bands(posterior, samples, grid, probability=0.95):
     """Credible band of the mean profile and posterior predictive band at `grid`.
 
     The predictive draw at height z is f(z; theta) + e, e ~ N(0, s_meas(z)^2 + sigma^2):
-    s_meas^2 is the speeds' variance (plus the height variance through the slope),
+    s_meas^2 is the gates' variance (:meth:`ProfilePosterior.gate_variances`),
     interpolated between gates; sigma the scatter of the draw (0 without scatter).
     One predictive draw per posterior draw, from a generator seeded by the samples'
     size, so the band is reproducible.
@@ -158,9 +158,7 @@ def predictive_bands(posterior, samples, grid, probability=0.95):
     flat = flat[::step]
     k = len(posterior.names)
     profiles = posterior.model(grid[None, :], *[flat[:, j, None] for j in range(k)])
-    variance = np.diag(posterior.data.speed_covariance)
-    slope = posterior._slope(flat[:, :k])
-    variance = variance + slope**2 * np.diag(posterior.data.height_covariance)
+    variance = posterior.gate_variances(flat[:, :k])
     order = np.argsort(posterior.data.heights)
     heights = posterior.data.heights[order]
     noise = np.array([np.interp(grid, heights, v[order]) for v in variance])

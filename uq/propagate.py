@@ -100,8 +100,8 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         gum_note = f"no GUM: {error}"
     references = {q: _circular_reference(gum_value[q]) if q in circular else None
                   for q in gum_value}
-    runner = _Runner(wrapped, inputs_laid, method, seed, references, interval, chunk_size)
-    runner.covariance = tuple(covariance)
+    runner = _Runner(wrapped, inputs_laid, method, seed, references, interval, chunk_size,
+                     covariance)
     if set(covariance) & circular:
         raise ValueError(f"no covariance of circular outputs: {sorted(set(covariance) & circular)}")
     if control_variate:
@@ -175,7 +175,8 @@ def _named_outputs(model):
 class _Runner:
     """Draws blocks, evaluates the model chunk by chunk, accumulates statistics."""
 
-    def __init__(self, model, inputs, method, seed, references, interval, chunk_size):
+    def __init__(self, model, inputs, method, seed, references, interval, chunk_size,
+                 covariance=()):
         self.model, self.inputs, self.method, self.seed = model, inputs, method, seed
         self.references, self.interval = references, interval
         blocks = DEFAULT_BLOCKS_PER_CHUNK if chunk_size is None else -(-int(chunk_size) // RNG_BLOCK_SIZE)
@@ -184,7 +185,7 @@ class _Runner:
         self.batch_size = BATCH_SIZE if method == "mc" else RNG_BLOCK_SIZE
         self.stats, self.batches, self.n_done = None, {}, 0
         self.control, self.linear = None, {}
-        self.covariance, self.comoments = (), {}
+        self.covariance, self.comoments = tuple(covariance), {}
 
     def _start(self, capacity, shapes):
         self.stats = {q: StreamingStatistics(shape, capacity, self.references[q])
