@@ -1,4 +1,6 @@
 """The measurement model against closed forms and limiting cases."""
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -146,3 +148,41 @@ def test_half_cone_error_moves_the_gates():
     scene = make_scene(**{"lidar.height": 0.0, "lidar.ranges": [100.0]})
     height = reconstruct(scene, lidar_half_cone=np.array([1.0]))["gate_height"]
     assert height[0] == pytest.approx(100.0 * np.cos(d(29)) / np.cos(d(28)), rel=1e-12)
+
+
+@pytest.mark.parametrize("correction", ["none", "yaw", "full"])
+def test_height_error_reads_the_wind_of_another_height(correction):
+    """A level lidar that sits e lower than configured measures, at every gate, the power
+    law at H + r - e: V ((H + r + e) / z_ref)^alpha (the reconstruction is exact
+    otherwise), and its gate height says so."""
+    scene = make_scene(**{"wind.shear": 0.14, "wind.reference_height": 80.0,
+                          "lidar.height": 3.0, "lidar.ranges": [37.0, 77.0],
+                          "correction": correction})
+    out = reconstruct(scene, lidar_height=np.array([-2.0]))
+    heights = 3.0 - 2.0 + np.array([37.0, 77.0])
+    np.testing.assert_allclose(out["wind_speed"], 5.0 * (heights / 80.0) ** 0.14, rtol=1e-12)
+    np.testing.assert_allclose(out["gate_height"], heights, rtol=1e-12)
+
+
+def test_scene_draws_are_per_scene_and_equal_common_draws_when_equal():
+    """scene_draws: errors shaped (n, *S, ...) give each scene its own draws; a scene's
+    result equals that scene run alone with its draws, and replicating one set of draws
+    over the scenes equals the common-random-numbers call."""
+    speeds = np.array([4.0, 9.0, 14.0])
+    scene = make_scene(**{"wind.shear": 0.1, "lidar.ranges": [60.0, 100.0]})
+    batch = dataclasses.replace(scene, wind_speed=speeds)
+    rng = np.random.default_rng(3)
+    draws = {"ins_heading": rng.normal(0, 1, (5, 3, 1)), "ins_sog": rng.normal(0, .1, (5, 3, 1)),
+             "lidar_half_cone": rng.normal(0, .5, (5, 3)), "lidar_height": rng.normal(0, 1, (5, 3)),
+             "lidar_radial_velocity": rng.normal(0, .1, (5, 3, 4, 2))}
+    together = measurement_model(batch, scene_draws=True, **draws)
+    for i, speed in enumerate(speeds):
+        alone = measurement_model(dataclasses.replace(scene, wind_speed=speed),
+                                  **{k: v[:, i] for k, v in draws.items()})
+        for q in ("wind_speed", "wind_direction", "gate_height"):
+            np.testing.assert_allclose(together[q][:, i], alone[q], rtol=1e-13)
+    common = {k: v[:, :1] for k, v in draws.items()}
+    crn = measurement_model(batch, **{k: v[:, 0] for k, v in common.items()})
+    replicated = measurement_model(batch, scene_draws=True, **{
+        k: np.repeat(v, 3, axis=1) for k, v in common.items()})
+    np.testing.assert_allclose(replicated["wind_speed"], crn["wind_speed"], rtol=1e-13)

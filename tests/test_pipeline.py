@@ -154,4 +154,18 @@ def test_result_says_what_was_skipped():
     assert "computed once per scene" in case.attrs["skipped"]
     assert "input not sampled (no error declared): ins.pitch" in case.attrs["skipped"]
     assert "output not requested, not computed: radial_velocity" in case.attrs["skipped"]
-    assert full.attrs["skipped"] == "nothing"      # every error declared, every output
+    # every error but the lidar's height declared, every output requested
+    assert full.attrs["skipped"] == "input not sampled (no error declared): lidar.errors.height"
+
+
+def test_lidar_height_error_budget_is_the_power_law_slope():
+    """lidar.errors.height (draft, tide): a level lidar's speed at gate height z is
+    V (z / z_ref)^alpha, so the GUM budget of u(h) is (alpha V(z) / z)^2 u(h)^2."""
+    ds = uq.run(uq.load_scenario({"name": "h", "wind": {"shear": 0.2, "speed": 8.0},
+                                  "lidar": {"height": 20.0, "ranges": [100.0],
+                                            "errors": {"height": {"dist": "normal", "u": 0.5}}},
+                                  "sampling": {"n": 2000}}))
+    speed = 8.0 * (120.0 / 100.0) ** 0.2
+    budget = ds.wind_speed_budget.sel(input="lidar.errors.height")
+    # complex-step Jacobian: exact to rounding; 1e-6 leaves room for the budget units only
+    assert float(budget) == pytest.approx((0.2 * speed / 120.0 * 0.5) ** 2, rel=1e-6)

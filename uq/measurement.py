@@ -13,10 +13,20 @@ input                        shape            meaning
 ``lidar_half_cone``          (n,)             true minus configured half-cone [deg]
 ``lidar_misalignment``       (n,)             true minus configured misalignment [deg]
 ``lidar_radial_velocity``    (n, beams, gates) radial-velocity noise [m s-1]
+``lidar_height``             (n,)             true minus configured height of the lidar
+                                              above sea level [m] (draft, ballast, tide)
 ===========================  ===============  ========================================
 
 k = 1 when INS errors are shared by the beams of a scan (``scan``) and k = n_beams when
 each beam has its own reading (``beam``). Missing inputs are zero.
+
+By default every scene of a batch sees the same draws (common random numbers). With
+``scene_draws=True`` the errors carry the scene axes instead, shape (n, *S, ...) (INS
+errors (n, *S, k)): independent draws per scene, as for the records of a measurement
+campaign (:mod:`uq.golden.campaign`).
+
+A height error moves every range gate with the lidar: the reconstruction still believes
+the configured heights, so under shear it reads the wind of another height.
 
 The *true* radial velocities use the true attitude and ship velocity, the true
 geometry (configured + error), and the true wind at each beam's true height (power-law
@@ -140,15 +150,18 @@ def true_wind(scene, heights, trailing=1):
     return np.stack([north, east, up], axis=-1)
 
 
-def beam_heights(scene, beams_earth):
+def beam_heights(scene, beams_earth, height_error=0.0):
     """True height above sea level of every beam's range gates [m].
 
     The lidar places gate g at the slant distance ``range_g / cos(half_cone)`` along its
-    (configured) cone; the true height follows from the true earth-frame beam.
+    (configured) cone; the true height follows from the true earth-frame beam and the
+    lidar's true height (configured + `height_error`).
 
     Parameters
     ----------
     beams_earth : ndarray, shape (..., *S, n_beams, 3)
+    height_error : float or ndarray, shape (n, *S) or (n, *1)
+        True minus configured lidar height [m].
 
     Returns
     -------
@@ -156,10 +169,11 @@ def beam_heights(scene, beams_earth):
     """
     slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
                             scene.vertical_beam)                        # (*S, b, g)
-    return scene.field("lidar_height", 2) + slant * beams_earth[..., 2:3]
+    lidar = scene.field("lidar_height", 2) + np.asarray(height_error)[..., None, None]
+    return lidar + slant * beams_earth[..., 2:3]
 
 
-def true_radial_velocity(scene, beams_earth, ship_velocity):
+def true_radial_velocity(scene, beams_earth, ship_velocity, height_error=0.0):
     """Radial velocities of the true wind seen from the moving lidar [m s-1].
 
     Parameters
@@ -169,6 +183,8 @@ def true_radial_velocity(scene, beams_earth, ship_velocity):
         True earth-frame beam unit vectors.
     ship_velocity : ndarray, shape (*S, 3)
         True ship velocity (north, east, up) [m s-1].
+    height_error : float or ndarray
+        True minus configured lidar height [m] (:func:`beam_heights`).
 
     Returns
     -------
@@ -177,15 +193,17 @@ def true_radial_velocity(scene, beams_earth, ship_velocity):
     wind_only : ndarray, shape (..., n_beams, n_gates)
         ``n . u_wind(z)``, the motion-free radial wind.
     """
-    heights = beam_heights(scene, beams_earth)                          # (..., *S, b, g)
+    heights = beam_heights(scene, beams_earth, height_error)            # (..., *S, b, g)
     wind_vector = true_wind(scene, heights, trailing=2)                 # (..., *S, b, g, 3)
     wind_only = np.sum(beams_earth[..., None, :] * wind_vector, axis=-1)
     ship_along = np.sum(beams_earth * np.asarray(ship_velocity)[..., None, :], axis=-1)
     return wind_only - ship_along[..., None], wind_only
 
 
-def measurement_model(scene, outputs=OUTPUTS, **errors):
+def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, **errors):
     """Propagate errors through measurement and correction; see the module docstring.
+
+    `scene_draws` (bool): the errors carry the scene axes (independent draws per scene).
 
     Returns
     -------
@@ -195,15 +213,9 @@ def measurement_model(scene, outputs=OUTPUTS, **errors):
         motion-corrected radial velocity along the beam the correction believes in.
     """
     n = _sample_count(errors)
-    scenes = (1,) * len(scene.shape)                 # scene axes follow the sample axis
-    err = {}
-    for name in _ERROR_NAMES:
-        value = np.asarray(errors.get(name, 0.0))
-        if name.startswith("ins_"):                  # INS errors to shape (n|1, *1, k)
-            # a missing (scalar) error stays one row: no per-sample rotation matrices
-            value = value[:, None] if value.ndim == 1 else value + np.zeros((1, 1))
-        err[name] = value.reshape(value.shape[:1] + scenes + value.shape[1:]) \
-            if value.ndim else value
+    scenes = scene.shape if scene_draws else (1,) * len(scene.shape)
+    err = {name: _error_shape(np.asarray(errors.get(name, 0.0)), name, scenes, scene_draws)
+           for name in _ERROR_NAMES}
     measured, navigation, beams_earth = _measure(scene, err, (n,) + scenes)
     unit_vectors = scene.nominal_unit_vectors()
     operator = least_squares_operator(unit_vectors)
@@ -211,8 +223,21 @@ def measurement_model(scene, outputs=OUTPUTS, **errors):
                                    navigation, scene.field("heading", 1))
     result = _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors)
     if "gate_height" in outputs:
-        result["gate_height"] = _gate_height(scene, beams_earth)
+        result["gate_height"] = _gate_height(scene, beams_earth, err["lidar_height"])
     return _full_shape(result, (n,) + scene.shape, scene.n_beams)
+
+
+def _error_shape(value, name, scenes, scene_draws):
+    """An error array shaped to broadcast against (n, *S, ...): the scene axes follow the
+    sample axis, as ones (common draws) or as given (`scene_draws`)."""
+    if value.ndim == 0:          # a missing error stays a scalar: no per-sample rotations
+        return value if not name.startswith("ins_") else value + np.zeros((1,) * (
+            len(scenes) + 2))
+    if scene_draws:
+        return value
+    if name.startswith("ins_"):                      # INS errors to shape (n, *1, k)
+        value = value[:, None] if value.ndim == 1 else value
+    return value.reshape(value.shape[:1] + scenes + value.shape[1:])
 
 
 def _full_shape(result, leading, n_beams):
@@ -223,7 +248,7 @@ def _full_shape(result, leading, n_beams):
 
 
 _ERROR_NAMES = tuple(f"ins_{key}" for key in NAVIGATION) + (
-    "lidar_half_cone", "lidar_misalignment", "lidar_radial_velocity")
+    "lidar_half_cone", "lidar_misalignment", "lidar_radial_velocity", "lidar_height")
 
 
 def _sample_count(errors):
@@ -243,7 +268,8 @@ def _measure(scene, err, batch):
                                    scene.vertical_beam)                    # ([n], *S, b, 3)
     attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)    # (*S, 3, 3)
     beams_earth = true_beams @ np.swapaxes(attitude, -1, -2)
-    radial, _ = true_radial_velocity(scene, beams_earth, _ship_velocity(scene))
+    radial, _ = true_radial_velocity(scene, beams_earth, _ship_velocity(scene),
+                                     err["lidar_height"])
     measured = radial + err["lidar_radial_velocity"]
     navigation = {}
     for key in NAVIGATION:
@@ -253,10 +279,11 @@ def _measure(scene, err, batch):
     return measured, navigation, beams_earth
 
 
-def _gate_height(scene, beams_earth):
+def _gate_height(scene, beams_earth, height_error):
     """Mean true height of the slanted beams per gate [m], shape ([n], *S, n_gates)."""
     slanted = len(scene.azimuths)
-    return np.mean(beam_heights(scene, beams_earth)[..., :slanted, :], axis=-2)
+    heights = beam_heights(scene, beams_earth, height_error)
+    return np.mean(heights[..., :slanted, :], axis=-2)
 
 
 def _ship_velocity(scene):

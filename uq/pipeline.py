@@ -21,7 +21,7 @@ from .metadata import COORDINATES, QUANTITIES, variable_attributes
 from .propagate import propagate
 from .rubio2022 import rubio2022_scene_uncertainty
 from .sampling import new_seed
-from .scenario import INS_KEYS, load_scenario
+from .scenario import INS_KEYS, LIDAR_ERROR_KEYS, load_scenario
 from .statistics import unwrap
 from .sweep import batch_scene, group_assignments, sweep_plan, vector_fields
 
@@ -257,7 +257,7 @@ def skipped_work(settings, outputs):
     lidar, ins = settings["lidar"], settings["ins"]
     lines = [f"input not sampled (no error declared): {key}" for key in
              [f"ins.{k}" for k in INS_KEYS if k not in ins]
-             + [f"lidar.errors.{k}" for k in ("half_cone", "misalignment", "radial_velocity")
+             + [f"lidar.errors.{k}" for k in LIDAR_ERROR_KEYS
                 if k not in lidar["errors"]]]
     if not ({"half_cone", "misalignment"} & set(lidar["errors"])):
         lines.append("true beams and true radial velocities computed once per scene, not "

@@ -31,7 +31,7 @@ from .sweep import VECTOR_KEYS
 
 INS_CORRELATIONS = ("scan", "beam")
 INS_KEYS = ("heading", "pitch", "roll", "sog", "cog", "heave")
-LIDAR_ERROR_KEYS = ("half_cone", "misalignment", "radial_velocity")
+LIDAR_ERROR_KEYS = ("half_cone", "misalignment", "radial_velocity", "height")
 #: Largest tilt the model accepts [deg]; beyond it the lidar looks sideways.
 MAX_TILT_DEG = 89.0
 MAX_SAMPLES = 10**10
