@@ -53,3 +53,29 @@ VON_KARMAN = 0.40
 #: Fewest emcee walkers of a profile fit [1]: issue 5 asks for at least 32; the
 #: affine-invariant ensemble needs more than twice the parameters (here <= 3).
 MIN_WALKERS = 32
+
+# --- golden-lidar verification (uq.golden) -------------------------------------------
+
+#: Width of the reference-wind-speed bins [m s-1]; bins are centred on multiples of it.
+#: IEC 61400-12-1:2017 Annex L, and Coll-Vinent & Miquel (FLS200 golden lidar).
+GOLDEN_BIN_WIDTH = 0.5
+
+#: Reference-speed range whose bins must each hold enough records [m s-1] (bin centres,
+#: inclusive). IEC 61400-12-1:2017 Annex L calibration range, as asked in issue 6.
+GOLDEN_REQUIRED_RANGE = (4.0, 16.0)
+
+#: Fewest 10-min records a bin in the required range needs [1] (issue 6).
+GOLDEN_MIN_RECORDS = 6
+
+#: Level of the two-sided t-test on a sensitivity slope [1]: a slope is significant when
+#: its p-value is below this (the conventional 5 %).
+GOLDEN_SIGNIFICANCE = 0.05
+
+#: Floating-lidar acceptance KPIs, (best practice, minimum), Carbon Trust OWA roadmap as
+#: reproduced in IEA Wind RP 18 (issue 6). Slopes are bands around 1, R^2 lower bounds,
+#: the direction offset an upper bound on |offset| [deg].
+KPI_SPEED_SLOPE = ((0.98, 1.02), (0.97, 1.03))
+KPI_SPEED_R2 = (0.98, 0.97)
+KPI_DIRECTION_SLOPE = ((0.97, 1.03), (0.95, 1.05))
+KPI_DIRECTION_OFFSET_DEG = (5.0, 10.0)
+KPI_DIRECTION_R2 = (0.97, 0.95)
