@@ -79,3 +79,8 @@ KPI_SPEED_R2 = (0.98, 0.97)
 KPI_DIRECTION_SLOPE = ((0.97, 1.03), (0.95, 1.05))
 KPI_DIRECTION_OFFSET_DEG = (5.0, 10.0)
 KPI_DIRECTION_R2 = (0.97, 0.95)
+
+#: Availability KPI (best practice, minimum) [1]: the OWA roadmap's overall
+#: post-processed data availability. Configurable (``golden.kpi.availability``): check it
+#: against the roadmap version a report is written to.
+KPI_AVAILABILITY = (0.90, 0.85)

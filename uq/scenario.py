@@ -142,7 +142,7 @@ def load_scenario(path_or_mapping, overrides=None):
         raw, source = copy.deepcopy(path_or_mapping), "<mapping>"
     else:
         source = str(path_or_mapping)
-        raw = _read_yaml(Path(path_or_mapping))
+        raw = read_yaml(Path(path_or_mapping))
         if isinstance(raw, dict):
             raw.setdefault("name", Path(path_or_mapping).stem)
     if not isinstance(raw, dict):
@@ -153,7 +153,7 @@ def load_scenario(path_or_mapping, overrides=None):
     return _build(raw, source)
 
 
-def _read_yaml(path):
+def read_yaml(path):
     try:
         text = path.read_text()
     except OSError as error:
@@ -195,11 +195,11 @@ def _build(raw, source):
 
 def load_fit_settings(raw_fit, source):
     """A :class:`uq.fitconfig.FitConfig` from a ``fit`` mapping; errors name `source`."""
-    return validate_fit(_Checker(source), raw_fit)
+    return validate_fit(Checker(source), raw_fit)
 
 
 def _validate(raw, source):
-    check = _Checker(source)
+    check = Checker(source)
     check.keys(raw, "", DEFAULTS)
     settings = {
         "name": check.name(raw.get("name", DEFAULTS["name"])),
@@ -363,7 +363,7 @@ def _sweep_values(spec, key, source):
             raise ScenarioError(source, key, "empty list; allowed: a non-empty list")
         return spec
     if isinstance(spec, dict) and set(spec) == {"start", "stop", "step"}:
-        check = _Checker(source)
+        check = Checker(source)
         start, stop, step = (check.number(spec[k], f"{key}.{k}") for k in ("start", "stop", "step"))
         if step == 0 or (stop - start) / step <= 0:
             raise ScenarioError(source, key, "start, stop, step give no values; allowed: "
@@ -374,7 +374,7 @@ def _sweep_values(spec, key, source):
                         "{same_as: another swept key}")
 
 
-class _Checker:
+class Checker:
     """Type and range checks that raise ScenarioError naming the key."""
 
     def __init__(self, source):

@@ -35,6 +35,14 @@ def unwrap(values, reference):
         + HALF_CIRCLE_DEG
 
 
+def circular_mean_deg(values, axis=0):
+    """Direction of the mean unit vector of angles [deg], in (-180, 180]; the mean of 350
+    and 10 deg is 0, not 180."""
+    radians = np.deg2rad(values)
+    return np.rad2deg(np.arctan2(np.mean(np.sin(radians), axis=axis),
+                                 np.mean(np.cos(radians), axis=axis)))
+
+
 def tail_capacity(n, probability=COVERAGE_PROBABILITY, kind="shortest"):
     """Order statistics to keep on each side for `n` samples (JCGM 101, 7.7).
 

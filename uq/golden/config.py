@@ -1,0 +1,257 @@
+"""The ``uq golden`` configuration: which files hold which instrument, at which heights,
+which comparisons to make, and the settings of bins, classification and KPIs.
+
+A configuration is a YAML file with one top-level key ``golden``; see
+``scenarios/golden_campaign.yaml`` (the shipped synthetic campaign, a ``synthetic``
+section instead of files) and the README for the form with data files. Validated once, at
+construction; a bad key raises :class:`uq.errors.ScenarioError` naming the file, the key
+and what is allowed.
+"""
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..constants import (GOLDEN_BIN_WIDTH, GOLDEN_MIN_RECORDS, GOLDEN_REQUIRED_RANGE,
+                         GOLDEN_SIGNIFICANCE, KPI_AVAILABILITY)
+from ..errors import ScenarioError
+from ..scenario import Checker, read_yaml
+
+TOP_KEYS = ("name", "description", "instruments", "comparisons", "smc", "classification",
+            "bins", "kpi", "synthetic")
+INSTRUMENT_KEYS = ("file", "time", "heights", "environment", "calibration", "class_number")
+HEIGHT_KEYS = ("speed", "direction", "environment")
+CLASSIFICATION_KEYS = ("variables", "significance", "ranges", "route")
+ROUTES = ("per_variable", "class_number")
+SYNTHETIC_KEYS = ("truth", "verification", "smc", "lidars", "mast", "scans_per_record",
+                  "site_separation", "direction_separation", "seed")
+
+
+@dataclass(frozen=True)
+class Instrument:
+    """One instrument's records: a file, its time column and its columns per height.
+
+    ``heights`` maps a height [m] to ``{"speed": column, "direction": column or None,
+    "environment": {variable: column}}``; ``environment`` holds the columns common to
+    all heights (a height's own entry wins). ``calibration`` (absolute [m s-1], relative
+    [1]) and ``class_number`` [%] are given for a reference that is not itself verified
+    in this configuration (a mast)."""
+
+    name: str
+    file: Path
+    time: str
+    heights: dict
+    environment: dict
+    calibration: tuple = None
+    class_number: float = None
+
+
+@dataclass(frozen=True)
+class GoldenConfig:
+    """A validated ``golden`` section (see the module docstring)."""
+
+    name: str
+    source: str
+    description: str = ""
+    instruments: dict = field(default_factory=dict)
+    comparisons: tuple = ()
+    smc: Instrument = None
+    variables: tuple = ()
+    significance: float = GOLDEN_SIGNIFICANCE
+    ranges: dict = field(default_factory=dict)
+    route: str = "per_variable"
+    bin_width: float = GOLDEN_BIN_WIDTH
+    required: tuple = GOLDEN_REQUIRED_RANGE
+    minimum_records: int = GOLDEN_MIN_RECORDS
+    availability: tuple = KPI_AVAILABILITY
+    synthetic: dict = None
+
+
+def load_golden_config(path):
+    """Read and validate a ``uq golden`` configuration file."""
+    path = Path(path)
+    raw = read_yaml(path)
+    check = Checker(str(path))
+    if not isinstance(raw, dict) or "golden" not in raw:
+        check.fail("golden", "missing; allowed: a mapping under the top-level key 'golden'")
+    check.keys(raw, "", ("golden",))
+    return validate_golden(raw["golden"], check, path.parent)
+
+
+def validate_golden(raw, check, base):
+    """A :class:`GoldenConfig` from the ``golden`` mapping; relative files are read from
+    `base`."""
+    check.mapping(raw, "golden")
+    check.keys(raw, "golden", TOP_KEYS)
+    settings = {"name": check.text(raw.get("name", "golden"), "golden.name"),
+                "source": check.source,
+                "description": check.text(raw.get("description", ""), "golden.description")}
+    settings.update(_bins(check, raw.get("bins") or {}))
+    settings.update(_classification(check, raw.get("classification") or {}))
+    settings["availability"] = _availability(check, raw.get("kpi") or {})
+    if "synthetic" in raw:
+        for key in ("instruments", "comparisons", "smc"):
+            if key in raw:
+                check.fail(f"golden.{key}", "not allowed with golden.synthetic (the synthetic "
+                           "campaign generates its instruments); allowed: one of the two")
+        settings["synthetic"] = _synthetic(check, raw["synthetic"])
+        return GoldenConfig(**settings)
+    for key in ("instruments", "comparisons"):
+        if key not in raw:
+            check.fail(f"golden.{key}", "missing; allowed: data files and comparisons, or a "
+                       "'synthetic' section")
+    check.mapping(raw["instruments"], "golden.instruments")
+    instruments = {name: _instrument(check, spec, f"golden.instruments.{name}", name, base)
+                   for name, spec in raw["instruments"].items()}
+    settings["instruments"] = instruments
+    settings["comparisons"] = _comparisons(check, raw["comparisons"], instruments)
+    if "smc" in raw:
+        settings["smc"] = _instrument(check, raw["smc"], "golden.smc", "smc", base)
+    _references_are_calibrated(check, settings["comparisons"], instruments)
+    return GoldenConfig(**settings)
+
+
+def _instrument(check, spec, key, name, base):
+    check.mapping(spec, key)
+    check.keys(spec, key, INSTRUMENT_KEYS)
+    for needed in ("file", "heights"):
+        if needed not in spec:
+            check.fail(f"{key}.{needed}", "missing")
+    heights = {}
+    check.mapping(spec["heights"], f"{key}.heights")
+    for height, columns in spec["heights"].items():
+        where = f"{key}.heights.{height}"
+        value = check.number(height, where, low=0.0, low_open=True)
+        check.mapping(columns, where)
+        check.keys(columns, where, HEIGHT_KEYS)
+        if "speed" not in columns:
+            check.fail(f"{where}.speed", "missing; allowed: the column of the wind speed [m s-1]")
+        heights[value] = {"speed": check.text(columns["speed"], f"{where}.speed"),
+                          "direction": _optional_text(check, columns.get("direction"),
+                                                      f"{where}.direction"),
+                          "environment": _columns(check, columns.get("environment") or {},
+                                                  f"{where}.environment")}
+    calibration = None
+    if "calibration" in spec:
+        cal = spec["calibration"]
+        check.mapping(cal, f"{key}.calibration")
+        check.keys(cal, f"{key}.calibration", ("absolute", "relative"))
+        calibration = (check.number(cal.get("absolute", 0.0), f"{key}.calibration.absolute",
+                                    low=0.0),
+                       check.number(cal.get("relative", 0.0), f"{key}.calibration.relative",
+                                    low=0.0))
+    class_number = spec.get("class_number")
+    if class_number is not None:
+        class_number = check.number(class_number, f"{key}.class_number", low=0.0)
+    return Instrument(name=name, file=base / check.text(spec["file"], f"{key}.file"),
+                      time=check.text(spec.get("time", "time"), f"{key}.time"),
+                      heights=heights,
+                      environment=_columns(check, spec.get("environment") or {},
+                                           f"{key}.environment"),
+                      calibration=calibration, class_number=class_number)
+
+
+def _columns(check, value, key):
+    check.mapping(value, key)
+    return {name: check.text(column, f"{key}.{name}") for name, column in value.items()}
+
+
+def _optional_text(check, value, key):
+    return None if value is None else check.text(value, key)
+
+
+def _comparisons(check, value, instruments):
+    items = check.list(value, "golden.comparisons")
+    pairs = []
+    for i, item in enumerate(items):
+        key = f"golden.comparisons[{i}]"
+        check.mapping(item, key)
+        check.keys(item, key, ("unit", "reference"))
+        pair = tuple(check.choice(item.get(role), f"{key}.{role}", tuple(instruments))
+                     for role in ("unit", "reference"))
+        if pair[0] == pair[1]:
+            check.fail(key, "unit and reference are the same instrument; allowed: two "
+                       "different instruments")
+        pairs.append(pair)
+    if not pairs:
+        check.fail("golden.comparisons", "empty; allowed: at least one {unit, reference}")
+    return tuple(pairs)
+
+
+def _references_are_calibrated(check, comparisons, instruments):
+    """A reference is calibrated by a stated uncertainty or by being the unit of exactly
+    one comparison (the golden-lidar chain); loops are not allowed."""
+    verified = {}
+    for unit, reference in comparisons:
+        verified.setdefault(unit, []).append(reference)
+    for _, reference in comparisons:
+        stated = instruments[reference].calibration is not None
+        count = len(verified.get(reference, []))
+        if not stated and count != 1:
+            check.fail(f"golden.instruments.{reference}.calibration", "a reference needs a "
+                       "stated calibration {absolute, relative} or exactly one comparison in "
+                       f"which it is the unit (it has {count})")
+        if stated and count:
+            check.fail(f"golden.instruments.{reference}.calibration", "given, but the "
+                       "instrument is also verified here; allowed: one of the two")
+    for unit in verified:
+        seen, node = {unit}, unit
+        while node in verified and instruments[node].calibration is None:
+            node = verified[node][0]
+            if node in seen:
+                check.fail("golden.comparisons", f"the chain of references loops at {node}")
+            seen.add(node)
+
+
+def _bins(check, raw):
+    check.mapping(raw, "golden.bins")
+    check.keys(raw, "golden.bins", ("width", "required", "minimum_records"))
+    required = check.number_list(raw.get("required", list(GOLDEN_REQUIRED_RANGE)),
+                                 "golden.bins.required", low=0.0)
+    if len(required) != 2 or required[0] > required[1]:
+        check.fail("golden.bins.required", "allowed: [low, high] bin centres, low <= high")
+    return {"bin_width": check.number(raw.get("width", GOLDEN_BIN_WIDTH), "golden.bins.width",
+                                      low=0.0, low_open=True),
+            "required": tuple(required),
+            "minimum_records": check.integer(raw.get("minimum_records", GOLDEN_MIN_RECORDS),
+                                             "golden.bins.minimum_records", low=1)}
+
+
+def _classification(check, raw):
+    check.mapping(raw, "golden.classification")
+    check.keys(raw, "golden.classification", CLASSIFICATION_KEYS)
+    variables = [check.text(v, f"golden.classification.variables[{i}]") for i, v in
+                 enumerate(check.list(raw.get("variables", []),
+                                      "golden.classification.variables"))]
+    ranges = {}
+    for name, pair in (raw.get("ranges") or {}).items():
+        values = check.number_list(pair, f"golden.classification.ranges.{name}")
+        if len(values) != 2 or values[0] >= values[1]:
+            check.fail(f"golden.classification.ranges.{name}", "allowed: [low, high], low < high")
+        ranges[name] = tuple(values)
+    return {"variables": tuple(variables), "ranges": ranges,
+            "significance": check.number(raw.get("significance", GOLDEN_SIGNIFICANCE),
+                                         "golden.classification.significance", low=0.0,
+                                         high=1.0, low_open=True, high_open=True),
+            "route": check.choice(raw.get("route", "per_variable"),
+                                  "golden.classification.route", ROUTES)}
+
+
+def _availability(check, raw):
+    check.mapping(raw, "golden.kpi")
+    check.keys(raw, "golden.kpi", ("availability",))
+    values = check.number_list(raw.get("availability", list(KPI_AVAILABILITY)),
+                               "golden.kpi.availability", low=0.0, high=1.0)
+    if len(values) != 2 or values[0] < values[1]:
+        check.fail("golden.kpi.availability", "allowed: [best, minimum], best >= minimum")
+    return tuple(values)
+
+
+def _synthetic(check, raw):
+    from .campaign import validate_synthetic
+    check.mapping(raw, "golden.synthetic")
+    check.keys(raw, "golden.synthetic", SYNTHETIC_KEYS)
+    return validate_synthetic(check, raw)
+
+
+def fail(source, key, problem):
+    """Raise the one-line bad-input error (file, key, what is allowed)."""
+    raise ScenarioError(source, key, problem)
