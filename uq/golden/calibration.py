@@ -52,8 +52,10 @@ def deviation_terms(statistics, framework):
 
 
 def quadrature(*terms):
-    """Root sum of squares of independent standard uncertainties [m s-1]."""
-    return np.sqrt(sum(np.square(np.asarray(t, dtype=float)) for t in terms))
+    """Root sum of squares of independent standard uncertainties [m s-1] (numbers, arrays
+    or xarray objects, which keep their labels)."""
+    terms = [t if hasattr(t, "dims") else np.asarray(t, dtype=float) for t in terms]
+    return np.sqrt(sum(t ** 2 for t in terms))
 
 
 def calibration_uncertainty(reference_calibration, reference_classification, deviation):

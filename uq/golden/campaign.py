@@ -42,7 +42,7 @@ TEMPERATURE_COLUMN = "T2m"
 PERCENT = 100.0
 DEFAULTS = {"truth": "brightwind", "verification": ["2016-06-01", "2016-09-01"],
             "smc": ["2016-10-01", "2017-01-01"], "scans_per_record": 10,
-            "site_separation": 0.01, "direction_separation": 2.0, "outage": 0.02,
+            "site_separation": 0.02, "direction_separation": 2.0, "outage": 0.02,
             "seed": 1, "mast": {"calibration": {"absolute": 0.05, "relative": 0.005}}}
 
 
@@ -96,11 +96,18 @@ def shear_exponent(table, low=40.0, high=80.0):
         return np.log(v_high / v_low).where(valid) / np.log(high / low)
 
 
-def lidar_records(scenario, mast, rng, settings):
-    """One floating lidar's table over the mast's records (see the module docstring)."""
+def site_difference(n, rng, settings):
+    """(relative speed factor, direction turn [deg]) of the buoys' site against the mast,
+    one per record, shared by the collocated buoys."""
+    return (1.0 + settings["site_separation"] * rng.standard_normal(n),
+            settings["direction_separation"] * rng.standard_normal(n))
+
+
+def lidar_records(scenario, mast, site, rng, settings):
+    """One floating lidar's table over the mast's records, at the site whose wind differs
+    from the mast's by `site` (:func:`site_difference`); see the module docstring."""
     n = len(mast)
-    site_speed = 1.0 + settings["site_separation"] * rng.standard_normal(n)
-    site_turn = settings["direction_separation"] * rng.standard_normal(n)
+    site_speed, site_turn = site
     shear = np.nan_to_num(mast["shear"].to_numpy(), nan=0.0)
     table = pd.DataFrame(index=mast.index)
     for height in MAST_COLUMNS:
@@ -157,12 +164,15 @@ def generate_campaign(config, directory):
     for period in ("verification", "smc"):
         start, stop = (pd.Timestamp(str(p)) for p in settings[period])
         mast = mast_records(truth[(truth.index >= start) & (truth.index < stop)])
+        site = site_difference(len(mast), rng, settings)
         if period == "verification":
             tables["mast"] = mast
             for role, name in (("golden", "flsb"), ("unit", "flsa")):
-                tables[name] = lidar_records(settings["lidars"][role], mast, rng, settings)
+                tables[name] = lidar_records(settings["lidars"][role], mast, site, rng,
+                                             settings)
         else:
-            tables["smc"] = lidar_records(settings["lidars"]["unit"], mast, rng, settings)
+            tables["smc"] = lidar_records(settings["lidars"]["unit"], mast, site, rng,
+                                          settings)
     for name, table in tables.items():
         table.to_csv(directory / f"{name}.csv", index_label="timestamp", float_format="%.5g")
     path = directory / "campaign.yaml"

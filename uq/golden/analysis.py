@@ -1,0 +1,219 @@
+"""The orchestrator of ``uq golden``: records in, one Dataset of every table out.
+
+For each comparison (a unit verified against a reference) and height: the per-bin
+statistics, the deviation terms of Eq. 3 under both frameworks, the sensitivity slopes
+and the unit's classification uncertainty (Eq. 1 and the class-number route), the KPIs;
+then the golden-lidar chain (seed Fig. 1): a reference that is itself verified here
+brings its own calibration and classification uncertainty into the unit's Eq. 2.
+
+Dimensions: ``comparison`` (``unit-reference``), ``height`` [m], ``bin`` (centre
+[m s-1]), ``framework`` (``iec``, ``lusr``), ``variable`` (environmental), ``time``
+(the paired records, for the figures).
+"""
+import numpy as np
+import xarray as xr
+
+from ..errors import ScenarioError
+from . import binning, calibration, classification, kpi
+from .records import align, load_records
+
+FRAMEWORKS = calibration.FRAMEWORKS
+RECORD_PERIOD = np.timedelta64(10, "m")
+#: Sensitivity fields -> result variables (dimension ``variable``).
+SENSITIVITY_NAMES = {"slope": "slope", "intercept": "slope_intercept",
+                     "slope_standard_error": "slope_standard_error",
+                     "p_value": "slope_p_value", "r_squared": "slope_r_squared",
+                     "n_records": "slope_n_records", "significant": "slope_significant"}
+
+
+def analyse(config):
+    """Every table of a :class:`uq.golden.config.GoldenConfig` as one Dataset."""
+    records = {name: load_records(spec) for name, spec in config.instruments.items()}
+    smc = load_records(config.smc) if config.smc is not None else None
+    _check_variables(config, records, smc)
+    pairs = {f"{u}-{r}": align(records[u], records[r]) for u, r in config.comparisons}
+    top = max(float(np.nanmax(ref["speed"].values)) for _, ref, _ in pairs.values())
+    centres = binning.bin_centres(0.0, top, config.bin_width)
+    parts = [_comparison(config, key, *pairs[key], centres, smc) for key in pairs]
+    ds = xr.concat(parts, dim="comparison", join="outer", coords="different",
+                   compat="equals")
+    ds = ds.assign_coords(comparison=list(pairs), bin=centres)
+    ds["unit"] = ("comparison", [u for u, _ in config.comparisons])
+    ds["reference"] = ("comparison", [r for _, r in config.comparisons])
+    _chain(config, ds)
+    ds.attrs.update(name=config.name, description=config.description,
+                    significance=config.significance, route=config.route,
+                    bin_width=config.bin_width, required_low=config.required[0],
+                    required_high=config.required[1], minimum_records=config.minimum_records,
+                    n_invalid=sum(int(r.attrs["n_invalid"]) for r in records.values()))
+    return ds
+
+
+def _check_variables(config, records, smc):
+    for name in config.variables:
+        for where, ds in list(records.items()) + [("smc", smc)]:
+            if ds is not None and name not in ds:
+                raise ScenarioError(config.source, "golden.classification.variables",
+                                    f"{name!r} is not an environmental variable of {where}; "
+                                    f"allowed: {', '.join(_env(ds)) or 'none declared'}")
+    if config.route == "class_number":
+        missing = [v for v in config.variables if v not in config.ranges]
+        if missing:
+            raise ScenarioError(config.source, "golden.classification.ranges",
+                                f"no range for {', '.join(missing)}; the class-number route "
+                                "needs [low, high] for every variable")
+    elif config.smc is None and any(s.calibration is None for s in config.instruments.values()):
+        raise ScenarioError(config.source, "golden.smc", "missing; the per_variable route "
+                            "(Eq. 1) needs the specific measurement campaign's records, "
+                            "or set classification.route: class_number")
+
+
+def _env(ds):
+    return [v for v in ds.data_vars if v not in ("speed", "direction")]
+
+
+def _comparison(config, key, unit, reference, counts, centres, smc):
+    """Tables of one comparison, dimensions (height, bin, framework, variable, time)."""
+    heights = unit["height"].values
+    per_height = [_height_tables(config, unit.sel(height=h), reference.sel(height=h),
+                                 centres, smc.sel(height=h) if smc is not None and h in
+                                 smc["height"].values else None) for h in heights]
+    ds = xr.concat(per_height, dim="height").assign_coords(height=heights)
+    ds["records_only_unit"] = counts["only_unit"]
+    ds["records_only_reference"] = counts["only_reference"]
+    return ds.expand_dims(comparison=[key])
+
+
+def _height_tables(config, unit, reference, centres, smc):
+    ref_speed, unit_speed = reference["speed"].values, unit["speed"].values
+    stats = binning.bin_statistics(ref_speed, unit_speed, centres, config.bin_width)
+    sufficient, required = binning.sufficient_bins(stats["n_records"], centres,
+                                                   config.minimum_records, config.required)
+    data = {k: ("bin", v) for k, v in stats.items()}
+    data.update(sufficient=("bin", sufficient), required=("bin", required))
+    terms = [calibration.deviation_terms(stats, f) for f in FRAMEWORKS]
+    data["statistical"] = (("framework", "bin"), np.array([t[0] for t in terms]))
+    data["mean_deviation"] = (("framework", "bin"), np.array([t[1] for t in terms]))
+    data.update(_sensitivities(config, unit, reference))
+    data.update(_classification(config, centres, unit, reference, smc, data))
+    data.update(_kpis(config, unit, reference, sufficient, required))
+    data.update(_paired(config, unit, reference))
+    return xr.Dataset(data, coords={"framework": list(FRAMEWORKS),
+                                    "variable": list(config.variables)})
+
+
+def _in_required_range(config, speed):
+    half = config.bin_width / 2.0
+    return (speed >= config.required[0] - half) & (speed < config.required[1] + half)
+
+
+def _sensitivities(config, unit, reference):
+    ref_speed = reference["speed"].values
+    deviation = classification.percentage_deviation(unit["speed"].values, ref_speed)
+    deviation = np.where(_in_required_range(config, ref_speed), deviation, np.nan)
+    fits = [classification.sensitivity(reference[v].values, deviation, config.significance)
+            for v in config.variables]
+    return {SENSITIVITY_NAMES[name]: ("variable", np.array([getattr(f, name) for f in fits]))
+            for name in SENSITIVITY_NAMES} if fits else {}
+
+
+def _bin_means(values, speed, centres, width):
+    """Mean of `values` per bin of `speed`."""
+    index = binning.bin_index(speed, width)
+    keys = np.rint(np.asarray(centres) / width).astype(int)
+    return np.array([np.nanmean(values[index == k]) if np.any(np.isfinite(
+        values[index == k])) else np.nan for k in keys])
+
+
+def _classification(config, centres, unit, reference, smc, data):
+    """The unit's classification uncertainty by both routes (NaN where not possible)."""
+    slopes = np.where(data["slope_significant"][1], data["slope"][1], 0.0) if config.variables \
+        else np.zeros(0)
+    out = {}
+    ver = np.array([_bin_means(reference[v].values, reference["speed"].values, centres,
+                               config.bin_width) for v in config.variables])
+    out["verification_mean"] = (("variable", "bin"), ver.reshape(len(config.variables), -1))
+    if smc is not None:
+        smc_means = np.array([_bin_means(smc[v].values, smc["speed"].values, centres,
+                                         config.bin_width) for v in config.variables])
+        smc_means = smc_means.reshape(len(config.variables), -1)
+        out["smc_mean"] = (("variable", "bin"), smc_means)
+        out["smc_n_records"] = ("bin", binning.bin_statistics(
+            smc["speed"].values, smc["speed"].values, centres, config.bin_width)["n_records"])
+        per_variable = classification.per_variable_uncertainty(centres, slopes, smc_means,
+                                                               ver.reshape(smc_means.shape))
+    else:
+        per_variable = np.full(len(centres), np.nan)
+    out["classification_per_variable"] = ("bin", per_variable)
+    ranges = [config.ranges.get(v) for v in config.variables]
+    number = classification.class_number([m for m, r in zip(slopes, ranges) if r],
+                                         [r for r in ranges if r]) \
+        if all(ranges) else np.nan
+    out["class_number"] = number
+    out["classification_class_number"] = ("bin", classification.class_number_uncertainty(
+        centres, number))
+    return out
+
+
+def _kpis(config, unit, reference, sufficient, required):
+    values = {**kpi.speed_kpis(reference["speed"].values, unit["speed"].values),
+              **kpi.direction_kpis(reference["direction"].values, unit["direction"].values)}
+    times = reference["time"].values
+    expected = int((times.max() - times.min()) / RECORD_PERIOD) + 1 if len(times) else 0
+    available = kpi.availability(np.sum(np.isfinite(unit["speed"].values)), expected)
+    values.update(availability=available,
+                  availability_verdict=kpi.lower_bound_verdict(
+                      available + 1e-12, config.availability),
+                  coverage_verdict=kpi.coverage_verdict(sufficient, required))
+    return values
+
+
+def _paired(config, unit, reference):
+    data = {"paired_reference_speed": ("time", reference["speed"].values),
+            "paired_unit_speed": ("time", unit["speed"].values),
+            "paired_reference_direction": ("time", reference["direction"].values),
+            "paired_unit_direction": ("time", unit["direction"].values)}
+    if config.variables:
+        data["paired_environment"] = (("variable", "time"), np.array(
+            [reference[v].values for v in config.variables]))
+    return {k: xr.Variable(dims, v) for k, (dims, v) in data.items()} | {
+        "time": ("time", reference["time"].values)}
+
+
+def _chain(config, ds):
+    """Eq. 2 along the golden-lidar chain, per comparison, framework, height and bin."""
+    ds["deviation"] = calibration.quadrature(ds["statistical"], ds["mean_deviation"])
+    chosen = ds["classification_per_variable"] if config.route == "per_variable" \
+        else ds["classification_class_number"]
+    ds["classification"] = chosen
+    verified = {u: key for key, u in zip(ds["comparison"].values, ds["unit"].values)}
+    cal, cls = [], []
+    for key, reference in zip(ds["comparison"].values, ds["reference"].values):
+        ref_cal, ref_cls = _reference_terms(config, ds, reference, verified)
+        cal.append(ref_cal)
+        cls.append(ref_cls)
+    like = ds["deviation"]
+    ds["reference_calibration"] = xr.concat(cal, "comparison").broadcast_like(like)
+    ds["reference_classification"] = xr.concat(cls, "comparison").broadcast_like(like)
+    ds["calibration"] = calibration.calibration_uncertainty(
+        ds["reference_calibration"], ds["reference_classification"], ds["deviation"])
+    ds["total"] = calibration.quadrature(ds["calibration"], ds["classification"])
+    ds["reference_calibration"] = ds["reference_calibration"].transpose(*like.dims)
+    ds["reference_classification"] = ds["reference_classification"].transpose(*like.dims)
+
+
+def _reference_terms(config, ds, reference, verified):
+    """(u_cal,Ref, u_class,Ref) of a reference: stated, or from its own comparison."""
+    spec = config.instruments[reference]
+    centres = ds["bin"]
+    if spec.calibration is not None:
+        stated = calibration.stated_calibration(centres.values, *spec.calibration)
+        number = spec.class_number or 0.0
+        return (xr.DataArray(stated, coords={"bin": centres}, dims="bin"),
+                xr.DataArray(classification.class_number_uncertainty(centres.values, number),
+                             coords={"bin": centres}, dims="bin"))
+    own = ds.sel(comparison=verified[reference])
+    own_cal = calibration.calibration_uncertainty(
+        *_reference_terms(config, ds, own["reference"].item(), verified), own["deviation"])
+    return own_cal.drop_vars("comparison", errors="ignore"), \
+        own["classification"].drop_vars("comparison", errors="ignore")
