@@ -1,5 +1,5 @@
 """Command line: ``uq run``, ``uq check``, ``uq plot``, ``uq report``, ``uq bench``,
-``uq fit``, ``uq --version``.
+``uq fit``, ``uq golden``, ``uq --version``.
 
 Exit status: 0 success; 2 bad input (one line naming the file, the key and what is
 allowed; no traceback; no output file); 1 anything else.
@@ -75,6 +75,12 @@ def build_parser():
                      "<name>_fit.nc); figures beside it")
     fit.add_argument("--set", action="append", default=[], metavar="fit.KEY=VALUE",
                      help="override a fit setting (dotted key, YAML value); repeatable")
+    golden = commands.add_parser("golden", help="golden-lidar verification: calibration and "
+                                 "classification uncertainty per bin (IEC 61400-12-1, LUSR), "
+                                 "KPIs and a report")
+    golden.add_argument("config", help="golden-lidar configuration (YAML with a 'golden' "
+                        "section), e.g. scenarios/golden_campaign.yaml")
+    golden.add_argument("-o", "--output", help="output folder (default results/<name>/)")
     check = commands.add_parser("check", help="validate a scenario without running it")
     check.add_argument("scenario", help="scenario YAML file")
     check.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
@@ -256,8 +262,14 @@ def _fit(args):
     return run_fit(args.input, args.config, args.output, parse_overrides(args.set))
 
 
+def _golden(args):
+    from .golden.command import run_golden
+    run_golden(args.config, args.output)
+    return EXIT_OK
+
+
 _COMMANDS = {"run": _run, "check": _check, "plot": _plot, "report": _report, "bench": _bench,
-             "fit": _fit}
+             "fit": _fit, "golden": _golden}
 
 if __name__ == "__main__":
     sys.exit(main())

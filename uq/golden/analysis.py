@@ -38,6 +38,9 @@ def analyse(config):
     ds = xr.concat(parts, dim="comparison", join="outer", coords="different",
                    compat="equals")
     ds = ds.assign_coords(comparison=list(pairs), bin=centres)
+    ds["required"] = ("bin", binning.sufficient_bins(np.zeros(len(centres)), centres,
+                                                     config.minimum_records,
+                                                     config.required)[1])
     ds["unit"] = ("comparison", [u for u, _ in config.comparisons])
     ds["reference"] = ("comparison", [r for _, r in config.comparisons])
     _chain(config, ds)
@@ -90,7 +93,7 @@ def _height_tables(config, unit, reference, centres, smc):
     sufficient, required = binning.sufficient_bins(stats["n_records"], centres,
                                                    config.minimum_records, config.required)
     data = {k: ("bin", v) for k, v in stats.items()}
-    data.update(sufficient=("bin", sufficient), required=("bin", required))
+    data["sufficient"] = ("bin", sufficient)
     terms = [calibration.deviation_terms(stats, f) for f in FRAMEWORKS]
     data["statistical"] = (("framework", "bin"), np.array([t[0] for t in terms]))
     data["mean_deviation"] = (("framework", "bin"), np.array([t[1] for t in terms]))

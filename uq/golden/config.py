@@ -22,7 +22,7 @@ HEIGHT_KEYS = ("speed", "direction", "environment")
 CLASSIFICATION_KEYS = ("variables", "significance", "ranges", "route")
 ROUTES = ("per_variable", "class_number")
 SYNTHETIC_KEYS = ("truth", "verification", "smc", "lidars", "mast", "scans_per_record",
-                  "site_separation", "direction_separation", "seed")
+                  "site_separation", "direction_separation", "outage", "seed")
 
 
 @dataclass(frozen=True)

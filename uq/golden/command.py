@@ -1,0 +1,111 @@
+"""``uq golden CONFIG.yaml [-o DIR]``: analyse a verification campaign and write its
+report, tables and figures into one folder.
+
+The folder (default ``results/<name>/``) holds ``<name>.nc`` (every table),
+``tables/per_bin.csv``, ``tables/sensitivity.csv``, ``tables/kpi.csv``, ``figures/*.png``,
+``report.html`` (self-contained) and ``report.md``; for a synthetic campaign also
+``data/`` (the generated records and their ``campaign.yaml``, the form a real campaign's
+configuration takes). Everything is written into ``.<name>.partial/`` beside it and
+renamed at the end, so a failure leaves no half-written folder.
+"""
+import shutil
+import sys
+from pathlib import Path
+
+import matplotlib
+
+from ..io import write_results
+from .analysis import analyse
+from .config import load_golden_config
+from .findings import thin_bins
+from .report import render_html, render_markdown, report_blocks
+
+PER_BIN = ("n_records", "sufficient", "reference_mean", "unit_mean", "unit_std",
+           "deviation_mean", "deviation_std", "reference_calibration",
+           "reference_classification", "statistical", "mean_deviation", "deviation",
+           "calibration", "classification_per_variable", "classification_class_number",
+           "classification", "total")
+SENSITIVITY = ("slope", "slope_intercept", "slope_standard_error", "slope_p_value",
+               "slope_r_squared", "slope_n_records", "slope_significant")
+KPI = ("speed_slope", "speed_r_squared", "speed_n_records", "speed_slope_verdict",
+       "speed_r_squared_verdict", "direction_slope", "direction_offset",
+       "direction_r_squared", "direction_n_records", "direction_slope_verdict",
+       "direction_offset_verdict", "direction_r_squared_verdict", "availability",
+       "availability_verdict", "coverage_verdict", "class_number")
+
+
+def run_golden(config_path, output=None, stream=sys.stdout, errors=sys.stderr):
+    """Analyse the campaign of `config_path` and write the folder; returns its path."""
+    config = load_golden_config(config_path)
+    folder = Path(output) if output else Path("results") / config.name
+    partial = folder.with_name(f".{folder.name}.partial")
+    shutil.rmtree(partial, ignore_errors=True)
+    try:
+        if config.synthetic is not None:
+            from .campaign import generate_campaign
+            config = load_golden_config(generate_campaign(config, partial / "data"))
+        ds = analyse(config)
+        _write(ds, partial, config.name)
+    except BaseException:
+        shutil.rmtree(partial, ignore_errors=True)
+        raise
+    shutil.rmtree(folder, ignore_errors=True)
+    partial.rename(folder)
+    for key, height, bins in thin_bins(ds):
+        print(f"uq golden: warning: {key} at {height:g} m: required bins with too few "
+              f"records: {', '.join(f'{b:g} m/s ({n})' for b, n in bins)}", file=errors)
+    print(_summary(ds), file=stream)
+    print(f"wrote {folder}/ (report.html, report.md, {config.name}.nc, tables/, figures/)",
+          file=stream)
+    return folder
+
+
+def _write(ds, folder, name):
+    from . import plots
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    (folder / "tables").mkdir(parents=True, exist_ok=True)
+    (folder / "figures").mkdir(exist_ok=True)
+    write_results(ds, folder / f"{name}.nc")
+    for table, frame in golden_tables(ds).items():
+        frame.to_csv(folder / "tables" / f"{table}.csv", float_format="%.6g")
+    height = float(ds["height"].max())
+    figures = {}
+    drawings = {"scatter": (plots.plot_scatter, "Unit against reference with the KPI "
+                            "regressions"),
+                "deviation": (plots.plot_deviation_against_environment, "Percentage "
+                              "deviation against the environmental variables"),
+                "uncertainty_terms": (plots.plot_uncertainty_terms, "Calibration-"
+                                      "uncertainty terms per bin (seed Fig. 3)")}
+    for stem, (draw, caption) in drawings.items():
+        fig = draw(ds, height)
+        path = folder / "figures" / f"{stem}.png"
+        fig.savefig(path, dpi=90)
+        plt.close(fig)
+        figures[f"{caption}, {height:g} m"] = path
+    blocks = report_blocks(ds, figures, height)
+    (folder / "report.md").write_text(render_markdown(blocks))
+    (folder / "report.html").write_text(render_html(blocks))
+
+
+def golden_tables(ds):
+    """The Dataset's tables as pandas DataFrames (long format, one row per index)."""
+    return {"per_bin": ds[list(PER_BIN)].to_dataframe(),
+            "sensitivity": ds[list(SENSITIVITY)].to_dataframe(),
+            "kpi": ds[list(KPI)].to_dataframe()}
+
+
+def _summary(ds):
+    lines = [f"{'comparison':<12}{'height':>8}{'speed slope':>13}{'R2':>9}{'dir offset':>12}"
+             f"  verdicts (speed slope, R2, dir slope, offset, R2, availability, coverage)"]
+    for k in ds["comparison"].values:
+        for h in ds["height"].values:
+            c = ds.sel(comparison=k, height=h)
+            verdicts = ", ".join(str(c[v].values) for v in (
+                "speed_slope_verdict", "speed_r_squared_verdict", "direction_slope_verdict",
+                "direction_offset_verdict", "direction_r_squared_verdict",
+                "availability_verdict", "coverage_verdict"))
+            lines.append(f"{k:<12}{h:>8g}{float(c['speed_slope']):>13.4f}"
+                         f"{float(c['speed_r_squared']):>9.4f}"
+                         f"{float(c['direction_offset']):>12.2f}  {verdicts}")
+    return "\n".join(lines)
