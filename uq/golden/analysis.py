@@ -44,7 +44,8 @@ def analyse(config):
     ds["unit"] = ("comparison", [u for u, _ in config.comparisons])
     ds["reference"] = ("comparison", [r for _, r in config.comparisons])
     _chain(config, ds)
-    ds.attrs.update(name=config.name, description=config.description,
+    _annotate(ds)
+    ds.attrs.update(Conventions="CF-1.10", name=config.name, description=config.description,
                     significance=config.significance, route=config.route,
                     bin_width=config.bin_width, required_low=config.required[0],
                     required_high=config.required[1], minimum_records=config.minimum_records,
@@ -220,3 +221,70 @@ def _reference_terms(config, ds, reference, verified):
         *_reference_terms(config, ds, own["reference"].item(), verified), own["deviation"])
     return own_cal.drop_vars("comparison", errors="ignore"), \
         own["classification"].drop_vars("comparison", errors="ignore")
+
+
+#: units and long names of the result variables (verdicts and flags are dimensionless).
+METADATA = {
+    "height": ("m", "measurement height above sea level"),
+    "bin": ("m s-1", "centre of the reference-wind-speed bin"),
+    "n_records": ("1", "paired 10-min records in the bin"),
+    "sufficient": ("1", "the bin holds the minimum number of records"),
+    "required": ("1", "the bin is in the required range"),
+    "reference_mean": ("m s-1", "mean reference wind speed in the bin"),
+    "unit_mean": ("m s-1", "mean wind speed of the unit in the bin"),
+    "unit_std": ("m s-1", "standard deviation of the unit's wind speed in the bin"),
+    "deviation_mean": ("m s-1", "mean deviation unit minus reference (Delta v)"),
+    "deviation_std": ("m s-1", "standard deviation of the deviations"),
+    "statistical": ("m s-1", "sigma/sqrt(N) term of Eq. 3 (sigma_FLS for IEC, sigma_dev "
+                    "for LUSR)"),
+    "mean_deviation": ("m s-1", "|Delta v| term of Eq. 3 (IEC; zero for LUSR)"),
+    "deviation": ("m s-1", "deviation term u_dev (Eq. 3)"),
+    "reference_calibration": ("m s-1", "calibration uncertainty of the reference"),
+    "reference_classification": ("m s-1", "classification uncertainty of the reference"),
+    "calibration": ("m s-1", "calibration uncertainty of the unit against the reference "
+                    "(Eq. 2)"),
+    "classification_per_variable": ("m s-1", "classification uncertainty of the unit, "
+                                    "Eq. 1 for the SMC"),
+    "classification_class_number": ("m s-1", "classification uncertainty of the unit, "
+                                    "class number / sqrt(3) %"),
+    "classification": ("m s-1", "classification uncertainty of the unit (chosen route)"),
+    "total": ("m s-1", "calibration and classification uncertainty of the unit"),
+    "verification_mean": ("1", "bin mean of the variable in the verification campaign "
+                          "(units of the variable)"),
+    "smc_mean": ("1", "bin mean of the variable in the SMC (units of the variable)"),
+    "smc_n_records": ("1", "SMC records in the bin"),
+    "slope": ("percent", "sensitivity slope of the percentage deviation (per unit of the "
+              "variable)"),
+    "slope_intercept": ("percent", "intercept of the sensitivity regression"),
+    "slope_standard_error": ("percent", "standard error of the sensitivity slope"),
+    "slope_p_value": ("1", "two-sided p-value of the slope (t-test of zero slope)"),
+    "slope_r_squared": ("1", "R^2 of the sensitivity regression"),
+    "slope_n_records": ("1", "records in the sensitivity regression"),
+    "slope_significant": ("1", "slope significant at the configured level"),
+    "class_number": ("percent", "class number from the slopes and the variables' ranges"),
+    "speed_slope": ("1", "wind-speed regression slope through the origin"),
+    "speed_r_squared": ("1", "R^2 of the wind-speed regression"),
+    "speed_n_records": ("1", "records in the wind-speed regression"),
+    "direction_slope": ("1", "wind-direction regression slope"),
+    "direction_offset": ("degree", "wind-direction regression offset"),
+    "direction_r_squared": ("1", "R^2 of the wind-direction regression"),
+    "direction_n_records": ("1", "records in the wind-direction regression"),
+    "availability": ("1", "fraction of 10-min periods with a valid unit record"),
+    "records_only_unit": ("1", "timestamps of the unit without a reference record"),
+    "records_only_reference": ("1", "timestamps of the reference without a unit record"),
+    "paired_reference_speed": ("m s-1", "reference wind speed of the paired records"),
+    "paired_unit_speed": ("m s-1", "unit wind speed of the paired records"),
+    "paired_reference_direction": ("degree", "reference wind direction (from, clockwise "
+                                   "from north)"),
+    "paired_unit_direction": ("degree", "unit wind direction (from, clockwise from north)"),
+    "paired_environment": ("1", "environmental variables of the reference (their units)"),
+}
+
+
+def _annotate(ds):
+    for name, (units, long_name) in METADATA.items():
+        if name in ds.variables:
+            ds[name].attrs.update(units=units, long_name=long_name)
+    for name in ds.data_vars:
+        if name.endswith("_verdict") or name in ("unit", "reference"):
+            ds[name].attrs.update(units="1", long_name=name.replace("_", " "))

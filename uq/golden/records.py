@@ -11,6 +11,8 @@ missing file or column, unreadable or repeated timestamps, records not 10 min ap
 negative speeds or speeds that look like km/h or knots, directions outside [-360, 360] or
 that look like radians.
 """
+import warnings
+
 import numpy as np
 import pandas as pd
 import xarray as xr
@@ -41,7 +43,9 @@ def read_table(instrument):
     if instrument.time not in table.columns:
         raise ScenarioError(source, key, f"no column {instrument.time!r}; allowed: "
                             f"{_listing(table.columns)}")
-    time = pd.to_datetime(table[instrument.time], errors="coerce")
+    with warnings.catch_warnings():      # pandas warns when it parses element by element
+        warnings.simplefilter("ignore", UserWarning)
+        time = pd.to_datetime(table[instrument.time], errors="coerce")
     if time.isna().any():
         row = int(np.flatnonzero(time.isna())[0])
         raise ScenarioError(source, key, f"timestamp {table[instrument.time].iloc[row]!r} "
