@@ -167,3 +167,32 @@ def test_unknown_variable_and_missing_smc(tmp_path):
     _error(tmp_path, "'wave_height' is not an environmental variable of flsa; allowed: shear",
            classification={"variables": ["wave_height"], "route": "class_number"})
     _error(tmp_path, "golden.smc: missing", classification={"variables": ["shear"]})
+
+
+def test_per_variable_route_with_an_smc(tmp_path):
+    """Eq. 1 through the analysis: the SMC sees the same speeds with shear 0.1 higher in
+    every bin, FLSb's slope is -5 %/unit, so u_class,FLSb = v_i |-5 x 0.1| / 100."""
+    path = write_campaign(tmp_path, classification={"variables": ["shear"]},
+                          smc={"file": "smc.csv", "time": "time", "heights": {
+                              80: {"speed": "v80"}}, "environment": {"shear": "shear"}})
+    times = pd.date_range("2024-03-01", periods=6, freq="10min")
+    pd.DataFrame({"time": times, "v80": MAST, "shear": SHEAR + 0.1}).to_csv(
+        tmp_path / "smc.csv", index=False)
+    ds = analyse(load_golden_config(path))
+    flsb = ds.sel(comparison="flsb-mast", height=80.0, bin=[4.0, 4.5, 5.0])
+    np.testing.assert_allclose(flsb["classification"], [0.02, 0.0225, 0.025], rtol=1e-9)
+    chained = ds.sel(comparison="flsa-flsb", height=80.0, bin=[4.0, 4.5, 5.0],
+                     framework="lusr")["reference_classification"]
+    np.testing.assert_allclose(chained, [0.02, 0.0225, 0.025], rtol=1e-9)
+
+
+def test_netcdf_records_read_like_csv(tmp_path, six):
+    """An instrument's records may be netCDF (a time coordinate and one variable per
+    column); the result is the same as from CSV."""
+    path = write_campaign(tmp_path)
+    frame = pd.read_csv(tmp_path / "mast.csv", parse_dates=["time"]).set_index("time")
+    frame.to_xarray().to_netcdf(tmp_path / "mast.nc")
+    text = path.read_text().replace("file: mast.csv", "file: mast.nc")
+    path.write_text(text)
+    ds = analyse(load_golden_config(path))
+    np.testing.assert_allclose(ds["calibration"], six["calibration"], rtol=1e-12)
