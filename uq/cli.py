@@ -81,7 +81,8 @@ def build_parser():
     golden.add_argument("config", help="golden-lidar configuration (YAML with a 'golden' "
                         "section), e.g. scenarios/golden_campaign.yaml")
     golden.add_argument("-o", "--output", help="output folder (default results/<name>/)")
-    check = commands.add_parser("check", help="validate a scenario without running it")
+    check = commands.add_parser("check", help="validate a scenario (or a golden-lidar "
+                                "configuration) without running it")
     check.add_argument("scenario", help="scenario YAML file")
     check.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     return parser
@@ -122,7 +123,15 @@ def main(argv=None):
 
 
 def _check(args):
-    from .scenario import load_scenario
+    from .scenario import load_scenario, read_yaml
+    raw = read_yaml(Path(args.scenario))
+    if isinstance(raw, dict) and "golden" in raw:
+        from .golden.config import load_golden_config
+        config = load_golden_config(args.scenario)
+        what = "synthetic campaign" if config.synthetic else \
+            f"{len(config.comparisons)} comparison(s)"
+        print(f"{args.scenario}: ok (golden-lidar configuration {config.name}: {what})")
+        return EXIT_OK
     scenario = load_scenario(args.scenario, parse_overrides(args.set))
     scenes = 1
     for _, values in scenario.sweep:
