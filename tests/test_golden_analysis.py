@@ -196,3 +196,13 @@ def test_netcdf_records_read_like_csv(tmp_path, six):
     path.write_text(text)
     ds = analyse(load_golden_config(path))
     np.testing.assert_allclose(ds["calibration"], six["calibration"], rtol=1e-12)
+
+
+def test_direction_out_of_range(tmp_path):
+    path = write_campaign(tmp_path)
+    frame = pd.read_csv(tmp_path / "flsb.csv")
+    frame.loc[3, "d80"] = 400.0
+    frame.to_csv(tmp_path / "flsb.csv", index=False)
+    with pytest.raises(ScenarioError, match=r"direction 400 is out of range; allowed: "
+                                            r"degrees in \[-360, 360\]"):
+        analyse(load_golden_config(path))

@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from uq.golden.kpi import (BEST, FAIL, MINIMUM, NO_DATA, band_verdict, coverage_verdict,
+from uq.golden.kpi import (BEST, FAIL, MINIMUM, NO_DATA, at_least_verdict, band_verdict,
+                           coverage_verdict,
                            direction_kpis, direction_regression, lower_bound_verdict,
                            slope_through_origin, unwrap_to_reference, upper_bound_verdict)
 
@@ -48,6 +49,9 @@ def test_verdict_bounds():
     assert upper_bound_verdict(-4.9, (5.0, 10.0)) == BEST
     assert upper_bound_verdict(5.0, (5.0, 10.0)) == MINIMUM     # "< 5": strict
     assert upper_bound_verdict(12.0, (5.0, 10.0)) == FAIL
+    assert at_least_verdict(0.90, (0.90, 0.85)) == BEST         # "at least": inclusive
+    assert at_least_verdict(0.86, (0.90, 0.85)) == MINIMUM
+    assert at_least_verdict(0.80, (0.90, 0.85)) == FAIL
 
 
 def test_coverage_verdict():

@@ -98,8 +98,13 @@ def _height_tables(config, unit, reference, centres, smc):
     terms = [calibration.deviation_terms(stats, f) for f in FRAMEWORKS]
     data["statistical"] = (("framework", "bin"), np.array([t[0] for t in terms]))
     data["mean_deviation"] = (("framework", "bin"), np.array([t[1] for t in terms]))
-    data.update(_sensitivities(config, unit, reference))
-    data.update(_classification(config, centres, unit, reference, smc, data))
+    fits = _sensitivities(config, unit, reference)
+    data.update({SENSITIVITY_NAMES[name]: ("variable", np.array([getattr(f, name)
+                                                                 for f in fits]))
+                 for name in SENSITIVITY_NAMES} if fits else {})
+    # only significant slopes enter Eq. 1 and the class number (seed: "sensitive variables")
+    slopes = np.array([f.slope if f.significant else 0.0 for f in fits])
+    data.update(_classification(config, centres, reference, smc, slopes))
     data.update(_kpis(config, unit, reference, sufficient, required))
     data.update(_paired(config, unit, reference))
     return xr.Dataset(data, coords={"framework": list(FRAMEWORKS),
@@ -112,13 +117,13 @@ def _in_required_range(config, speed):
 
 
 def _sensitivities(config, unit, reference):
+    """:class:`uq.golden.classification.Sensitivity` per variable, over the records with
+    the reference speed in the required bins."""
     ref_speed = reference["speed"].values
     deviation = classification.percentage_deviation(unit["speed"].values, ref_speed)
     deviation = np.where(_in_required_range(config, ref_speed), deviation, np.nan)
-    fits = [classification.sensitivity(reference[v].values, deviation, config.significance)
+    return [classification.sensitivity(reference[v].values, deviation, config.significance)
             for v in config.variables]
-    return {SENSITIVITY_NAMES[name]: ("variable", np.array([getattr(f, name) for f in fits]))
-            for name in SENSITIVITY_NAMES} if fits else {}
 
 
 def _bin_means(values, speed, centres, width):
@@ -129,10 +134,8 @@ def _bin_means(values, speed, centres, width):
         values[index == k])) else np.nan for k in keys])
 
 
-def _classification(config, centres, unit, reference, smc, data):
+def _classification(config, centres, reference, smc, slopes):
     """The unit's classification uncertainty by both routes (NaN where not possible)."""
-    slopes = np.where(data["slope_significant"][1], data["slope"][1], 0.0) if config.variables \
-        else np.zeros(0)
     out = {}
     ver = np.array([_bin_means(reference[v].values, reference["speed"].values, centres,
                                config.bin_width) for v in config.variables])
@@ -160,19 +163,20 @@ def _classification(config, centres, unit, reference, smc, data):
 
 
 def _kpis(config, unit, reference, sufficient, required):
+    """KPIs and verdicts; availability over the reference's span of 10-min periods."""
     values = {**kpi.speed_kpis(reference["speed"].values, unit["speed"].values),
               **kpi.direction_kpis(reference["direction"].values, unit["direction"].values)}
     times = reference["time"].values
     expected = int((times.max() - times.min()) / RECORD_PERIOD) + 1 if len(times) else 0
     available = kpi.availability(np.sum(np.isfinite(unit["speed"].values)), expected)
     values.update(availability=available,
-                  availability_verdict=kpi.lower_bound_verdict(
-                      available + 1e-12, config.availability),
+                  availability_verdict=kpi.at_least_verdict(available, config.availability),
                   coverage_verdict=kpi.coverage_verdict(sufficient, required))
     return values
 
 
 def _paired(config, unit, reference):
+    """The paired records (for the figures of a finished Dataset)."""
     data = {"paired_reference_speed": ("time", reference["speed"].values),
             "paired_unit_speed": ("time", unit["speed"].values),
             "paired_reference_direction": ("time", reference["direction"].values),
@@ -180,8 +184,7 @@ def _paired(config, unit, reference):
     if config.variables:
         data["paired_environment"] = (("variable", "time"), np.array(
             [reference[v].values for v in config.variables]))
-    return {k: xr.Variable(dims, v) for k, (dims, v) in data.items()} | {
-        "time": ("time", reference["time"].values)}
+    return data | {"time": ("time", reference["time"].values)}
 
 
 def _chain(config, ds):

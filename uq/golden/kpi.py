@@ -12,7 +12,10 @@ RP 18) and their verdicts.
   +-180 deg of the reference's (350 and 10 deg differ by 20, not 340), so the pair lies
   near the line y = x across north.
 * Coverage: every required bin (4-16 m/s) holds enough records; availability is the
-  fraction of the campaign's 10-min periods with a valid record of the unit.
+  fraction of the campaign's 10-min periods with a valid record of the unit, at least
+  (inclusive) the configured bounds.
+
+The regressions use every paired record with both values finite (no speed filter).
 
 Verdict per KPI: ``best practice`` inside the best-practice bound, ``minimum`` inside the
 minimum bound only, ``fail`` otherwise, ``no data`` when it cannot be computed.
@@ -68,6 +71,14 @@ def lower_bound_verdict(value, bounds):
     if not np.isfinite(value):
         return NO_DATA
     return BEST if value > bounds[0] else MINIMUM if value > bounds[1] else FAIL
+
+
+def at_least_verdict(value, bounds):
+    """Verdict of a value that must reach (best, minimum), bounds inclusive
+    (availability "at least 90 %")."""
+    if not np.isfinite(value):
+        return NO_DATA
+    return BEST if value >= bounds[0] else MINIMUM if value >= bounds[1] else FAIL
 
 
 def upper_bound_verdict(value, bounds):

@@ -148,8 +148,9 @@ def _check_speed(speed, source, key):
 
 def _checked_direction(direction, source, key):
     finite = direction[np.isfinite(direction)]
-    if finite.size and (finite.min() < -FULL_CIRCLE_DEG or finite.max() > FULL_CIRCLE_DEG):
-        raise ScenarioError(source, key, f"direction {finite.max():g} is out of range; "
+    outside = finite[np.abs(finite) > FULL_CIRCLE_DEG]
+    if outside.size:
+        raise ScenarioError(source, key, f"direction {outside[0]:g} is out of range; "
                             "allowed: degrees in [-360, 360]")
     if finite.size > 1 and finite.min() >= 0 and finite.max() <= 2 * np.pi \
             and np.ptp(finite) > RADIAN_SPREAD:
