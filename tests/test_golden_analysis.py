@@ -206,3 +206,23 @@ def test_direction_out_of_range(tmp_path):
     with pytest.raises(ScenarioError, match=r"direction 400 is out of range; allowed: "
                                             r"degrees in \[-360, 360\]"):
         analyse(load_golden_config(path))
+
+
+def test_timestamps_only_in_one_instrument_are_counted(tmp_path):
+    path = write_campaign(tmp_path)
+    frame = pd.read_csv(tmp_path / "flsa.csv")
+    extra = frame.iloc[[-1]].assign(time="2024-01-01 01:00:00")
+    pd.concat([frame, extra]).to_csv(tmp_path / "flsa.csv", index=False)
+    ds = analyse(load_golden_config(path))
+    assert int(ds["records_only_unit"].sel(comparison="flsa-flsb").max()) == 1
+    assert int(ds["records_only_reference"].sel(comparison="flsa-flsb").max()) == 0
+
+
+def test_thin_bins_are_named_on_stderr(tmp_path, capsys):
+    from uq.cli import main
+    path = write_campaign(tmp_path, bins={"required": [4.0, 5.5], "minimum_records": 2})
+    assert main(["golden", str(path), "-o", str(tmp_path / "out")]) == 0
+    err = capsys.readouterr().err
+    assert "uq golden: warning: flsb-mast at 80 m: required bins with too few records: " \
+           "5.5 m/s (0)" in err
+    assert "5.5 m/s (0)" in (tmp_path / "out" / "report.md").read_text()

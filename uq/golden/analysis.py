@@ -33,7 +33,8 @@ def analyse(config):
     _check_variables(config, records, smc)
     pairs = {f"{u}-{r}": align(records[u], records[r]) for u, r in config.comparisons}
     top = max(float(np.nanmax(ref["speed"].values)) for _, ref, _ in pairs.values())
-    centres = binning.bin_centres(0.0, top, config.bin_width)
+    # the grid covers the data and the required range (an empty required bin is flagged)
+    centres = binning.bin_centres(0.0, max(top, config.required[1]), config.bin_width)
     parts = [_comparison(config, key, *pairs[key], centres, smc) for key in pairs]
     ds = xr.concat(parts, dim="comparison", join="outer", coords="different",
                    compat="equals")

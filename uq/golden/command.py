@@ -34,8 +34,10 @@ KPI = ("speed_slope", "speed_r_squared", "speed_n_records", "speed_slope_verdict
        "availability_verdict", "coverage_verdict", "class_number")
 
 
-def run_golden(config_path, output=None, stream=sys.stdout, errors=sys.stderr):
-    """Analyse the campaign of `config_path` and write the folder; returns its path."""
+def run_golden(config_path, output=None, stream=None, errors=None):
+    """Analyse the campaign of `config_path` and write the folder; returns its path.
+    The summary goes to `stream` (default stdout), warnings to `errors` (stderr)."""
+    stream, errors = stream or sys.stdout, errors or sys.stderr
     config = load_golden_config(config_path)
     folder = Path(output) if output else Path("results") / config.name
     partial = folder.with_name(f".{folder.name}.partial")
