@@ -49,7 +49,7 @@ def _scatter_direction(ax, c):
     slope, offset = float(c["direction_slope"]), float(c["direction_offset"])
     ax.plot([0, 360], [0, 360], "k:", lw=1)
     ax.plot([0, 360], [offset, offset + 360 * slope], "r-", lw=1.2,
-            label=f"y = {slope:.4f} x + {offset:.2f}°, R² = "
+            label=f"y = {slope:.4f} x {offset:+.2f}°, R² = "
             f"{float(c['direction_r_squared']):.4f}")
     ax.set(xlabel=f"{_name(c, 'reference')} [deg]", ylabel=f"{_name(c, 'unit')} [deg]",
            xlim=(0, 360))
