@@ -84,3 +84,7 @@ KPI_DIRECTION_R2 = (0.97, 0.95)
 #: post-processed data availability. Configurable (``golden.kpi.availability``): check it
 #: against the roadmap version a report is written to.
 KPI_AVAILABILITY = (0.90, 0.85)
+
+#: Fraction of the numerical tolerance delta to which Monte Carlo results are taken when
+#: they validate the GUM [1]: JCGM 101:2008, 8.2 (results for validation to delta / 5).
+VALIDATION_TOLERANCE_FRACTION = 0.2

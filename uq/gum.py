@@ -127,6 +127,18 @@ def numerical_tolerance(u, digits):
     return np.where(u > 0, 0.5 * 10.0**exponent, np.where(u == 0, 0.0, np.nan))
 
 
+def endpoint_differences(estimate, u, low, high, circular=False,
+                         probability=COVERAGE_PROBABILITY):
+    """GUM minus Monte Carlo interval endpoints, (d_low, d_high) (JCGM 101, 8.2);
+    circular outputs modulo 360 deg into [-180, 180)."""
+    k = ndtri((1 + probability) / 2)
+    d_low = estimate - k * u - low
+    d_high = estimate + k * u - high
+    if circular:
+        d_low, d_high = unwrap(d_low, 0.0), unwrap(d_high, 0.0)
+    return d_low, d_high
+
+
 def gum_interval_valid(estimate, u, low, high, digits, circular=False,
                        probability=COVERAGE_PROBABILITY):
     """JCGM 101, clause 8: is the GUM interval y +- k u within delta of Monte Carlo's?
@@ -135,11 +147,7 @@ def gum_interval_valid(estimate, u, low, high, digits, circular=False,
     differences must not exceed the numerical tolerance of u at `digits` digits.
     Circular outputs compare angles modulo 360 deg. NaN anywhere gives False.
     """
-    k = ndtri((1 + probability) / 2)
-    d_low = estimate - k * u - low
-    d_high = estimate + k * u - high
-    if circular:
-        d_low, d_high = unwrap(d_low, 0.0), unwrap(d_high, 0.0)
+    d_low, d_high = endpoint_differences(estimate, u, low, high, circular, probability)
     delta = numerical_tolerance(u, digits)
     with np.errstate(invalid="ignore"):
         return (np.abs(d_low) <= delta) & (np.abs(d_high) <= delta)

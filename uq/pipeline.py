@@ -23,6 +23,7 @@ from .rubio2022 import rubio2022_scene_uncertainty
 from .sampling import new_seed
 from .scenario import INS_KEYS, LIDAR_ERROR_KEYS, load_scenario
 from .statistics import unwrap
+from .stopping import STOPPED_BY
 from .sweep import batch_scene, group_assignments, sweep_plan, vector_fields
 
 
@@ -147,6 +148,7 @@ def run_scene(scenario, scene, seed):
                        interval=sampling["interval"], chunk_size=sampling.get("chunk_size"),
                        control_variate=sampling["control_variate"],
                        stopping=sampling["stopping"],
+                       stop_when_gum_valid=sampling["stop_when_gum_valid"],
                        covariance=profile_covariances(outputs, n_gates))
     return _scene_dataset(scene, settings, outputs, engine)
 
@@ -187,6 +189,8 @@ def _scene_dataset(scene, settings, outputs, engine):
         azimuths = list(np.rad2deg(scene.azimuths)) + [np.nan] * int(scene.vertical_beam)
         ds = ds.assign_coords(beam=azimuths)
     ds["mc_n_samples"] = ("scene", np.full(scene.shape, engine.attrs["n_samples"]))
+    ds["mc_stopped_by"] = ("scene", np.full(scene.shape, STOPPED_BY.index(
+        engine.attrs["stopped_by"]), dtype=np.int8))
     return ds
 
 
@@ -240,6 +244,10 @@ def _annotate(ds, scenario):
         if quantity:
             ds[name].attrs.update(variable_attributes(quantity, name[len(quantity) + 1:]))
     ds["mc_n_samples"].attrs.update(units="1", long_name="Monte Carlo trials used")
+    ds["mc_stopped_by"].attrs.update(  # a CF flag variable (CF 1.10, 3.5)
+        units="1", long_name="what stopped Monte Carlo sampling",
+        flag_values=np.arange(len(STOPPED_BY), dtype=np.int8),
+        flag_meanings=" ".join(name.replace(" ", "_") for name in STOPPED_BY))
     for name, attrs in COORDINATES.items():
         if name in ds.coords:
             ds[name].attrs.update(attrs)

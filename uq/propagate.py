@@ -14,11 +14,12 @@ import xarray as xr
 
 from . import controlvariate, gum
 from .constants import (ADAPTIVE_MAX_SAMPLES, BATCH_SIZE, COVERAGE_PROBABILITY,
+                        VALIDATION_TOLERANCE_FRACTION,
                         DEFAULT_BLOCKS_PER_CHUNK, DEFAULT_DIGITS, FULL_CIRCLE_DEG,
                         RNG_BLOCK_SIZE)
 from .inputs import input_set
 from .sampling import PROPAGATION_METHODS, new_seed, normal_scores
-from .stopping import STOPPING_RULES, may_stop
+from .stopping import STOPPING_RULES, gum_validated, may_stop
 from .statistics import (INTERVALS, CoMoments, Moments, StreamingStatistics, batch_statistics,
                          tail_capacity)
 
@@ -27,7 +28,8 @@ _BATCH_KEYS = ("mean", "u", "low", "high")
 
 def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
               correlation=None, circular=(), output_dims=None, interval="symmetric",
-              chunk_size=None, control_variate=False, stopping="jcgm101", covariance=()):
+              chunk_size=None, control_variate=False, stopping="jcgm101", covariance=(),
+              stop_when_gum_valid=False):
     """Propagate input distributions through `model` by Monte Carlo and by the GUM.
 
     Parameters
@@ -63,6 +65,13 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     stopping : {"jcgm101", "confident"}
         Stopping rule of adaptive sampling (:mod:`uq.stopping`): JCGM 101 7.9, or a
         rule that stops too early with probability at most 5 %.
+    stop_when_gum_valid : bool
+        Adaptive sampling for validating the GUM: Monte Carlo runs to a fifth of the
+        tolerance of `digits` (JCGM 101 8.2), but stops as soon as the clause 8
+        validation of every output's GUM interval is decided in its favour despite the
+        Monte Carlo noise (:func:`uq.stopping.gum_validated`); a scene whose GUM fails
+        gets the full precision. The attribute ``stopped_by`` says which rule stopped
+        the run (``digits``, ``gum validated``, ``sample limit``, ``fixed n``).
     control_variate : bool
         Use the GUM linearisation as a control variate for the mean and u
         (:mod:`uq.controlvariate`); the coverage interval stays plain Monte Carlo.
@@ -88,6 +97,8 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         ``q_mc_circular_std``.
     """
     _check_arguments(n, digits, method, interval, stopping)
+    if stop_when_gum_valid and n is not None:
+        raise ValueError("stop_when_gum_valid needs adaptive sampling (digits), not a fixed n")
     seed = _entropy(seed)
     inputs_laid = input_set(inputs, correlation)
     circular = set(circular)
@@ -112,7 +123,11 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     if method != "none" and n is not None:
         runner.run_fixed(int(n))
     elif method != "none":
-        runner.run_adaptive(digits or DEFAULT_DIGITS, stopping)
+        targets = None
+        if stop_when_gum_valid and not gum_note.startswith("no GUM"):
+            targets = {q: (gum_value[q], gum.combined_uncertainty(jacobian[q], inputs_laid),
+                           q in circular) for q in gum_value}
+        runner.run_adaptive(digits or DEFAULT_DIGITS, stopping, targets)
     validation_digits = digits or DEFAULT_DIGITS
     dataset = _gum_dataset(gum_value, jacobian, inputs_laid, output_dims or {})
     dataset = dataset.assign(_gum_covariances(jacobian, inputs_laid, dataset, covariance))
@@ -123,7 +138,8 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
                          digits=validation_digits, interval=interval,
                          coverage_probability=COVERAGE_PROBABILITY, gum=gum_note,
                          control_variate=int(bool(runner.control)),
-                         stopping_rule=stopping if n is None and method != "none" else "fixed n")
+                         stopping_rule=stopping if n is None and method != "none" else "fixed n",
+                         stopped_by=runner.stopped_by)
     return dataset
 
 
@@ -184,6 +200,7 @@ class _Runner:
         # independent batches: within an lhs or sobol block the points are not independent
         self.batch_size = BATCH_SIZE if method == "mc" else RNG_BLOCK_SIZE
         self.stats, self.batches, self.n_done = None, {}, 0
+        self.stopped_by = "fixed n"
         self.control, self.linear = None, {}
         self.covariance, self.comoments = tuple(covariance), {}
 
@@ -267,9 +284,11 @@ class _Runner:
                             {q: v.shape[1:] for q, v in outputs.items()})
             self._accumulate(outputs, linear)
 
-    def run_adaptive(self, digits, stopping="jcgm101"):
+    def run_adaptive(self, digits, stopping="jcgm101", gum_targets=None):
         """JCGM 101:2008, 7.9.4: batches of M >= 10^4 trials, one RNG block per step, until
-        the stopping rule (:mod:`uq.stopping`) is met or ADAPTIVE_MAX_SAMPLES is reached."""
+        the stopping rule (:mod:`uq.stopping`) is met, the GUM is validated (with
+        `gum_targets`: output -> (GUM value, GUM u, circular)) or ADAPTIVE_MAX_SAMPLES is
+        reached."""
         block = 0
         while True:
             outputs, linear = self._evaluate(block, 1, RNG_BLOCK_SIZE)
@@ -278,14 +297,37 @@ class _Runner:
                             {q: v.shape[1:] for q, v in outputs.items()})
             self._accumulate(outputs, linear)
             block += 1
-            if self._stable(digits, stopping, check=block) \
-                    or self.n_done + RNG_BLOCK_SIZE > ADAPTIVE_MAX_SAMPLES:
-                return
+            # validating the GUM: Monte Carlo to delta/5 (JCGM 101 8.2), unless the GUM
+            # is validated beyond the noise first
+            fraction = VALIDATION_TOLERANCE_FRACTION if gum_targets else 1.0
+            if self._stable(digits, stopping, check=block, fraction=fraction):
+                self.stopped_by = "digits"
+            elif gum_targets and self._gum_decided(gum_targets, digits, stopping, block):
+                self.stopped_by = "gum validated"
+            elif self.n_done + RNG_BLOCK_SIZE > ADAPTIVE_MAX_SAMPLES:
+                self.stopped_by = "sample limit"
+            else:
+                continue
+            return
 
-    def _stable(self, digits, stopping, check):
-        """Every output's mean, u and endpoints stable to `digits` under the rule."""
+    def _gum_decided(self, targets, digits, stopping, check):
+        """Every output's GUM interval validated beyond the Monte Carlo noise."""
+        for q, (value, u, circular) in targets.items():
+            result = self.result(q)
+            differences = gum.endpoint_differences(value, u, result["low"], result["high"],
+                                                   circular)
+            endpoints = tuple(np.array(self.batches[q][key]) for key in ("low", "high"))
+            if not gum_validated(stopping, differences, endpoints,
+                                 gum.numerical_tolerance(u, digits), check):
+                return False
+        return True
+
+    def _stable(self, digits, stopping, check, fraction=1.0):
+        """Every output's mean, u and endpoints stable to `fraction` of the tolerance of
+        `digits` under the rule."""
         return all(may_stop(stopping, [np.array(self.batches[q][key]) for key in _BATCH_KEYS],
-                            gum.numerical_tolerance(self.result(q)["u"], digits), check)
+                            fraction * gum.numerical_tolerance(self.result(q)["u"], digits),
+                            check)
                    for q in self.stats)
 
     def numerical_error(self, q):

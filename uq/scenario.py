@@ -283,7 +283,7 @@ def _lidar(check, value):
 
 def _sampling(check, value):
     allowed = ("method", "n", "digits", "seed", "control_variate", "interval", "chunk_size",
-               "stopping")
+               "stopping", "stop_when_gum_valid")
     value = {} if value is None else value
     check.mapping(value, "sampling")
     check.keys(value, "sampling", allowed)
@@ -302,6 +302,11 @@ def _sampling(check, value):
     out["seed"] = None if s["seed"] is None else check.integer(s["seed"], "sampling.seed", low=0)
     if "chunk_size" in value:
         out["chunk_size"] = check.integer(value["chunk_size"], "sampling.chunk_size", low=1)
+    out["stop_when_gum_valid"] = check.boolean(value.get("stop_when_gum_valid", False),
+                                               "sampling.stop_when_gum_valid")
+    if out["stop_when_gum_valid"] and "digits" not in out:
+        check.fail("sampling.stop_when_gum_valid", "needs adaptive sampling; allowed: with "
+                   "sampling.digits, not sampling.n")
     return out
 
 

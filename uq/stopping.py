@@ -17,14 +17,25 @@ endpoints) after every step and compare twice the standard deviation of their av
     2 sigma_y exceeds delta is at most 5 % (for batch values close to normal, which
     batches of >= 10^4 trials are). The price is a few more batches than 7.9 needs.
 
+**GUM validated** (this project, ``stop_when_gum_valid``). Sampling to the requested
+digits only to confirm the GUM wastes trials when the GUM is plainly right. JCGM 101
+clause 8 validates the GUM interval when both endpoint differences |d| <= delta. Here a
+run may stop as soon as that verdict is *decided despite the Monte Carlo noise*:
+``|d| + 2 f s_e <= delta`` for both endpoints e, with s_e the standard error of the
+endpoint from its batch values and f the same upper confidence factor as ``confident``
+(f = 1 under ``jcgm101``). The reported Monte Carlo results then carry their (larger)
+numerical error, which the result records; the GUM result is the one to use.
+
 References
 ----------
-.. [1] JCGM 101:2008, 7.9 (adaptive Monte Carlo procedure).
+.. [1] JCGM 101:2008, 7.9 (adaptive Monte Carlo procedure), 8 (validation).
 """
 import numpy as np
 from scipy.stats import chi2
 
 STOPPING_RULES = ("jcgm101", "confident")
+#: What may end a Monte Carlo run; its index is the CF flag value of ``mc_stopped_by``.
+STOPPED_BY = ("digits", "gum validated", "sample limit", "fixed n")
 #: Overall probability of stopping too early under ``confident`` [1].
 CONFIDENT_ALPHA = 0.05
 #: Fewest batches before ``confident`` may stop: below ~8 the chi-square bound on s is
@@ -45,6 +56,33 @@ def upper_bound_factor(h, check):
     return np.sqrt((h - 1) / chi2.ppf(alpha, h - 1))
 
 
+def _factor(rule, h, check):
+    """None when the rule may not stop yet with h batches, else its factor on 2 s."""
+    if h < 2 or (rule == "confident" and h < CONFIDENT_MIN_BATCHES):
+        return None
+    return 1.0 if rule == "jcgm101" else upper_bound_factor(h, check)
+
+
+def gum_validated(rule, differences, endpoint_batches, delta, check):
+    """Is the clause-8 validation of the GUM decided in its favour despite the noise?
+
+    Parameters
+    ----------
+    differences : tuple of ndarray
+        (d_low, d_high), GUM minus Monte Carlo endpoints, each of the output's shape.
+    endpoint_batches : tuple of ndarray
+        Batch values of the low and high endpoints, each of shape (h, *shape).
+    delta : ndarray
+        Numerical tolerance of the GUM u at the requested digits.
+    """
+    factor = _factor(rule, len(endpoint_batches[0]), check)
+    if factor is None:
+        return False
+    with np.errstate(invalid="ignore"):
+        return bool(all(np.all(np.abs(d) + 2 * factor * standard_error(b) <= delta)
+                        for d, b in zip(differences, endpoint_batches)))
+
+
 def may_stop(rule, batches, delta, check):
     """Is 2 s_y (or its upper bound) <= delta for every batch quantity and element?
 
@@ -58,9 +96,8 @@ def may_stop(rule, batches, delta, check):
     check : int
         How many times the rule has been applied in this run, this one included.
     """
-    h = len(batches[0])
-    if h < 2 or (rule == "confident" and h < CONFIDENT_MIN_BATCHES):
+    factor = _factor(rule, len(batches[0]), check)
+    if factor is None:
         return False
-    factor = 1.0 if rule == "jcgm101" else upper_bound_factor(h, check)
     error = np.max([2 * factor * standard_error(values) for values in batches], axis=0)
     return bool(np.all(error <= delta))
