@@ -77,6 +77,19 @@ def test_inverse_cdf_sampling_reproduces_each_distribution(dist):
         assert abs(float(ds[name]) - q) < K * np.sqrt(p * (1 - p) / N) / dist.pdf(q)
 
 
+def test_uniform_closed_form_equals_scipy_in_both_tails():
+    """The written-out uniform inverse CDF against scipy's ppf/isf (a second
+    implementation), from the far lower to the far upper tail: 2 ulp of the support."""
+    from uq.inputs import _inverse_cdf
+    from scipy.special import ndtr
+    dist = st.uniform(-0.3, 0.7)
+    z = np.concatenate([np.linspace(-40, 40, 1001), [0.0, -1e-300, 1e-300]])
+    expected = np.where(z <= 0, dist.ppf(ndtr(z)), dist.isf(ndtr(-z)))
+    np.testing.assert_allclose(_inverse_cdf(dist, z), expected, rtol=0, atol=2 * 2.2e-16 * 0.4)
+    assert _inverse_cdf(dist, np.array([-40.0]))[0] == -0.3
+    assert _inverse_cdf(dist, np.array([40.0]))[0] == pytest.approx(0.4, abs=1e-16)
+
+
 def test_shortest_interval_of_a_skewed_output():
     ds = uq.propagate(lambda x: x, {"x": st.expon()}, n=N, seed=6, interval="shortest")
     # shortest 95 % interval of Exp(1) is [0, -ln 0.05]

@@ -5,7 +5,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from uq.rotation import (attitude_from_matrix, attitude_from_rubio2022_angles, attitude_matrix,
-                         rotation_about_vertical, rubio2022_angles_from_attitude,
+                         rotate_vectors, rotation_about_vertical, rotation_pitch,
+                         rotation_roll, rubio2022_angles_from_attitude,
                          rubio2022_rotation)
 
 BOW, STARBOARD, UP = np.eye(3)
@@ -104,3 +105,29 @@ def test_apply_matrix_equals_matmul(matrix_shape, vector_shape):
     rng = np.random.default_rng(3)
     matrix, vectors = rng.random(matrix_shape), rng.random(vector_shape)
     np.testing.assert_allclose(apply_matrix(matrix, vectors), matrix @ vectors, rtol=1e-14)
+
+
+def test_attitude_matrix_is_the_product_of_the_elementary_rotations():
+    """The written-out matrix equals Rz(heading) Ry(pitch) Rx(roll) multiplied out, for
+    angles in every quadrant and complex-step input (1e-15: a few roundings)."""
+    rng = np.random.default_rng(0)
+    heading, pitch, roll = (rng.uniform(-np.pi, np.pi, 50) for _ in range(3))
+    product = rotation_about_vertical(heading) @ rotation_pitch(pitch) @ rotation_roll(roll)
+    np.testing.assert_allclose(attitude_matrix(heading, pitch, roll), product, atol=1e-15)
+    stepped = attitude_matrix(heading + 1e-20j, pitch, roll)
+    # d Rz / d psi = P Rz(psi + 90 deg) with P = diag(1, 1, 0): the product, last row zero
+    derivative = rotation_about_vertical(heading + np.pi / 2) @ rotation_pitch(pitch) \
+        @ rotation_roll(roll)
+    derivative[..., 2, :] = 0.0
+    np.testing.assert_allclose(stepped.imag / 1e-20, derivative, atol=1e-14)
+
+
+def test_rotate_vectors_one_matrix_and_a_stack_agree_with_matmul():
+    rng = np.random.default_rng(1)
+    vectors = rng.normal(size=(7, 2, 5, 3))
+    one = attitude_matrix(0.3, 0.1, -0.2)
+    np.testing.assert_allclose(rotate_vectors(one, vectors), vectors @ one.T, atol=1e-15)
+    stack = attitude_matrix(rng.normal(size=2), 0.1, -0.2)   # (2, 3, 3): one per scene S
+    expected = np.einsum("sij,nskj->nski", stack, vectors)
+    np.testing.assert_allclose(rotate_vectors(stack, vectors), expected, atol=1e-15)
+    np.testing.assert_allclose(expected[:, 1, 2], vectors[:, 1, 2] @ stack[1].T, atol=1e-15)

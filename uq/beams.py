@@ -36,10 +36,15 @@ def beam_unit_vectors(half_cone, azimuths, misalignment=0.0, vertical_beam=False
         Slanted beams first, in the order of `azimuths`, then the vertical beam.
     """
     half_cone = np.asarray(half_cone)[..., None]
-    azimuth = np.asarray(misalignment)[..., None] + np.asarray(azimuths)
+    misalignment = np.asarray(misalignment)[..., None]
+    azimuths = np.asarray(azimuths, dtype=float)
+    # cos(m + phi), sin(m + phi) by the addition theorems: two sines and cosines per
+    # misalignment instead of two per beam (the trigonometry dominates per-sample beams)
+    cos_m, sin_m = np.cos(misalignment), np.sin(misalignment)
+    cos_phi, sin_phi = np.cos(azimuths), np.sin(azimuths)
     sin_cone = np.sin(half_cone)
-    vectors = np.stack(np.broadcast_arrays(sin_cone * np.cos(azimuth),
-                                           sin_cone * np.sin(azimuth),
+    vectors = np.stack(np.broadcast_arrays(sin_cone * (cos_m * cos_phi - sin_m * sin_phi),
+                                           sin_cone * (sin_m * cos_phi + cos_m * sin_phi),
                                            np.cos(half_cone)), axis=-1)
     if vertical_beam:
         up = np.zeros(vectors.shape[:-2] + (1, 3), dtype=vectors.dtype)

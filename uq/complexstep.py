@@ -16,6 +16,8 @@ References
 """
 import numpy as np
 
+from .constants import HYPOT_SAFE_MAX, HYPOT_SAFE_MIN
+
 
 def arctan2(y, x):
     """``numpy.arctan2`` carrying a complex-step perturbation [rad]."""
@@ -29,9 +31,17 @@ def arctan2(y, x):
 
 def hypot(x, y):
     """sqrt(x^2 + y^2), analytic for complex-step (``numpy.hypot`` drops Im)."""
-    if not (np.iscomplexobj(y) or np.iscomplexobj(x)):
-        return np.hypot(x, y)
-    return np.sqrt(x * x + y * y)
+    if np.iscomplexobj(y) or np.iscomplexobj(x):
+        return np.sqrt(x * x + y * y)
+    # sqrt(x^2 + y^2) is ~9x faster than numpy.hypot (libm's careful hypot) and exact to
+    # an ulp or two while the squares neither overflow nor underflow (NaN stays NaN as in
+    # hypot); outside that range (an infinity, exactly zero) numpy.hypot decides
+    with np.errstate(over="ignore"):                  # overflow sends it to the fallback
+        radius = np.sqrt(x * x + y * y)
+    if np.size(radius) and HYPOT_SAFE_MIN < np.fmin.reduce(radius, axis=None) \
+            and np.fmax.reduce(radius, axis=None) < HYPOT_SAFE_MAX:
+        return radius
+    return np.hypot(x, y)
 
 
 def mod(x, period):

@@ -88,3 +88,16 @@ KPI_AVAILABILITY = (0.90, 0.85)
 #: Fraction of the numerical tolerance delta to which Monte Carlo results are taken when
 #: they validate the GUM [1]: JCGM 101:2008, 8.2 (results for validation to delta / 5).
 VALIDATION_TOLERANCE_FRACTION = 0.2
+
+#: Range of sqrt(x^2 + y^2) [any unit] inside which the plain formula is used for a
+#: hypotenuse: the squares stay normal doubles (1e-300 .. 1e300, DBL_MIN = 2.2e-308,
+#: DBL_MAX = 1.8e308), so it is exact to an ulp or two (IEEE 754); outside, numpy.hypot.
+HYPOT_SAFE_MIN, HYPOT_SAFE_MAX = 1e-150, 1e150
+
+#: Random values per call of the model inside a chunk [1] (trials x input dimension,
+#: :func:`uq.propagate.model_slice_size`). The model's intermediate arrays (e.g. the
+#: heights of 5 beams x 3 gates per trial) then stay in the L2 cache instead of streaming
+#: through memory. Measured on floating_lidar_full (23 inputs, 2^17 trials): 105 ms in
+#: one call, 84 ms in slices of 2^13 trials, slower again at 2^11 (per-call overhead);
+#: a 4-input scan scene is fastest with whole 2^16 blocks.
+MODEL_SLICE_VALUES = 2**18

@@ -135,12 +135,20 @@ def _cholesky(correlation, names, shapes, offsets, dimension):
 def _inverse_cdf(distribution, z):
     """Input values with normal scores `z`; exact in both tails.
 
-    Normal inputs are ``loc + scale z`` (no round trip through probabilities). Others use
+    Normal inputs are ``loc + scale z`` (no round trip through probabilities), uniform
+    ones the closed form of the two tails below. Others use
     ``ppf(Phi(z))`` for z <= 0 and ``isf(Phi(-z))`` for z > 0, so that upper-tail
     probabilities keep their relative precision.
     """
-    if getattr(getattr(distribution, "dist", None), "name", None) == "norm":
+    family = getattr(getattr(distribution, "dist", None), "name", None)
+    if family == "norm":
         return distribution.mean() + distribution.std() * z
+    if family == "uniform":
+        # ppf(p) = a + w p and isf(p) = b - w p, written out (scipy's generic ppf makes
+        # several argument-checking passes); the same two tails as below
+        low, high = distribution.support()
+        tail = (high - low) * ndtr(-np.abs(z))
+        return np.where(z <= 0, low + tail, high - tail)
     lower = z <= 0
     out = np.empty_like(z)
     out[lower] = distribution.ppf(ndtr(z[lower]))

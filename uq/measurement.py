@@ -53,7 +53,7 @@ import numpy as np
 from . import complexstep, wind
 from .beams import beam_unit_vectors, least_squares_operator, slant_distances
 from .correction import correction_rotation, correction_ship_velocity, reconstruct_wind
-from .rotation import attitude_matrix
+from .rotation import attitude_matrix, rotate_vectors
 
 SCENE_FIELDS = ("wind_speed", "wind_direction", "vertical_wind", "shear", "reference_height",
                 "sog", "cog", "heading", "pitch", "roll", "heave", "lidar_height",
@@ -194,9 +194,19 @@ def true_radial_velocity(scene, beams_earth, ship_velocity, height_error=0.0):
         ``n . u_wind(z)``, the motion-free radial wind.
     """
     heights = beam_heights(scene, beams_earth, height_error)            # (..., *S, b, g)
-    wind_vector = true_wind(scene, heights, trailing=2)                 # (..., *S, b, g, 3)
-    wind_only = np.sum(beams_earth[..., None, :] * wind_vector, axis=-1)
-    ship_along = np.sum(beams_earth * np.asarray(ship_velocity)[..., None, :], axis=-1)
+    field = lambda name, trailing: scene.field(name, trailing)          # noqa: E731
+    speed = wind.power_law_speed(field("wind_speed", 2), heights,
+                                 field("reference_height", 2), field("shear", 2))
+    # n . u(z) = U(z) (n_h . e_wind) + n_up w: the direction of the horizontal wind is the
+    # same at every height, so only its speed is evaluated per beam and gate (no stacked
+    # (..., b, g, 3) wind vectors)
+    to_north, to_east = wind.wind_components(1.0, complexstep.degrees(
+        field("wind_direction", 1)))                                    # (*S, 1)
+    north, east, up = (beams_earth[..., k] for k in range(3))           # (..., *S, b)
+    along_wind = north * to_north + east * to_east
+    ship = np.asarray(ship_velocity)[..., None, :]                      # (*S, 1, 3)
+    ship_along = north * ship[..., 0] + east * ship[..., 1] + up * ship[..., 2]
+    wind_only = speed * along_wind[..., None] + (up * field("vertical_wind", 1))[..., None]
     return wind_only - ship_along[..., None], wind_only
 
 
@@ -267,7 +277,7 @@ def _measure(scene, err, batch):
     true_beams = beam_unit_vectors(half_cone, np.asarray(scene.azimuths), misalignment,
                                    scene.vertical_beam)                    # ([n], *S, b, 3)
     attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)    # (*S, 3, 3)
-    beams_earth = true_beams @ np.swapaxes(attitude, -1, -2)
+    beams_earth = rotate_vectors(attitude, true_beams)
     radial, _ = true_radial_velocity(scene, beams_earth, _ship_velocity(scene),
                                      err["lidar_height"])
     measured = radial + err["lidar_radial_velocity"]

