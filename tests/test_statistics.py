@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from uq.statistics import (StreamingStatistics, coverage_interval, tail_capacity, unwrap)
+from uq.statistics import (StreamingStatistics, batch_statistics, coverage_interval, tail_capacity, unwrap)
 
 
 def direct_interval(values, p=0.95):
@@ -25,10 +25,15 @@ def test_no_interval_from_too_few_values(m):
     assert np.isnan(coverage_interval(np.arange(m), np.arange(m), m)).all()
 
 
+# every value kept / tails from the start / tails taking over after 15000 of 20000 values
+STORED = [2**23, 0, 15_000]
+
+
+@pytest.mark.parametrize("stored", STORED)
 @pytest.mark.parametrize("chunk", [1, 7, 100, 5000])
-def test_streaming_equals_in_memory(chunk, rng):
+def test_streaming_equals_in_memory(chunk, stored, rng):
     values = rng.gamma(2.0, size=(10_000, 2))
-    stats = StreamingStatistics((2,), tail_capacity(len(values)) + 1)
+    stats = StreamingStatistics((2,), tail_capacity(len(values)) + 1, stored_values=stored)
     for start in range(0, len(values), chunk):
         stats.update(values[start:start + chunk])
     result = stats.result()
@@ -38,10 +43,12 @@ def test_streaming_equals_in_memory(chunk, rng):
         assert (result["low"][j], result["high"][j]) == direct_interval(values[:, j])
 
 
-def test_shortest_interval(rng):
+@pytest.mark.parametrize("stored", STORED)
+def test_shortest_interval(stored, rng):
     values = rng.exponential(size=4000)
-    stats = StreamingStatistics((), tail_capacity(4000))
-    stats.update(values)
+    stats = StreamingStatistics((), tail_capacity(4000), stored_values=stored // 5)
+    for start in range(0, 4000, 1000):
+        stats.update(values[start:start + 1000])
     low, high = stats.result(kind="shortest")["low"], stats.result(kind="shortest")["high"]
     s = np.sort(values)
     q = int(np.floor(0.95 * 4000 + 0.5))
@@ -62,11 +69,27 @@ def test_unwrap():
     np.testing.assert_allclose(unwrap(np.array([1.0]), 359.0), [361.0])
 
 
-def test_nan_excluded_and_counted():
+@pytest.mark.parametrize("stored", STORED)
+def test_nan_excluded_and_counted(stored, rng):
     stats = StreamingStatistics((), 100)
     stats.update(np.array([1.0, np.nan, 3.0]))
     result = stats.result()
     assert result["n_valid"] == 2 and result["mean"] == 2.0
+    # intervals of the finite values only, whichever way they are kept
+    values = rng.normal(size=4000)
+    values[::7] = np.nan
+    values[::11] = np.inf
+    stats = StreamingStatistics((), tail_capacity(4000) + 1, stored_values=stored // 5)
+    for start in range(0, 4000, 500):
+        stats.update(values[start:start + 500])
+    finite = values[np.isfinite(values)]
+    result = stats.result()
+    assert result["n_valid"] == finite.size
+    assert (result["low"], result["high"]) == direct_interval(finite)
+    values[1::13] = -np.inf
+    batch = batch_statistics(values)
+    finite = values[np.isfinite(values)]
+    assert (batch["low"], batch["high"]) == direct_interval(finite)
 
 
 @pytest.mark.parametrize("m", [40, 999, 16384])

@@ -101,3 +101,10 @@ HYPOT_SAFE_MIN, HYPOT_SAFE_MAX = 1e-150, 1e150
 #: one call, 84 ms in slices of 2^13 trials, slower again at 2^11 (per-call overhead);
 #: a 4-input scan scene is fastest with whole 2^16 blocks.
 MODEL_SLICE_VALUES = 2**18
+
+#: Output values per statistic kept whole before only the tails are kept [1]
+#: (:class:`uq.statistics.StreamingStatistics`): 2^23 doubles = 64 MB. Below it the
+#: interval endpoints come from one partition at the end (exact, the same order
+#: statistics), which is ~3x cheaper than maintaining the tails batch by batch; above it
+#: memory stays bounded (10^8 trials).
+STORED_VALUES = 2**23

@@ -116,10 +116,25 @@ def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navig
 
 def _scan_correction(radial_velocity, model, operator, rotation, ship_velocity):
     """Eq. 13 [1]: u = R P u_lidar + s, with one navigation reading per scan."""
+    if rotation.size == 9:
+        # one rotation for every sample (no heading or attitude error): folded into the
+        # least-squares operator, one matrix product per sample instead of two
+        return apply_matrix(_earth_operator(model, rotation.reshape(3, 3), operator),
+                            radial_velocity) + ship_velocity[..., :, None]
     lidar_wind = apply_matrix(operator, radial_velocity)        # Eqs. 14-15, (..., 3, g)
     if model == "full":
         return apply_matrix(rotation, lidar_wind) + ship_velocity[..., :, None]
     return _horizontal_rotation(rotation, lidar_wind, ship_velocity)
+
+
+def _earth_operator(model, rotation, operator):
+    """Radial velocities -> earth-frame wind for a fixed rotation, shape (*S, 3, b):
+    ``R A^+`` (full) or the horizontal rows ``R_hh A^+_h`` over the lidar-frame
+    vertical row (Eq. 13 [1], as :func:`_horizontal_rotation`)."""
+    if model == "full":
+        return rotation @ operator
+    horizontal = rotation[:2, :2] @ operator[..., :2, :]
+    return np.concatenate([horizontal, operator[..., 2:3, :]], axis=-2)
 
 
 def _horizontal_rotation(rotation, lidar_wind, ship_velocity):

@@ -253,15 +253,17 @@ class _Runner:
         for q, values in outputs.items():
             for start in range(0, len(values), self.batch_size):
                 batch = values[start:start + self.batch_size]
-                self.stats[q].update(batch)
+                full = len(batch) == self.batch_size
+                summary = batch_statistics(batch, self.references[q], kind=self.interval) \
+                    if full else {"moments": None}
+                self.stats[q].update(batch, summary["moments"])   # moments computed once
                 if q in self.comoments:
                     self.comoments[q].update(batch)
                 lin = None if linear is None else linear[q][start:start + self.batch_size]
                 if lin is not None:
                     self.linear[q].update(lin, np.isfinite(batch))
-                if len(batch) < self.batch_size:
+                if not full:
                     continue
-                summary = batch_statistics(batch, self.references[q], kind=self.interval)
                 if lin is not None:
                     summary.update(self._controlled(q, summary, batch, lin))
                 for key in _BATCH_KEYS:

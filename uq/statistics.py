@@ -24,7 +24,7 @@ References
 """
 import numpy as np
 
-from .constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG
+from .constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG, STORED_VALUES
 
 INTERVALS = ("symmetric", "shortest")
 
@@ -107,12 +107,12 @@ class Moments:
         self.mean = np.zeros(shape)
         self.m2 = np.zeros(shape)
 
-    def update(self, values, valid):
-        """Add the entries of `values` (m, *shape) where `valid`."""
-        count = valid.sum(axis=0)
-        safe = np.where(valid, values, 0.0)
-        mean = np.divide(safe.sum(axis=0), count, out=np.zeros(self.shape), where=count > 0)
-        m2 = np.sum(np.where(valid, values - mean, 0.0) ** 2, axis=0)
+    def update(self, values, valid=None):
+        """Add the entries of `values` (m, *shape) where `valid` (default: where finite)."""
+        self.merge(*_batch_moments(values, self.shape, valid))
+
+    def merge(self, count, mean, m2):
+        """Add a batch given by its count, mean and sum of squared deviations."""
         total = self.count + count
         delta = mean - self.mean
         weight = np.divide(count, total, out=np.zeros(self.shape), where=total > 0)
@@ -124,6 +124,23 @@ class Moments:
         """Sample variance (ddof 1); NaN below two values."""
         return np.divide(self.m2, self.count - 1, out=np.full(self.shape, np.nan),
                          where=self.count > 1)
+
+
+def _batch_moments(values, shape, valid=None):
+    """(count, mean, m2) of `values` (m, *shape) over its entries where `valid`."""
+    with np.errstate(invalid="ignore", over="ignore"):      # inf - inf: the slow path
+        total = values.sum(axis=0)
+    if valid is None and np.all(np.isfinite(total)):
+        # every value finite (a non-finite one makes its sum non-finite): no masks
+        deviation = values - total / len(values)
+        return np.full(shape, len(values)), total / len(values), \
+            np.einsum("i...,i...->...", deviation, deviation)
+    valid = np.isfinite(values) if valid is None else valid
+    count = valid.sum(axis=0)
+    safe = np.where(valid, values, 0.0)
+    mean = np.divide(safe.sum(axis=0), count, out=np.zeros(shape), where=count > 0)
+    m2 = np.sum(np.where(valid, values - mean, 0.0) ** 2, axis=0)
+    return count, mean, m2
 
 
 class CoMoments:
@@ -178,7 +195,7 @@ class StreamingStatistics:
         For circular outputs, the unwrapping reference [deg], of `shape`.
     """
 
-    def __init__(self, shape, capacity, reference=None):
+    def __init__(self, shape, capacity, reference=None, stored_values=STORED_VALUES):
         self.shape = tuple(shape)
         self.capacity = int(capacity)
         self.reference = None if reference is None else np.broadcast_to(reference, shape)
@@ -187,18 +204,49 @@ class StreamingStatistics:
         size = int(np.prod(shape))
         self._low = [_Tail(self.capacity) for _ in range(size)]
         self._high = [_Tail(self.capacity) for _ in range(size)]      # holds -values
+        # every value is kept until `stored_values` are held, then the tails take over
+        self._stored, self._budget = [], int(stored_values)
 
-    def update(self, values):
-        """Add samples of shape (m, *shape)."""
+    def update(self, values, moments=None):
+        """Add samples of shape (m, *shape); `moments`, their (count, mean, m2) after
+        unwrapping (from :func:`batch_statistics`), if already known."""
         values = np.asarray(values, dtype=float)
         if self.reference is not None:
             self.resultant += np.nansum(np.exp(1j * np.deg2rad(values)), axis=0)
             values = unwrap(values, self.reference)
-        self.moments.update(values, np.isfinite(values))
+        self.moments.merge(*(moments or _batch_moments(values, self.shape)))
         flat = values.reshape(len(values), -1)
+        if self._stored is not None:
+            self._stored.append(flat.copy())
+            if len(self._stored) * flat.size > self._budget:
+                self._spill()
+            return
+        self._add_to_tails(flat)
+
+    def _spill(self):
+        """Hand the stored values to the tails (the memory bound of long runs)."""
+        stored, self._stored = self._stored, None
+        for flat in stored:
+            self._add_to_tails(flat)
+
+    def _extremes(self, j):
+        """(smallest, largest) kept values of element j, each ascending, and their count."""
+        if self._stored is None:
+            return np.sort(self._low[j].values()), np.sort(-self._high[j].values())
+        column = np.concatenate([flat[:, j] for flat in self._stored]) if self._stored \
+            else np.empty(0)
+        column = column[np.isfinite(column)]
+        k = min(self.capacity, len(column))
+        if k == 0:
+            return column, column
+        return (np.sort(np.partition(column, k - 1)[:k]),
+                np.sort(np.partition(column, len(column) - k)[len(column) - k:]))
+
+    def _add_to_tails(self, flat):
         low_bound = np.array([tail.threshold for tail in self._low])
         high_bound = np.array([-tail.threshold for tail in self._high])
-        below, above = flat < low_bound, flat > high_bound      # NaN is neither
+        finite = np.isfinite(flat)                  # as in the moments: no NaN, no +-inf
+        below, above = (flat < low_bound) & finite, (flat > high_bound) & finite
         for j in np.flatnonzero(below.any(axis=0)):
             self._low[j].add(flat[below[:, j], j])
         for j in np.flatnonzero(above.any(axis=0)):
@@ -211,9 +259,7 @@ class StreamingStatistics:
         mean = np.where(count > 0, self.moments.mean, np.nan)
         low, high = np.full(self.shape, np.nan), np.full(self.shape, np.nan)
         for j, m in enumerate(count.reshape(-1)):
-            bounds = coverage_interval(np.sort(self._low[j].values()),
-                                       np.sort(-self._high[j].values()), int(m),
-                                       probability, kind)
+            bounds = coverage_interval(*self._extremes(j), int(m), probability, kind)
             low.reshape(-1)[j], high.reshape(-1)[j] = bounds
         out = {"mean": mean, "u": u, "low": low, "high": high, "n_valid": count}
         if self.reference is not None:
@@ -294,7 +340,7 @@ def batch_statistics(values, reference=None, probability=COVERAGE_PROBABILITY,
     shape = values.shape[1:]
     flat = values.reshape(len(values), -1)
     moments = Moments(flat.shape[1:])
-    moments.update(flat, np.isfinite(flat))
+    moments.update(flat)
     low, high = np.full(flat.shape[1], np.nan), np.full(flat.shape[1], np.nan)
     ranks = _symmetric_ranks(len(flat), probability)
     if kind == "symmetric" and ranks and np.all(moments.count == len(flat)):
@@ -302,10 +348,11 @@ def batch_statistics(values, reference=None, probability=COVERAGE_PROBABILITY,
         picked = np.partition(flat, ranks, axis=0)
         low, high = picked[ranks[0]].copy(), picked[ranks[1]].copy()   # not views of the batch
     else:
-        ordered = np.sort(flat, axis=0)             # non-finite values sort last
         for j, m in enumerate(moments.count):
-            column = ordered[:m, j]
+            column = np.sort(flat[:, j][np.isfinite(flat[:, j])])   # -inf would sort first
             low[j], high[j] = coverage_interval(column, column, int(m), probability, kind)
     mean = np.where(moments.count > 0, moments.mean, np.nan)
     return {"mean": mean.reshape(shape), "u": np.sqrt(moments.variance()).reshape(shape),
-            "low": low.reshape(shape), "high": high.reshape(shape)}
+            "low": low.reshape(shape), "high": high.reshape(shape),
+            "moments": (moments.count.reshape(shape), moments.mean.reshape(shape),
+                        moments.m2.reshape(shape))}
