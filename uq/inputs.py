@@ -73,14 +73,28 @@ class InputSet:
         # independent inputs (identity Cholesky factor): no product needed
         independent = not self.dimension or np.array_equal(self.cholesky, np.eye(self.dimension))
         correlated = scores if independent else scores @ self.cholesky.T
+        # normal inputs, loc + scale z, in one pass over the whole matrix; each is then a
+        # (strided) view of it
+        normal = self._normal_columns()
+        affine = normal[0] + normal[1] * correlated if normal is not None else None
         arrays = {}
         for name in self.names:
             start = self.offsets[name]
             size = int(np.prod(self.shapes[name]))
-            z = correlated[:, start:start + size]
-            arrays[name] = _inverse_cdf(self.distributions[name], z).reshape(
-                (len(scores),) + tuple(self.shapes[name]))
+            columns = slice(start, start + size)
+            value = affine[:, columns] if _is_normal(self.distributions[name]) \
+                else _inverse_cdf(self.distributions[name], correlated[:, columns])
+            arrays[name] = value.reshape((len(scores),) + tuple(self.shapes[name]))
         return arrays
+
+    def _normal_columns(self):
+        """(loc, scale) per column, (0, 1) for non-normal inputs; None without normals."""
+        if not any(_is_normal(self.distributions[name]) for name in self.names):
+            return None
+        laid = [(self.distributions[name].mean(), self.distributions[name].std())
+                if _is_normal(self.distributions[name]) else (0.0, 1.0)
+                for name in self.names for _ in range(int(np.prod(self.shapes[name])))]
+        return np.array(laid).T
 
 
 def input_set(inputs, correlation=None):
@@ -130,6 +144,10 @@ def _cholesky(correlation, names, shapes, offsets, dimension):
         return np.linalg.cholesky(matrix)
     except np.linalg.LinAlgError:
         raise ValueError("correlation matrix is not positive definite") from None
+
+
+def _is_normal(distribution):
+    return getattr(getattr(distribution, "dist", None), "name", None) == "norm"
 
 
 def _inverse_cdf(distribution, z):

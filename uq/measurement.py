@@ -210,10 +210,13 @@ def true_radial_velocity(scene, beams_earth, ship_velocity, height_error=0.0):
     return wind_only - ship_along[..., None], wind_only
 
 
-def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, **errors):
+def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, **errors):
     """Propagate errors through measurement and correction; see the module docstring.
 
     `scene_draws` (bool): the errors carry the scene axes (independent draws per scene).
+    `compiled` (bool): where it applies (:func:`uq.fused.applicable`: one scene, real
+    errors, wind outputs), evaluate with the compiled loop of :mod:`uq.fused`, which
+    gives the same values to 1e-12; False forces the numpy arrays below.
 
     Returns
     -------
@@ -222,6 +225,9 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, **errors):
         shape (n, *S, n_gates); ``radial_velocity`` [m s-1] (n, *S, n_beams, n_gates), the
         motion-corrected radial velocity along the beam the correction believes in.
     """
+    from . import fused                     # (imports this module's constants)
+    if compiled and fused.applicable(scene, outputs, errors, scene_draws):
+        return fused.measurement_model(scene, outputs, **errors)   # the same, compiled
     n = _sample_count(errors)
     scenes = scene.shape if scene_draws else (1,) * len(scene.shape)
     err = {name: _error_shape(np.asarray(errors.get(name, 0.0)), name, scenes, scene_draws)

@@ -239,8 +239,8 @@ class StreamingStatistics:
         k = min(self.capacity, len(column))
         if k == 0:
             return column, column
-        return (np.sort(np.partition(column, k - 1)[:k]),
-                np.sort(np.partition(column, len(column) - k)[len(column) - k:]))
+        parted = np.partition(column, [k - 1, len(column) - k])     # both ends, one pass
+        return np.sort(parted[:k]), np.sort(parted[len(column) - k:])
 
     def _add_to_tails(self, flat):
         low_bound = np.array([tail.threshold for tail in self._low])
