@@ -136,3 +136,31 @@ def test_a_batch_of_scenes_goes_to_numpy_with_the_same_shapes(rng):
     assert measurement_model(batch, WIND, **err)["wind_speed"].shape == (20, 2, 1)
     assert_same(measurement_model(single, WIND, **err),
                 {k: v[:, 1:] for k, v in measurement_model(batch, WIND, **err).items()})
+
+
+@pytest.mark.parametrize("base", [0.0, 0.5, -2.0, 3.1])
+def test_angle_trig_equals_libm(base, rng):
+    """Taylor polynomials + angle addition within SMALL_ANGLE, libm beyond: cos and sin
+    of base + error to 4 ulp of 1 (two roundings of the addition theorem, and the
+    rounding of base + error that the direct call makes)."""
+    from uq.constants import SMALL_ANGLE
+    from uq.fusedkernels import angle_trig
+    errors_deg = np.concatenate([rng.normal(0, 3, 2000), [0.0, -0.0, np.nan, 1e-300],
+                                 np.rad2deg([SMALL_ANGLE, -SMALL_ANGLE, 0.2499999, 0.2500001,
+                                             1.0, -3.0, 100.0])])
+    strided = np.repeat(errors_deg, 3)[::3]                        # any stride
+    cos, sin = np.empty(len(errors_deg)), np.empty(len(errors_deg))
+    angle_trig(strided, base, 0, len(errors_deg), cos, sin)
+    exact = base + np.deg2rad(errors_deg)
+    np.testing.assert_allclose(cos, np.cos(exact), rtol=0, atol=4 * 2.2e-16)
+    np.testing.assert_allclose(sin, np.sin(exact), rtol=0, atol=4 * 2.2e-16)
+    assert np.isnan(cos[2002]) and np.isnan(sin[2002])
+
+
+def test_angle_trig_of_a_constant_error_fills_the_block():
+    from uq.fusedkernels import angle_trig
+    cos, sin = np.full(5, -9.0), np.full(5, -9.0)
+    angle_trig(np.array([30.0]), 0.0, 10, 14, cos, sin)
+    np.testing.assert_allclose(cos[:4], np.cos(np.deg2rad(30.0)), rtol=1e-15)
+    np.testing.assert_allclose(sin[:4], 0.5, rtol=1e-15)
+    assert cos[4] == -9.0                                  # nothing past the block

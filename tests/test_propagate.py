@@ -186,3 +186,12 @@ def test_covariance_is_the_same_whatever_the_chunk_size():
     a, b = (uq.propagate(model, inputs, n=70_000, seed=2, covariance=("y",), chunk_size=size)
             for size in (None, 2**16))
     np.testing.assert_array_equal(a["y_mc_covariance"].values, b["y_mc_covariance"].values)
+
+
+@pytest.mark.parametrize("method", ["mc", "lhs", "sobol"])
+def test_scores_drawn_into_a_buffer_are_the_same_draws(method):
+    from uq.sampling import normal_scores
+    plain = normal_scores(method, 11, 3, 5, block_size=256)
+    buffer = np.full((2, 256, 5), np.nan)
+    normal_scores(method, 11, 3, 5, block_size=256, out=buffer[1])
+    assert np.array_equal(buffer[1], plain) and np.isnan(buffer[0]).all()

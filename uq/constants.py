@@ -108,3 +108,22 @@ MODEL_SLICE_VALUES = 2**18
 #: statistics), which is ~3x cheaper than maintaining the tails batch by batch; above it
 #: memory stays bounded (10^8 trials).
 STORED_VALUES = 2**23
+
+#: Largest |angular error| [rad] whose sine and cosine the compiled model takes from
+#: their Taylor polynomials (sin to x^15, cos to x^16; :mod:`uq.fusedkernels`) [1].
+#: The first omitted terms relative to the result, x^16/17! = 6.5e-25 (sin x ~ x) and
+#: x^18/18! = 1.1e-26 (cos x > 0.96) at 0.25 rad, are far below half an ulp (1.1e-16),
+#: so the polynomials are as exact as libm. Larger errors use libm (14 deg covers INS
+#: and geometry errors). [1] Abramowitz and Stegun (1964), 4.3.65-66.
+SMALL_ANGLE = 0.25
+
+#: Trials per block of the compiled model (:func:`uq.fused.measurement_model`) [1]:
+#: its scratch arrays (beams, gate heights; ~8 x 15 doubles per trial) stay in the L2
+#: cache between the compiled loops and numpy's SIMD log and exp; the per-block Python
+#: overhead (~20 us) stays below 2 % of a block's time.
+FUSED_BLOCK_TRIALS = 2**12
+
+#: Size of the strided sample that brackets an order statistic [1]
+#: (:mod:`uq.orderstats`): its sort costs ~20 us; the brackets it gives hold ~1 % of
+#: the values around each wanted rank. [1] Floyd and Rivest (1975), sample selection.
+ORDER_SAMPLE = 1024

@@ -1,10 +1,14 @@
-"""The measurement model fused into one compiled loop over trials (numba).
+"""The measurement model fused into compiled loops over trials (numba).
 
 :func:`uq.measurement.measurement_model` is written with numpy array operations: every
 step (beam vectors, heights, the power law, radial velocities, the correction) makes a
 pass over arrays of shape (trials, beams, gates). For plain Monte Carlo those passes,
 not the arithmetic, set the speed. This module computes the same quantities trial by
-trial in a single compiled loop, so each trial's intermediate values stay in registers.
+trial in compiled loops (:mod:`uq.fusedkernels`), block by block
+(:data:`~uq.constants.FUSED_BLOCK_TRIALS` trials, in the cache), so each trial's
+intermediate values stay in registers. What is left is the transcendental functions:
+sines and cosines of the angles come from SIMD polynomials, the power law from numpy's
+SIMD ``log`` and ``exp`` on the whole block, the direction from numpy's SIMD ``arctan2``.
 
 It is a second, independent implementation of the physics (scalar code, written from
 the conventions of :mod:`uq.rotation`, :mod:`uq.beams`, :mod:`uq.wind` and
@@ -30,17 +34,17 @@ import dataclasses
 import math
 
 import numpy as np
-from numba import njit
 
+from . import fusedkernels as kernels
+from .beams import least_squares_operator, slant_distances
+from .constants import FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS
 from .correction import CORRECTION_MODELS
 from .measurement import NAVIGATION, SCENE_FIELDS
+from .rotation import attitude_matrix
 
 #: Outputs the fused loop computes; any other requested output uses the numpy model.
 FUSED_OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind")
-_DEG = math.pi / 180.0
-_RAD_TO_DEG = 180.0 / math.pi
-_ERRORS = ("lidar_half_cone", "lidar_misalignment", "lidar_height") + tuple(
-    f"ins_{key}" for key in NAVIGATION)
+_INS_ANGLES = ("heading", "pitch", "roll", "cog")
 
 
 def applicable(scene, outputs, errors, scene_draws=False):
@@ -65,36 +69,97 @@ def measurement_model(scene, outputs, **errors):
     """The fused equivalent of :func:`uq.measurement.measurement_model` (same inputs,
     degrees for angular errors; same outputs, each shape (n, *S, n_gates) for a batch
     of S = one scene, e.g. (1,))."""
-    shape = scene.shape
+    shape, gates = scene.shape, len(scene.ranges)
     scene = dataclasses.replace(scene, **{name: float(np.ravel(getattr(scene, name))[0])
                                           for name in SCENE_FIELDS})
     n = max([len(np.atleast_1d(v)) for v in errors.values()] + [1])
-    columns = [_column(errors.get(name)) for name in _ERRORS]
-    noise = errors.get("lidar_radial_velocity")
-    noise = np.zeros((1, scene.n_beams, len(scene.ranges))) if noise is None \
-        else np.require(noise, dtype=float, requirements="W")
-    speed, direction, vertical = (np.empty((n, len(scene.ranges))) for _ in range(3))
-    _trials(_scene_constants(scene), *columns, noise,
-            CORRECTION_MODELS.index(scene.correction), "wind_direction" in outputs,
-            speed, direction, vertical)
-    result = {"wind_speed": speed, "wind_direction": direction, "vertical_wind": vertical}
-    return {q: result[q].reshape((n,) + shape + (len(scene.ranges),)) for q in outputs}
+    out = {name: np.empty((n, gates)) for name in FUSED_OUTPUTS}
+    evaluate = _Blocks(scene, errors, out, "wind_direction" in outputs)
+    for start in range(0, n, FUSED_BLOCK_TRIALS):
+        evaluate(start, min(n, start + FUSED_BLOCK_TRIALS))
+    return {q: out[q].reshape((n,) + shape + (gates,)) for q in outputs}
+
+
+class _Blocks:
+    """One call of the model, evaluated block by block (the three kernels of
+    :mod:`uq.fusedkernels` and numpy's SIMD log/exp between them) into ``out``."""
+
+    def __init__(self, scene, errors, out, want_direction):
+        self.scene, self.out, self.want_direction = scene, out, want_direction
+        self.constants = scene_constants(scene)
+        self.column = {name: _column(errors.get(name)) for name in (
+            "lidar_half_cone", "lidar_misalignment", "lidar_height", "ins_sog", "ins_heave",
+            *(f"ins_{key}" for key in _INS_ANGLES))}
+        noise = errors.get("lidar_radial_velocity")
+        self.noise = np.zeros((1, scene.n_beams, len(scene.ranges))) if noise is None \
+            else np.require(noise, dtype=float, requirements="W")
+        # the truth (beams, gate heights) is common to all trials without geometry errors
+        self.fixed_truth = all(len(self.column[name]) == 1 for name in (
+            "lidar_half_cone", "lidar_misalignment", "lidar_height"))
+        block = 1 if self.fixed_truth else FUSED_BLOCK_TRIALS
+        self.geometry_trig = np.empty((2, 2, block))
+        self.beams = np.empty((block, scene.n_beams, 3))
+        self.profile = np.empty((block, scene.n_beams, len(scene.ranges)))
+        self.trig = np.empty((4, 2, FUSED_BLOCK_TRIALS))
+        self.from_east = np.empty((FUSED_BLOCK_TRIALS, len(scene.ranges)))
+        self.from_north = np.empty_like(self.from_east)
+        if self.fixed_truth:
+            self._truth(0, 1)
+
+    def __call__(self, start, stop):
+        if not self.fixed_truth:
+            self._truth(start, stop - start)
+        scene = self.scene
+        for k, key in enumerate(_INS_ANGLES):
+            kernels.angle_trig(self.column[f"ins_{key}"], getattr(scene, key), start, stop,
+                               self.trig[k, 0], self.trig[k, 1])
+        kernels.wind(self.constants, self.beams, self.profile, len(self.beams), self.trig,
+                     self.column["ins_sog"], self.column["ins_heave"], self.noise,
+                     CORRECTION_MODELS.index(scene.correction), start, stop,
+                     self.out["wind_speed"], self.out["vertical_wind"], self.from_north,
+                     self.from_east)
+        if self.want_direction:
+            _direction(self.from_north[:stop - start], self.from_east[:stop - start],
+                       self.out["wind_direction"][start:stop])
+
+    def _truth(self, start, rows):
+        """Beams and the power-law profile U(z) / U_ref of trials start .. start + rows."""
+        scene, trig = self.scene, self.geometry_trig
+        for k, (name, base) in enumerate((("lidar_half_cone", scene.half_cone),
+                                          ("lidar_misalignment", scene.misalignment))):
+            kernels.angle_trig(self.column[name], base, start, start + rows, trig[k, 0],
+                               trig[k, 1])
+        profile = self.profile[:rows]
+        kernels.geometry(self.constants, trig[0], trig[1], self.column["lidar_height"], start,
+                         rows, scene.shear != 0.0, self.beams, self.profile)
+        if scene.shear != 0.0:                      # (z / z_ref)^alpha, SIMD; NaN stays NaN
+            np.log(profile, out=profile)
+            profile *= scene.shear
+            np.exp(profile, out=profile)
+
+
+def _direction(from_north, from_east, out):
+    """Meteorological direction [deg] in [0, 360) of the "from" vector, into out
+    (as :func:`uq.wind.wind_direction`)."""
+    np.arctan2(from_east, from_north, out=out)
+    np.multiply(out, 180.0 / math.pi, out=out)
+    np.add(out, FULL_CIRCLE_DEG, out=out, where=out < 0.0)
+    np.subtract(out, FULL_CIRCLE_DEG, out=out, where=out >= FULL_CIRCLE_DEG)   # -1e-17 + 360
 
 
 def _column(value):
-    """An error as a float array (any stride) of length n (per trial) or 1 (absent or
-    constant: the loop then reads element 0)."""
+    """An error as a writable float array of length n (per trial, any stride) or 1
+    (absent or constant: the kernels read element 0)."""
     if value is None:
         return np.zeros(1)
     value = np.asarray(value, dtype=float)
     value = value if value.ndim == 1 else np.atleast_1d(value).ravel()
-    return value if value.flags.writeable else value.copy()    # one signature: writable
+    return value if value.flags.writeable else value.copy()
 
 
-def _scene_constants(scene):
-    """The scene as one float vector (numba takes no dataclass); layout in _unpack."""
-    from .beams import least_squares_operator, slant_distances
-    from .rotation import attitude_matrix
+def scene_constants(scene):
+    """The scene as one float vector (numba takes no dataclass); read by the accessors
+    at the end of :mod:`uq.fusedkernels`."""
     azimuths = np.asarray(scene.azimuths, dtype=float)
     operator = least_squares_operator(scene.nominal_unit_vectors())           # (3, b)
     slant = slant_distances(scene.ranges, scene.half_cone, len(azimuths),
@@ -108,151 +173,3 @@ def _scene_constants(scene):
     return np.concatenate([np.asarray(head, dtype=float), np.cos(azimuths),
                            np.sin(azimuths), attitude.ravel(),
                            operator.ravel(), slant.ravel()])
-
-
-@njit(cache=True)
-def _at(column, i):
-    return column[i] if column.shape[0] > 1 else column[0]
-
-
-@njit(cache=True)
-def _attitude(heading, pitch, roll, out):
-    """Rz(heading) Ry(pitch) Rx(roll) (:mod:`uq.rotation`), written out, into out (3, 3)."""
-    ch, sh = math.cos(heading), math.sin(heading)
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    cr, sr = math.cos(roll), math.sin(roll)
-    out[0, 0], out[0, 1], out[0, 2] = ch * cp, ch * sp * sr - sh * cr, -ch * sp * cr - sh * sr
-    out[1, 0], out[1, 1], out[1, 2] = sh * cp, sh * sp * sr + ch * cr, -sh * sp * cr + ch * sr
-    out[2, 0], out[2, 1], out[2, 2] = sp, -cp * sr, cp * cr
-
-
-@njit(cache=True)
-def _earth_beams(half_cone, misalignment, azimuths, vertical_beam, attitude, out):
-    """Earth-frame unit vectors of the true beams into out (b, 3) (Eq. 1 [1], rotated)."""
-    sin_cone, cos_cone = math.sin(half_cone), math.cos(half_cone)
-    cos_m, sin_m = math.cos(misalignment), math.sin(misalignment)
-    n_slanted = azimuths.shape[0] // 2            # (cos a_1 .. cos a_k, sin a_1 .. sin a_k)
-    for b in range(n_slanted + vertical_beam):
-        if b < n_slanted:
-            cos_a, sin_a = azimuths[b], azimuths[n_slanted + b]
-            x = sin_cone * (cos_m * cos_a - sin_m * sin_a)        # cos(m + a)
-            y = sin_cone * (sin_m * cos_a + cos_m * sin_a)        # sin(m + a)
-            z = cos_cone
-        else:
-            x, y, z = 0.0, 0.0, 1.0
-        for k in range(3):
-            out[b, k] = attitude[k, 0] * x + attitude[k, 1] * y + attitude[k, 2] * z
-
-
-@njit(cache=True)
-def _true_radial(beams, heights_base, slant, wind, ship, out):
-    """Motion-including radial velocity of the true wind at each beam's true heights
-    into out (b, g): U(z) (n_h . e_wind) + n_up w - n . u_ship (power-law shear; NaN
-    at a height <= 0, outside the model)."""
-    speed_ref, reference_height, shear, to_north, to_east, w = wind
-    for b in range(out.shape[0]):
-        along = beams[b, 0] * to_north + beams[b, 1] * to_east
-        moving = beams[b, 0] * ship[0] + beams[b, 1] * ship[1] + beams[b, 2] * ship[2]
-        for g in range(out.shape[1]):
-            height = heights_base + slant[b, g] * beams[b, 2]
-            # U (z / z_ref)^alpha as exp(alpha ln(z / z_ref)): ~20 % cheaper than pow
-            if not height > 0:                   # outside the model (also NaN height)
-                speed = np.nan
-            elif shear == 0.0:
-                speed = speed_ref
-            else:
-                speed = speed_ref * math.exp(shear * math.log(height / reference_height))
-            out[b, g] = speed * along + beams[b, 2] * w - moving
-
-
-@njit(cache=True)
-def _correct(truth, noise, operator, rotation, ship, full, g, out):
-    """Eq. 13 [1] for gate g with one reading: out = (north, east, up) of R P A^+ v + s
-    (``full``: R A^+ v + s with heave), v = true radial velocity + noise."""
-    x = y = z = 0.0                                       # A^+ v, the lidar-frame wind
-    for b in range(truth.shape[0]):
-        radial = truth[b, g] + noise[b, g]
-        x += operator[0, b] * radial
-        y += operator[1, b] * radial
-        z += operator[2, b] * radial
-    out[0] = rotation[0, 0] * x + rotation[0, 1] * y + ship[0]
-    out[1] = rotation[1, 0] * x + rotation[1, 1] * y + ship[1]
-    out[2] = z
-    if full:
-        out[0] += rotation[0, 2] * z
-        out[1] += rotation[1, 2] * z
-        out[2] = rotation[2, 0] * x + rotation[2, 1] * y + rotation[2, 2] * z + ship[2]
-
-
-@njit(cache=True)
-def _reading(model, heading, pitch, roll, sog, cog, heave, nominal_heading, rotation, ship):
-    """The rotation and ship velocity the correction model believes (:mod:`uq.correction`):
-    none 0 (nominal heading, no ship velocity), yaw 1, tilt2d 2, full 3."""
-    if model == 0:
-        _attitude(nominal_heading, 0.0, 0.0, rotation)
-    elif model == 1:
-        _attitude(heading, 0.0, 0.0, rotation)
-    else:
-        _attitude(heading, pitch, roll, rotation)
-    moving = model != 0
-    ship[0] = sog * math.cos(cog) if moving else 0.0
-    ship[1] = sog * math.sin(cog) if moving else 0.0
-    ship[2] = heave if model == 3 else 0.0
-
-
-_A1, _A3 = "float64[:]", "float64[:, :, :]"
-_OUT = "float64[:, :]"
-
-
-# one explicit signature with any-layout arrays: strided views of the input matrix and
-# length-1 placeholders compile once, not once per combination of layouts
-@njit(f"void(float64[::1], {_A1}, {_A1}, {_A1}, {_A1}, {_A1}, {_A1}, {_A1}, {_A1}, {_A1}, {_A3}, "
-      f"int64, boolean, {_OUT}, {_OUT}, {_OUT})", cache=True)
-def _trials(constants, d_cone, d_misalignment, d_height, d_heading, d_pitch, d_roll, d_sog,
-            d_cog, d_heave, noise, model, want_direction, speed, direction, vertical):
-    """The loop over trials; angular errors in degrees. Writes speed, direction [deg]
-    in [0, 360) and vertical wind, each (n, g)."""
-    n_slanted, vertical_beam, n_gates = int(constants[0]), int(constants[1]), int(constants[2])
-    n_beams = n_slanted + vertical_beam
-    cone0, misalignment0, lidar_height = constants[3], constants[4], constants[5]
-    wind = (constants[6], constants[7], constants[8], constants[9], constants[10],
-            constants[11])                 # speed, reference height, shear, unit wind, w
-    sog0, cog0, heave0 = constants[12], constants[13], constants[14]
-    heading0, pitch0, roll0 = constants[15], constants[16], constants[17]
-    at = 18
-    azimuths = constants[at:at + 2 * n_slanted]          # their cosines, then sines
-    attitude = constants[at + 2 * n_slanted:at + 2 * n_slanted + 9].reshape(3, 3)
-    at += 2 * n_slanted + 9
-    operator = constants[at:at + 3 * n_beams].reshape(3, n_beams)
-    slant = constants[at + 3 * n_beams:at + 3 * n_beams + n_beams * n_gates].reshape(
-        n_beams, n_gates)
-    true_ship = np.array([sog0 * math.cos(cog0), sog0 * math.sin(cog0), heave0])
-    beams, truth = np.empty((n_beams, 3)), np.empty((n_beams, n_gates))
-    rotation, ship, earth = np.zeros((3, 3)), np.zeros(3), np.zeros(3)
-    fixed_geometry = d_cone.shape[0] == 1 and d_misalignment.shape[0] == 1
-    fixed_truth = fixed_geometry and d_height.shape[0] == 1
-    fixed_reading = max(d_heading.shape[0], d_pitch.shape[0], d_roll.shape[0], d_sog.shape[0],
-                        d_cog.shape[0], d_heave.shape[0]) == 1       # no INS error: once
-    if fixed_truth:
-        _earth_beams(cone0 + d_cone[0] * _DEG, misalignment0 + d_misalignment[0] * _DEG,
-                     azimuths, vertical_beam, attitude, beams)
-        _true_radial(beams, lidar_height + d_height[0], slant, wind, true_ship, truth)
-    for i in range(speed.shape[0]):
-        if not fixed_truth:
-            _earth_beams(cone0 + _at(d_cone, i) * _DEG,
-                         misalignment0 + _at(d_misalignment, i) * _DEG, azimuths,
-                         vertical_beam, attitude, beams)
-            _true_radial(beams, lidar_height + _at(d_height, i), slant, wind, true_ship, truth)
-        if i == 0 or not fixed_reading:
-            _reading(model, heading0 + _at(d_heading, i) * _DEG,
-                     pitch0 + _at(d_pitch, i) * _DEG, roll0 + _at(d_roll, i) * _DEG,
-                     sog0 + _at(d_sog, i), cog0 + _at(d_cog, i) * _DEG,
-                     heave0 + _at(d_heave, i), heading0, rotation, ship)
-        row = i if noise.shape[0] > 1 else 0
-        for g in range(n_gates):
-            _correct(truth, noise[row], operator, rotation, ship, model == 3, g, earth)
-            speed[i, g] = math.sqrt(earth[0] * earth[0] + earth[1] * earth[1])
-            vertical[i, g] = earth[2]
-            if want_direction:
-                angle = math.atan2(-earth[1], -earth[0]) * _RAD_TO_DEG % 360.0
-                direction[i, g] = angle - 360.0 if angle >= 360.0 else angle

@@ -196,6 +196,13 @@ def model_slice_size(dimension):
     return int(np.clip(size, 2**10, RNG_BLOCK_SIZE))
 
 
+def _joined(pieces):
+    """Dicts of arrays, joined along the trials."""
+    if len(pieces) == 1:
+        return pieces[0]
+    return {q: np.concatenate([p[q] for p in pieces]) for q in pieces[0]}
+
+
 class _Runner:
     """Draws blocks, evaluates the model chunk by chunk, accumulates statistics."""
 
@@ -220,32 +227,32 @@ class _Runner:
         self.comoments = {q: CoMoments(shapes[q]) for q in self.covariance}
 
     def _evaluate(self, first_block, n_blocks, n_samples):
-        scores = np.concatenate([normal_scores(self.method, self.seed, b, self.inputs.dimension)
-                                 for b in range(first_block, first_block + n_blocks)])
-        values = self.inputs.values(scores[:n_samples])
-        outputs = self._model_in_slices(values, n_samples)
-        if not self.control:
-            return outputs, None
-        columns = controlvariate.input_columns(values, self.inputs)
-        return outputs, {q: controlvariate.linear_deviation(self.control[q][0], columns)
-                         for q in outputs}
-
-    def _model_in_slices(self, values, n_samples):
-        """The model on slices of trials (:func:`model_slice_size`), joined; slices start on
-        block boundaries, so they do not depend on the chunk size."""
-        pieces, step = [], model_slice_size(self.inputs.dimension)
+        """Outputs (and linear deviations, with a control variate) of n_samples trials
+        from the blocks first_block ..; inputs are made slice by slice (in the cache)."""
+        scores = np.empty((n_blocks * RNG_BLOCK_SIZE, self.inputs.dimension))
+        for k in range(n_blocks):
+            normal_scores(self.method, self.seed, first_block + k, self.inputs.dimension,
+                          out=scores[k * RNG_BLOCK_SIZE:(k + 1) * RNG_BLOCK_SIZE])
+        pieces, linear, step = [], [], model_slice_size(self.inputs.dimension)
         for start in range(0, n_samples, step):
-            piece = {name: v[start:start + step] for name, v in values.items()}
             size = min(step, n_samples - start)
-            with np.errstate(all="ignore"):       # out-of-domain trials become NaN, counted
-                outputs = self.model(**piece, **self.inputs.constants)
-            # outputs that do not depend on any random input may come back with one row
-            pieces.append({q: np.broadcast_to(np.real(np.asarray(v, dtype=float)),
-                                              (size,) + np.shape(v)[1:])
-                           for q, v in outputs.items()})
-        if len(pieces) == 1:
-            return pieces[0]
-        return {q: np.concatenate([p[q] for p in pieces]) for q in pieces[0]}
+            values = self.inputs.values(scores[start:start + size])
+            pieces.append(self._model(values, size))
+            if self.control:
+                columns = controlvariate.input_columns(values, self.inputs)
+                linear.append({q: controlvariate.linear_deviation(self.control[q][0], columns)
+                               for q in pieces[-1]})
+        return _joined(pieces), (_joined(linear) if self.control else None)
+
+    def _model(self, values, size):
+        """The model on one slice of `size` trials; slices start on block boundaries, so
+        they do not depend on the chunk size."""
+        with np.errstate(all="ignore"):           # out-of-domain trials become NaN, counted
+            outputs = self.model(**values, **self.inputs.constants)
+        # outputs that do not depend on any random input may come back with one row
+        return {q: np.broadcast_to(np.real(np.asarray(v, dtype=float)),
+                                   (size,) + np.shape(v)[1:])
+                for q, v in outputs.items()}
 
     def _accumulate(self, outputs, linear):
         """Statistics batch by batch; chunks start on block boundaries, so the sequence of

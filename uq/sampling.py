@@ -38,7 +38,7 @@ def block_generator(seed, block):
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(block,)))
 
 
-def normal_scores(method, seed, block, dimension, block_size=RNG_BLOCK_SIZE):
+def normal_scores(method, seed, block, dimension, block_size=RNG_BLOCK_SIZE, out=None):
     """Standard normal scores of one block, shape (block_size, dimension).
 
     Parameters
@@ -50,17 +50,20 @@ def normal_scores(method, seed, block, dimension, block_size=RNG_BLOCK_SIZE):
         Block index, >= 0.
     dimension : int
         Number of scalar random inputs.
+    out : ndarray, optional
+        C-contiguous float64 (block_size, dimension) to draw into (no copy).
     """
+    out = np.empty((block_size, dimension)) if out is None else out
     if dimension == 0:
-        return np.zeros((block_size, 0))
+        return out
     if method == "mc":
-        return block_generator(seed, block).standard_normal((block_size, dimension))
+        return block_generator(seed, block).standard_normal(out=out)
     if method == "lhs":
         engine = qmc.LatinHypercube(dimension, rng=block_generator(seed, block))
-        return ndtri(engine.random(block_size))
+        return ndtri(engine.random(block_size), out=out)
     if method == "sobol":
         engine = qmc.Sobol(dimension, scramble=True, rng=block_generator(seed, block))
-        return ndtri(engine.random(block_size))
+        return ndtri(engine.random(block_size), out=out)
     raise ValueError(f"unknown sampling method {method!r}; allowed: {SAMPLING_METHODS}")
 
 

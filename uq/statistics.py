@@ -25,6 +25,7 @@ References
 import numpy as np
 
 from .constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG, STORED_VALUES
+from .orderstats import order_statistics
 
 INTERVALS = ("symmetric", "shortest")
 
@@ -229,13 +230,24 @@ class StreamingStatistics:
         for flat in stored:
             self._add_to_tails(flat)
 
+    def _stored_column(self, j):
+        """Every stored finite value of element j."""
+        column = np.concatenate([flat[:, j] for flat in self._stored]) if self._stored \
+            else np.empty(0)
+        return column[np.isfinite(column)]
+
+    def _symmetric(self, j, m, probability):
+        """JCGM 101 7.7.2 endpoints of element j from all stored values: just the two
+        order statistics (:func:`uq.orderstats.order_statistics`), no sorted tails."""
+        ranks = _symmetric_ranks(m, probability)
+        return tuple(order_statistics(self._stored_column(j), ranks)) if ranks \
+            else (np.nan, np.nan)
+
     def _extremes(self, j):
         """(smallest, largest) kept values of element j, each ascending, and their count."""
         if self._stored is None:
             return np.sort(self._low[j].values()), np.sort(-self._high[j].values())
-        column = np.concatenate([flat[:, j] for flat in self._stored]) if self._stored \
-            else np.empty(0)
-        column = column[np.isfinite(column)]
+        column = self._stored_column(j)
         k = min(self.capacity, len(column))
         if k == 0:
             return column, column
@@ -259,7 +271,10 @@ class StreamingStatistics:
         mean = np.where(count > 0, self.moments.mean, np.nan)
         low, high = np.full(self.shape, np.nan), np.full(self.shape, np.nan)
         for j, m in enumerate(count.reshape(-1)):
-            bounds = coverage_interval(*self._extremes(j), int(m), probability, kind)
+            if kind == "symmetric" and self._stored is not None:
+                bounds = self._symmetric(j, int(m), probability)
+            else:
+                bounds = coverage_interval(*self._extremes(j), int(m), probability, kind)
             low.reshape(-1)[j], high.reshape(-1)[j] = bounds
         out = {"mean": mean, "u": u, "low": low, "high": high, "n_valid": count}
         if self.reference is not None:
