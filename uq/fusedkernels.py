@@ -58,6 +58,27 @@ def _reading_rotation(model, trig, j, nominal):
 
 
 @njit(cache=True)
+def _truth(beams, profile, speed_ref, to_north, to_east, w, ship, out):
+    """True radial velocities (b, g): U(z) (n_h . e_wind) + n_up w - n . u_ship."""
+    for b in range(out.shape[0]):
+        along = beams[b, 0] * to_north + beams[b, 1] * to_east
+        moving = beams[b, 0] * ship[0] + beams[b, 1] * ship[1] + beams[b, 2] * ship[2]
+        for g in range(out.shape[1]):
+            out[b, g] = speed_ref * profile[b, g] * along + beams[b, 2] * w - moving
+
+
+@njit(cache=True)
+def _solve(operator, radial, out):
+    """out (3, g) = A^+ radial: the least-squares lidar-frame wind of each gate."""
+    for g in range(radial.shape[1]):
+        for k in range(3):
+            total = 0.0
+            for b in range(radial.shape[0]):
+                total += operator[k, b] * radial[b, g]
+            out[k, g] = total
+
+
+@njit(cache=True)
 def _hypot(x, y):
     """sqrt(x^2 + y^2), libm's hypot where the squares could over- or underflow (as
     :func:`uq.complexstep.hypot`)."""
@@ -171,15 +192,13 @@ def wind(constants, beams, profile, rows, trig, sog_error, heave_error, noise, m
     operator = _operator(constants)
     nominal = (math.cos(heading0), math.sin(heading0))
     truth = np.empty((n_beams, n_gates))             # true radial velocities of a trial
+    lidar_frame = np.empty((3, n_gates))             # A^+ truth: the noise-free wind
     for i in range(start, stop):
         j = i - start
         r = j if rows > 1 else 0
-        for b in range(n_beams):
-            along = beams[r, b, 0] * to_north + beams[r, b, 1] * to_east
-            moving = (beams[r, b, 0] * true_ship[0] + beams[r, b, 1] * true_ship[1]
-                      + beams[r, b, 2] * true_ship[2])
-            for g in range(n_gates):                                  # U(z) (n_h . e) + n_up w
-                truth[b, g] = speed_ref * profile[r, b, g] * along + beams[r, b, 2] * w - moving
+        if rows > 1 or i == start:                   # one truth for all: computed once
+            _truth(beams[r], profile[r], speed_ref, to_north, to_east, w, true_ship, truth)
+            _solve(operator, truth, lidar_frame)
         rotation = _reading_rotation(model, trig, j, nominal)
         sog = sog0 + sog_error[i if sog_error.shape[0] > 1 else 0]
         heave = heave0 + heave_error[i if heave_error.shape[0] > 1 else 0]
@@ -187,13 +206,12 @@ def wind(constants, beams, profile, rows, trig, sog_error, heave_error, noise, m
         ship = (sog * trig[3, 0, j] if moving else 0.0, sog * trig[3, 1, j] if moving else 0.0,
                 heave if model == 3 else 0.0)
         row = i if noise.shape[0] > 1 else 0
-        for g in range(n_gates):
-            x = y = z = 0.0                                     # A^+ v: the lidar-frame wind
+        for g in range(n_gates):                 # A^+ (truth + noise): the lidar-frame wind
+            x, y, z = lidar_frame[0, g], lidar_frame[1, g], lidar_frame[2, g]
             for b in range(n_beams):
-                value = truth[b, g] + noise[row, b, g]
-                x += operator[0, b] * value
-                y += operator[1, b] * value
-                z += operator[2, b] * value
+                x += operator[0, b] * noise[row, b, g]
+                y += operator[1, b] * noise[row, b, g]
+                z += operator[2, b] * noise[row, b, g]
             north = rotation[0] * x + rotation[1] * y + ship[0]            # Eq. 13 [1]
             east = rotation[3] * x + rotation[4] * y + ship[1]
             up = z

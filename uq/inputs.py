@@ -81,7 +81,8 @@ class InputSet:
         affine = None
         if normal is not None:
             affine = np.multiply(correlated, normal[1])
-            affine += normal[0]
+            if np.any(normal[0]):                   # errors are mostly centred: no pass
+                affine += normal[0]
         arrays = {}
         for name in self.names:
             start = self.offsets[name]

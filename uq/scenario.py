@@ -85,7 +85,9 @@ class Scenario:
     @property
     def text(self):
         """The scenario as YAML text (as run), defaults filled in."""
-        return yaml.safe_dump(self.settings, sort_keys=False)
+        # libyaml's emitter where PyYAML has it (~20x faster than the pure-Python one)
+        dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+        return yaml.dump(self.settings, Dumper=dumper, sort_keys=False)
 
     def get(self, dotted):
         """Value at a dotted key, e.g. ``wind.direction``."""

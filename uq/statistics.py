@@ -359,9 +359,10 @@ def batch_statistics(values, reference=None, probability=COVERAGE_PROBABILITY,
     low, high = np.full(flat.shape[1], np.nan), np.full(flat.shape[1], np.nan)
     ranks = _symmetric_ranks(len(flat), probability)
     if kind == "symmetric" and ranks and np.all(moments.count == len(flat)):
-        # all values finite: the two order statistics by one partition (JCGM 101 7.7.2)
-        picked = np.partition(flat, ranks, axis=0)
-        low, high = picked[ranks[0]].copy(), picked[ranks[1]].copy()   # not views of the batch
+        # all values finite: just the two order statistics (JCGM 101 7.7.2)
+        columns = np.ascontiguousarray(flat.T)
+        picked = np.array([order_statistics(column, ranks) for column in columns])
+        low, high = picked[:, 0].copy(), picked[:, 1].copy()     # not views of the batch
     else:
         for j, m in enumerate(moments.count):
             column = np.sort(flat[:, j][np.isfinite(flat[:, j])])   # -inf would sort first
