@@ -195,3 +195,13 @@ def test_scores_drawn_into_a_buffer_are_the_same_draws(method):
     buffer = np.full((2, 256, 5), np.nan)
     normal_scores(method, 11, 3, 5, block_size=256, out=buffer[1])
     assert np.array_equal(buffer[1], plain) and np.isnan(buffer[0]).all()
+
+
+@pytest.mark.parametrize("method", ["mc", "lhs", "sobol"])
+@pytest.mark.parametrize("rows", [1, 1000, 1024, 4097])
+def test_leading_rows_of_a_block_are_the_rows_of_the_whole_block(method, rows):
+    """A short last block draws only what it needs, and the same values."""
+    from uq.sampling import normal_scores
+    whole = normal_scores(method, 5, 2, 3, block_size=8192)
+    assert np.array_equal(normal_scores(method, 5, 2, 3, block_size=8192, rows=rows),
+                          whole[:rows])

@@ -106,8 +106,9 @@ def time_to_target(dataset):
     return rows
 
 
-def draw_floor(name, n):
-    """Seconds to draw n trials' standard normals for the scene's random inputs."""
+def draw_floor(name, n, repeats=5):
+    """Seconds to draw n trials' standard normals for the scene's random inputs (the
+    median of `repeats`, as the run times it is compared with), and their dimension."""
     from .pipeline import error_inputs, scene_from_settings
     from .inputs import input_set
     scenario = scene(name)
@@ -115,9 +116,12 @@ def draw_floor(name, n):
     dimension = input_set(error_inputs(scenario.settings, base.n_beams,
                                        len(base.ranges))).dimension
     generator = np.random.default_rng(1)
-    started = time.perf_counter()
-    generator.standard_normal((n, dimension))
-    return time.perf_counter() - started, dimension
+    times = []
+    for _ in range(repeats):
+        started = time.perf_counter()
+        generator.standard_normal((n, dimension))
+        times.append(time.perf_counter() - started)
+    return float(np.median(times)), dimension
 
 
 def scan_throughput(n=10**6):

@@ -239,22 +239,24 @@ def _assemble(scenario, plan, results):
 
 
 def _annotate(ds, scenario):
+    # attributes set on the Variables in place (ds[name] would build a DataArray each)
     for name in ds.data_vars:
         quantity = next((q for q in QUANTITIES if name.startswith(q + "_")), None)
         if quantity:
-            ds[name].attrs.update(variable_attributes(quantity, name[len(quantity) + 1:]))
-    ds["mc_n_samples"].attrs.update(units="1", long_name="Monte Carlo trials used")
-    ds["mc_stopped_by"].attrs.update(  # a CF flag variable (CF 1.10, 3.5)
+            ds.variables[name].attrs.update(
+                variable_attributes(quantity, name[len(quantity) + 1:]))
+    ds.variables["mc_n_samples"].attrs.update(units="1", long_name="Monte Carlo trials used")
+    ds.variables["mc_stopped_by"].attrs.update(  # a CF flag variable (CF 1.10, 3.5)
         units="1", long_name="what stopped Monte Carlo sampling",
         flag_values=np.arange(len(STOPPED_BY), dtype=np.int8),
         flag_meanings=" ".join(name.replace(" ", "_") for name in STOPPED_BY))
     for name, attrs in COORDINATES.items():
         if name in ds.coords:
-            ds[name].attrs.update(attrs)
+            ds.variables[name].attrs.update(attrs)
     for key, _ in scenario.sweep:
-        ds[key.replace(".", "_")].attrs["long_name"] = f"swept scenario key {key}"
+        ds.variables[key.replace(".", "_")].attrs["long_name"] = f"swept scenario key {key}"
     for follower, leader in scenario.links:
-        ds[follower.replace(".", "_")].attrs["long_name"] = \
+        ds.variables[follower.replace(".", "_")].attrs["long_name"] = \
             f"scenario key {follower}, linked to the swept key {leader}"
     return ds
 

@@ -229,10 +229,11 @@ class _Runner:
     def _evaluate(self, first_block, n_blocks, n_samples):
         """Outputs (and linear deviations, with a control variate) of n_samples trials
         from the blocks first_block ..; inputs are made slice by slice (in the cache)."""
-        scores = np.empty((n_blocks * RNG_BLOCK_SIZE, self.inputs.dimension))
-        for k in range(n_blocks):
+        scores = np.empty((n_samples, self.inputs.dimension))
+        for k in range(n_blocks):               # the last block only as far as needed
+            rows = min(RNG_BLOCK_SIZE, n_samples - k * RNG_BLOCK_SIZE)
             normal_scores(self.method, self.seed, first_block + k, self.inputs.dimension,
-                          out=scores[k * RNG_BLOCK_SIZE:(k + 1) * RNG_BLOCK_SIZE])
+                          out=scores[k * RNG_BLOCK_SIZE:k * RNG_BLOCK_SIZE + rows], rows=rows)
         pieces, linear, step = [], [], model_slice_size(self.inputs.dimension)
         for start in range(0, n_samples, step):
             size = min(step, n_samples - start)

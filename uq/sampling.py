@@ -22,6 +22,8 @@ inputs are obtained from them by inverse CDFs (:mod:`uq.inputs`), so each works 
 every distribution. mc draws ``z`` directly; lhs and sobol map uniforms through the
 normal inverse CDF.
 """
+import math
+
 import numpy as np
 from scipy.special import ndtri
 from scipy.stats import qmc
@@ -38,7 +40,8 @@ def block_generator(seed, block):
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(block,)))
 
 
-def normal_scores(method, seed, block, dimension, block_size=RNG_BLOCK_SIZE, out=None):
+def normal_scores(method, seed, block, dimension, block_size=RNG_BLOCK_SIZE, out=None,
+                  rows=None):
     """Standard normal scores of one block, shape (block_size, dimension).
 
     Parameters
@@ -51,19 +54,25 @@ def normal_scores(method, seed, block, dimension, block_size=RNG_BLOCK_SIZE, out
     dimension : int
         Number of scalar random inputs.
     out : ndarray, optional
-        C-contiguous float64 (block_size, dimension) to draw into (no copy).
+        C-contiguous float64 (rows, dimension) to draw into (no copy).
+    rows : int, optional
+        Only the first `rows` rows of the block (the same values as in the whole
+        block: the generator's stream and the Sobol' sequence are sequential; a Latin
+        hypercube is drawn whole, its strata span the block).
     """
-    out = np.empty((block_size, dimension)) if out is None else out
+    rows = block_size if rows is None else int(rows)
+    out = np.empty((rows, dimension)) if out is None else out
     if dimension == 0:
         return out
     if method == "mc":
         return block_generator(seed, block).standard_normal(out=out)
     if method == "lhs":
         engine = qmc.LatinHypercube(dimension, rng=block_generator(seed, block))
-        return ndtri(engine.random(block_size), out=out)
+        return ndtri(engine.random(block_size)[:rows], out=out)
     if method == "sobol":
         engine = qmc.Sobol(dimension, scramble=True, rng=block_generator(seed, block))
-        return ndtri(engine.random(block_size), out=out)
+        points = engine.random_base2(max(0, math.ceil(math.log2(rows))))   # balanced prefix
+        return ndtri(points[:rows], out=out)
     raise ValueError(f"unknown sampling method {method!r}; allowed: {SAMPLING_METHODS}")
 
 
