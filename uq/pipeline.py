@@ -180,18 +180,16 @@ def _scene_dataset(scene, settings, outputs, engine):
             if q == "wind_direction":
                 bias = unwrap(bias, 0.0)
             data[f"{q}_mc_bias"] = (dims, bias)
-    ds = engine.assign(data)
-    ds = ds.assign_coords(input=[input_label(name) for name in ds["input"].values],
-                          range=list(scene.ranges))
-    if "range_other" in ds.dims:
-        ds = ds.assign_coords(range_other=list(scene.ranges))
-    if "beam" in ds.dims:
-        azimuths = list(np.rad2deg(scene.azimuths)) + [np.nan] * int(scene.vertical_beam)
-        ds = ds.assign_coords(beam=azimuths)
-    ds["mc_n_samples"] = ("scene", np.full(scene.shape, engine.attrs["n_samples"]))
-    ds["mc_stopped_by"] = ("scene", np.full(scene.shape, STOPPED_BY.index(
+    data["mc_n_samples"] = ("scene", np.full(scene.shape, engine.attrs["n_samples"]))
+    data["mc_stopped_by"] = ("scene", np.full(scene.shape, STOPPED_BY.index(
         engine.attrs["stopped_by"]), dtype=np.int8))
-    return ds
+    coords = {"input": [input_label(name) for name in engine["input"].values],
+              "range": list(scene.ranges)}
+    if "range_other" in engine.dims:
+        coords["range_other"] = list(scene.ranges)
+    if "beam" in engine.dims:
+        coords["beam"] = list(np.rad2deg(scene.azimuths)) + [np.nan] * int(scene.vertical_beam)
+    return engine.assign(data).assign_coords(coords)      # one merge each (xarray's cost)
 
 
 def _paper_uncertainty(scene, settings, gate_speeds):
