@@ -74,20 +74,23 @@ class InputSet:
         """Input name of each column."""
         return [name for name in self.names for _ in range(int(np.prod(self.shapes[name])))]
 
-    def values(self, scores):
+    def values(self, scores, overwrite=False):
         """Input arrays from normal scores of shape (n, dimension).
 
         Returns dict name -> array of shape (n, *shape) of the random inputs only.
+        With `overwrite` the scores (C-contiguous float64) are turned into the values in
+        place: no new matrix, and the returned arrays are views of `scores`.
         """
         # independent inputs (identity Cholesky factor): no product needed
         independent = not self.dimension or np.array_equal(self.cholesky, np.eye(self.dimension))
         correlated = scores if independent else scores @ self.cholesky.T
         # normal inputs, loc + scale z, in one pass over the whole matrix; each is then a
-        # (strided) view of it
+        # (strided) view of it. Other columns get (0, 1): unchanged, so in place is safe
         normal = self._normal_columns
         affine = None
         if normal is not None:
-            affine = np.multiply(correlated, normal[1])
+            in_place = overwrite or correlated is not scores        # (a product is ours)
+            affine = np.multiply(correlated, normal[1], out=correlated if in_place else None)
             if np.any(normal[0]):                   # errors are mostly centred: no pass
                 affine += normal[0]
         arrays = {}

@@ -237,7 +237,7 @@ class _Runner:
         pieces, linear, step = [], [], model_slice_size(self.inputs.dimension)
         for start in range(0, n_samples, step):
             size = min(step, n_samples - start)
-            values = self.inputs.values(scores[start:start + size])
+            values = self.inputs.values(scores[start:start + size], overwrite=True)
             pieces.append(self._model(values, size))
             if self.control:
                 columns = controlvariate.input_columns(values, self.inputs)

@@ -234,6 +234,8 @@ class StreamingStatistics:
         """Every stored finite value of element j."""
         column = np.concatenate([flat[:, j] for flat in self._stored]) if self._stored \
             else np.empty(0)
+        if len(column) == self.moments.count.reshape(-1)[j]:
+            return column                  # the moments counted every value finite
         return column[np.isfinite(column)]
 
     def _symmetric(self, j, m, probability):
