@@ -196,8 +196,17 @@ def wind(constants, beams, profile, rows, trig, sog_error, heave_error, noise, m
     for i in range(start, stop):
         j = i - start
         r = j if rows > 1 else 0
-        if rows > 1 or i == start:                   # one truth for all: computed once
-            _truth(beams[r], profile[r], speed_ref, to_north, to_east, w, true_ship, truth)
+        row = i if noise.shape[0] > 1 else 0
+        if rows > 1:                                 # this trial's true radial velocities
+            for b in range(n_beams):
+                along = beams[r, b, 0] * to_north + beams[r, b, 1] * to_east
+                moving = (beams[r, b, 0] * true_ship[0] + beams[r, b, 1] * true_ship[1]
+                          + beams[r, b, 2] * true_ship[2])
+                for g in range(n_gates):                          # U(z) (n_h . e) + n_up w
+                    truth[b, g] = speed_ref * profile[r, b, g] * along + beams[r, b, 2] * w \
+                        - moving
+        elif i == start:                             # one truth for all: A^+ truth once
+            _truth(beams[0], profile[0], speed_ref, to_north, to_east, w, true_ship, truth)
             _solve(operator, truth, lidar_frame)
         rotation = _reading_rotation(model, trig, j, nominal)
         sog = sog0 + sog_error[i if sog_error.shape[0] > 1 else 0]
@@ -205,13 +214,20 @@ def wind(constants, beams, profile, rows, trig, sog_error, heave_error, noise, m
         moving = model != 0
         ship = (sog * trig[3, 0, j] if moving else 0.0, sog * trig[3, 1, j] if moving else 0.0,
                 heave if model == 3 else 0.0)
-        row = i if noise.shape[0] > 1 else 0
-        for g in range(n_gates):                 # A^+ (truth + noise): the lidar-frame wind
-            x, y, z = lidar_frame[0, g], lidar_frame[1, g], lidar_frame[2, g]
-            for b in range(n_beams):
-                x += operator[0, b] * noise[row, b, g]
-                y += operator[1, b] * noise[row, b, g]
-                z += operator[2, b] * noise[row, b, g]
+        for g in range(n_gates):                     # the lidar-frame wind A^+ v
+            if rows > 1:                             # v = truth + noise
+                x = y = z = 0.0
+                for b in range(n_beams):
+                    value = truth[b, g] + noise[row, b, g]
+                    x += operator[0, b] * value
+                    y += operator[1, b] * value
+                    z += operator[2, b] * value
+            else:                                    # A^+ truth + A^+ noise
+                x, y, z = lidar_frame[0, g], lidar_frame[1, g], lidar_frame[2, g]
+                for b in range(n_beams):
+                    x += operator[0, b] * noise[row, b, g]
+                    y += operator[1, b] * noise[row, b, g]
+                    z += operator[2, b] * noise[row, b, g]
             north = rotation[0] * x + rotation[1] * y + ship[0]            # Eq. 13 [1]
             east = rotation[3] * x + rotation[4] * y + ship[1]
             up = z
