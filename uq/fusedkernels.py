@@ -208,7 +208,8 @@ def wind(constants, beams, profile, rows, trig, sog_error, heave_error, noise, m
         elif i == start:                             # one truth for all: A^+ truth once
             _truth(beams[0], profile[0], speed_ref, to_north, to_east, w, true_ship, truth)
             _solve(operator, truth, lidar_frame)
-        rotation = _reading_rotation(model, trig, j, nominal)
+        if model != 0 or i == start:             # none: the configured heading, fixed
+            rotation = _reading_rotation(model, trig, j, nominal)
         sog = sog0 + sog_error[i if sog_error.shape[0] > 1 else 0]
         heave = heave0 + heave_error[i if heave_error.shape[0] > 1 else 0]
         moving = model != 0
