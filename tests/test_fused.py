@@ -120,8 +120,6 @@ def test_only_requested_outputs():
 
 def test_not_applicable_where_the_numpy_model_is_needed():
     scene = make_scene()
-    batch = dataclasses.replace(scene, wind_speed=np.array([4.0, 8.0]))
-    assert not fused.applicable(batch, WIND, {})
     assert not fused.applicable(scene, ("radial_velocity",), {})
     assert not fused.applicable(scene, WIND, {"ins_heading": np.zeros((3, 4))})   # beam INS
     assert not fused.applicable(scene, WIND, {"lidar_half_cone": np.zeros(3) + 1e-20j})
@@ -129,13 +127,25 @@ def test_not_applicable_where_the_numpy_model_is_needed():
     assert fused.applicable(scene, WIND, {"ins_heading": np.zeros((3, 1))})    # scan INS
 
 
-def test_a_batch_of_scenes_goes_to_numpy_with_the_same_shapes(rng):
-    batch = dataclasses.replace(make_scene(), wind_speed=np.array([4.0, 8.0]))
-    single = dataclasses.replace(make_scene(), wind_speed=np.array([8.0]))
-    err = errors(rng, 20, single, ("ins_heading", "lidar_half_cone"))
-    assert measurement_model(batch, WIND, **err)["wind_speed"].shape == (20, 2, 1)
-    assert_same(measurement_model(single, WIND, **err),
-                {k: v[:, 1:] for k, v in measurement_model(batch, WIND, **err).items()})
+@pytest.mark.parametrize("model", ["yaw", "full"])
+def test_a_batch_of_scenes_agrees_with_numpy_scene_by_scene(model, rng):
+    """A sweep's batch (S = (2, 3); heading the same for all): every scene sees the
+    same draws, in the numpy model's layout (n, *S, gates)."""
+    base = make_scene(**{"correction": model, "wind.shear": 0.1, "ship.pitch": 2.0,
+                         "lidar.ranges": [50, 120]})
+    grid = np.ones((2, 3))
+    batch = dataclasses.replace(base, wind_speed=np.array([[4.0], [8.0]]) * grid,
+                                wind_direction=np.deg2rad([0.0, 90.0, 359.0]) * grid,
+                                heading=0.3)
+    err = errors(rng, 100, base, ALL_SOURCES)
+    assert fused.applicable(batch, WIND, err)
+    compiled, plain = both(batch, **err)
+    assert compiled["wind_speed"].shape == (100, 2, 3, 2)
+    assert_same(compiled, plain)
+    single = dataclasses.replace(base, wind_speed=8.0, wind_direction=np.deg2rad(90.0),
+                                 heading=0.3)
+    alone = measurement_model(single, WIND, **err)
+    np.testing.assert_array_equal(alone["wind_speed"], compiled["wind_speed"][:, 1, 1])
 
 
 @pytest.mark.parametrize("base", [0.0, 0.5, -2.0, 3.1])

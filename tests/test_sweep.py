@@ -47,6 +47,23 @@ def test_vector_sweep_equals_scene_by_scene():
                                                rtol=RTOL, atol=1e-13, err_msg=name)
 
 
+def test_compiled_sweep_equals_the_numpy_model_in_single_scene_chunks(monkeypatch):
+    """Wind outputs, scan INS: the compiled model, several scenes per chunk. The numpy
+    model scene by scene gives the same results to the ulps of two implementations."""
+    sweep = {"wind.direction": [0.0, 120.0, 359.0], "ship.pitch": [-4.0, 6.0]}
+    scenario = small(**{"sampling.n": 2**14, "sweep": sweep,
+                        "outputs": ["wind_speed", "wind_direction", "vertical_wind"]})
+    assert uq.sweep.scenes_per_chunk(scenario) > 1
+    compiled = uq.run(scenario)
+    monkeypatch.setattr(uq.sweep, "SWEEP_CHUNK_ELEMENTS_COMPILED", 1)       # 1 per chunk
+    monkeypatch.setattr("uq.fused.applicable", lambda *args, **kwargs: False)
+    assert uq.sweep.scenes_per_chunk(scenario) == 1
+    plain = uq.run(scenario)
+    for name in plain.data_vars:
+        np.testing.assert_allclose(compiled[name].values, plain[name].values,
+                                   rtol=RTOL, atol=1e-12, err_msg=name)
+
+
 def test_common_random_numbers_across_scenes_and_groups():
     """Identical scenes in a sweep, whether vectorised (wind.direction) or in separate
     groups (ins.sog.u), see the same draws: identical results, not ~1/sqrt(N) apart."""

@@ -46,6 +46,13 @@ HALF_CIRCLE_DEG = 180.0
 #: (~1 ms) is small against the arithmetic.
 SWEEP_CHUNK_ELEMENTS = 2**20
 
+#: Trial x scene x gate x output values of one sweep evaluation by the compiled model
+#: [1] (:mod:`uq.fused`: it holds no per-beam temporaries): 2^22 doubles = 32 MB of
+#: outputs, a few times that in the statistics' copies. Fewer, larger chunks draw the
+#: shared random numbers fewer times (a 2^16-trial sweep of floating_lidar_full: 7
+#: scenes per chunk instead of 1).
+SWEEP_CHUNK_ELEMENTS_COMPILED = 2**22
+
 #: von Karman constant [1]: 0.40, the value of Hogstrom (1996), Boundary-Layer
 #: Meteorol. 78, 215-246 (0.40 +- 0.01 from his review of surface-layer experiments).
 VON_KARMAN = 0.40

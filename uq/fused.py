@@ -14,10 +14,10 @@ It is a second, independent implementation of the physics (scalar code, written 
 the conventions of :mod:`uq.rotation`, :mod:`uq.beams`, :mod:`uq.wind` and
 :mod:`uq.correction`, not from the array code); ``tests/test_fused.py`` checks that the
 two agree to 1e-12 for every correction model and error source. The numpy model stays
-the reference: it alone runs complex-step (the GUM Jacobian), batches of scenes
-(vectorised sweeps), point-wise correction (``ins.correlation: beam``), independent
-draws per scene, and the outputs ``radial_velocity`` and ``gate_height``;
-:func:`applicable` says when the fused loop is used.
+the reference: it alone runs complex-step (the GUM Jacobian), point-wise correction
+(``ins.correlation: beam``), independent draws per scene, and the outputs
+``radial_velocity`` and ``gate_height``; :func:`applicable` says when the fused loop
+is used. A batch of scenes (a sweep's chunk) is evaluated scene after scene.
 
 Conventions (as in the modules named above): earth frame (north, east, up); ship frame
 (bow, starboard, up); body-to-earth ``Rz(heading) Ry(pitch) Rx(roll)``, pitch positive
@@ -51,11 +51,11 @@ _INS_ANGLES = ("heading", "pitch", "roll", "cog")
 def applicable(scene, outputs, errors, scene_draws=False):
     """Can the fused loop evaluate this call of the measurement model?
 
-    One scene (no batch of scenes), common draws, only :data:`FUSED_OUTPUTS`, real
-    errors, one INS reading per scan (``scan``) and radial noise of shape (n, beams,
-    gates) if any.
+    Common draws for every scene of a batch (not ``scene_draws``), only
+    :data:`FUSED_OUTPUTS`, real errors, one INS reading per scan (``scan``) and radial
+    noise of shape (n, beams, gates) if any.
     """
-    if np.prod(scene.shape) != 1 or scene_draws or not set(outputs) <= set(FUSED_OUTPUTS):
+    if scene_draws or not set(outputs) <= set(FUSED_OUTPUTS):
         return False
     if any(np.iscomplexobj(value) for value in errors.values()):
         return False
@@ -69,16 +69,26 @@ def applicable(scene, outputs, errors, scene_draws=False):
 def measurement_model(scene, outputs, **errors):
     """The fused equivalent of :func:`uq.measurement.measurement_model` (same inputs,
     degrees for angular errors; same outputs, each shape (n, *S, n_gates) for a batch
-    of S = one scene, e.g. (1,))."""
+    of scenes of shape S). The scenes of a batch are evaluated one after the other,
+    each with the same draws (common random numbers)."""
     shape, gates = scene.shape, len(scene.ranges)
-    scene = dataclasses.replace(scene, **{name: float(np.ravel(getattr(scene, name))[0])
-                                          for name in SCENE_FIELDS})
     n = max([len(np.atleast_1d(v)) for v in errors.values()] + [1])
-    out = {name: np.empty((n, gates)) for name in FUSED_OUTPUTS}
-    evaluate = _Blocks(scene, errors, out, "wind_direction" in outputs)
-    for start in range(0, n, FUSED_BLOCK_TRIALS):
-        evaluate(start, min(n, start + FUSED_BLOCK_TRIALS))
-    return {q: out[q].reshape((n,) + shape + (gates,)) for q in outputs}
+    result = {q: np.empty((n,) + shape + (gates,)) for q in FUSED_OUTPUTS if q in outputs}
+    scratch = {q: np.empty((n, gates)) for q in FUSED_OUTPUTS if q not in outputs}
+    for index in np.ndindex(*shape):
+        into = {q: result[q][(slice(None),) + index] if q in result else scratch[q]
+                for q in FUSED_OUTPUTS}                       # (n, gates) views
+        evaluate = _Blocks(_one_scene(scene, index), errors, into, "wind_direction" in outputs)
+        for start in range(0, n, FUSED_BLOCK_TRIALS):
+            evaluate(start, min(n, start + FUSED_BLOCK_TRIALS))
+    return {q: result[q] for q in outputs}
+
+
+def _one_scene(scene, index):
+    """Scene `index` of a batch, with float fields."""
+    return dataclasses.replace(scene, **{
+        name: float(np.broadcast_to(getattr(scene, name), scene.shape)[index])
+        for name in SCENE_FIELDS})
 
 
 class _Blocks:

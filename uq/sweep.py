@@ -18,7 +18,8 @@ import math
 
 import numpy as np
 
-from .constants import DEFAULT_BLOCKS_PER_CHUNK, RNG_BLOCK_SIZE, SWEEP_CHUNK_ELEMENTS
+from .constants import (DEFAULT_BLOCKS_PER_CHUNK, RNG_BLOCK_SIZE, SWEEP_CHUNK_ELEMENTS,
+                        SWEEP_CHUNK_ELEMENTS_COMPILED)
 
 #: Swept keys that are evaluated as arrays: dotted key -> Scene field.
 VECTOR_KEYS = {
@@ -97,6 +98,7 @@ def scenes_per_chunk(scenario):
     :data:`SWEEP_CHUNK_ELEMENTS` trial x scene x beam x gate elements.
 
     Adaptive sampling (``digits``) runs scene by scene: each scene stops on its own.
+    With the compiled model the element is trial x scene x gate x output.
     """
     sampling = scenario.sampling
     if "digits" in sampling:
@@ -110,7 +112,18 @@ def scenes_per_chunk(scenario):
         rows = 1 + (len(ins) - 1) * per_reading + len(lidar["errors"]) * beams * gates
     else:
         rows = min(sampling["n"], DEFAULT_BLOCKS_PER_CHUNK * RNG_BLOCK_SIZE)
+        if _compiled(scenario):          # no (trial, scene, beam, gate) temporaries
+            outputs = len(scenario.settings["outputs"])
+            return max(1, SWEEP_CHUNK_ELEMENTS_COMPILED // (rows * gates * outputs))
     return max(1, SWEEP_CHUNK_ELEMENTS // (rows * beams * gates))
+
+
+def _compiled(scenario):
+    """Will the Monte Carlo trials run the compiled model (:func:`uq.fused.applicable`:
+    wind outputs only, one INS reading per scan)?"""
+    from .fused import FUSED_OUTPUTS
+    return set(scenario.settings["outputs"]) <= set(FUSED_OUTPUTS) and \
+        scenario.settings["ins"]["correlation"] == "scan"
 
 
 def group_assignments(scenario, plan, group):
