@@ -125,6 +125,11 @@ def test_not_applicable_where_the_numpy_model_is_needed():
     assert not fused.applicable(scene, WIND, {"lidar_half_cone": np.zeros(3) + 1e-20j})
     assert not fused.applicable(scene, WIND, {}, scene_draws=True)
     assert fused.applicable(scene, WIND, {"ins_heading": np.zeros((3, 1))})    # scan INS
+    # a large batch (a GUM grid): the numpy model vectorises over its scenes
+    from uq.constants import FUSED_MAX_SCENES
+    for scenes, expected in ((FUSED_MAX_SCENES, True), (FUSED_MAX_SCENES + 1, False)):
+        batch = dataclasses.replace(scene, wind_speed=np.full(scenes, 5.0))
+        assert fused.applicable(batch, WIND, {}) is expected
 
 
 @pytest.mark.parametrize("model", ["yaw", "full"])

@@ -38,7 +38,7 @@ import numpy as np
 
 from . import fusedkernels as kernels
 from .beams import least_squares_operator, slant_distances
-from .constants import FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS
+from .constants import FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS, FUSED_MAX_SCENES
 from .correction import CORRECTION_MODELS
 from .measurement import NAVIGATION, SCENE_FIELDS
 from .rotation import attitude_matrix
@@ -51,11 +51,13 @@ _INS_ANGLES = ("heading", "pitch", "roll", "cog")
 def applicable(scene, outputs, errors, scene_draws=False):
     """Can the fused loop evaluate this call of the measurement model?
 
-    Common draws for every scene of a batch (not ``scene_draws``), only
+    At most :data:`~uq.constants.FUSED_MAX_SCENES` scenes, common draws for every
+    scene of the batch (not ``scene_draws``), only
     :data:`FUSED_OUTPUTS`, real errors, one INS reading per scan (``scan``) and radial
     noise of shape (n, beams, gates) if any.
     """
-    if scene_draws or not set(outputs) <= set(FUSED_OUTPUTS):
+    if scene_draws or not set(outputs) <= set(FUSED_OUTPUTS) or \
+            math.prod(scene.shape) > FUSED_MAX_SCENES:
         return False
     if any(np.iscomplexobj(value) for value in errors.values()):
         return False

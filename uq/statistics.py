@@ -333,6 +333,11 @@ class _Tail:
             self.threshold = self.buffer[:self.size].max()
 
 
+#: Up to this many columns a batch's endpoints come from bracketed selection, column by
+#: column (2-4x faster than numpy.partition per column, but a Python loop over them).
+_SELECTION_COLUMNS = 8
+
+
 def _symmetric_ranks(m, probability):
     """0-based ranks of the probabilistically symmetric endpoints among M sorted values
     (those :func:`coverage_interval` picks); () when M is too small for an interval."""
@@ -361,10 +366,15 @@ def batch_statistics(values, reference=None, probability=COVERAGE_PROBABILITY,
     low, high = np.full(flat.shape[1], np.nan), np.full(flat.shape[1], np.nan)
     ranks = _symmetric_ranks(len(flat), probability)
     if kind == "symmetric" and ranks and np.all(moments.count == len(flat)):
-        # all values finite: just the two order statistics (JCGM 101 7.7.2)
-        columns = np.ascontiguousarray(flat.T)
-        picked = np.array([order_statistics(column, ranks) for column in columns])
-        low, high = picked[:, 0].copy(), picked[:, 1].copy()     # not views of the batch
+        # all values finite: just the two order statistics (JCGM 101 7.7.2); by bracketed
+        # selection for a few columns, else one partition vectorised over the columns
+        if flat.shape[1] <= _SELECTION_COLUMNS:
+            picked = np.array([order_statistics(np.ascontiguousarray(column), ranks)
+                               for column in flat.T])
+            low, high = picked[:, 0].copy(), picked[:, 1].copy()  # not views of the batch
+        else:
+            picked = np.partition(flat, ranks, axis=0)
+            low, high = picked[ranks[0]].copy(), picked[ranks[1]].copy()
     else:
         for j, m in enumerate(moments.count):
             column = np.sort(flat[:, j][np.isfinite(flat[:, j])])   # -inf would sort first

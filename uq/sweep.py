@@ -18,8 +18,8 @@ import math
 
 import numpy as np
 
-from .constants import (DEFAULT_BLOCKS_PER_CHUNK, RNG_BLOCK_SIZE, SWEEP_CHUNK_ELEMENTS,
-                        SWEEP_CHUNK_ELEMENTS_COMPILED)
+from .constants import (DEFAULT_BLOCKS_PER_CHUNK, FUSED_MAX_SCENES, RNG_BLOCK_SIZE,
+                        SWEEP_CHUNK_ELEMENTS, SWEEP_CHUNK_ELEMENTS_COMPILED)
 
 #: Swept keys that are evaluated as arrays: dotted key -> Scene field.
 VECTOR_KEYS = {
@@ -114,7 +114,8 @@ def scenes_per_chunk(scenario):
         rows = min(sampling["n"], DEFAULT_BLOCKS_PER_CHUNK * RNG_BLOCK_SIZE)
         if _compiled(scenario):          # no (trial, scene, beam, gate) temporaries
             outputs = len(scenario.settings["outputs"])
-            return max(1, SWEEP_CHUNK_ELEMENTS_COMPILED // (rows * gates * outputs))
+            return int(np.clip(SWEEP_CHUNK_ELEMENTS_COMPILED // (rows * gates * outputs),
+                               1, FUSED_MAX_SCENES))
     return max(1, SWEEP_CHUNK_ELEMENTS // (rows * beams * gates))
 
 
