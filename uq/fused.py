@@ -40,11 +40,11 @@ from . import fusedkernels as kernels
 from .beams import least_squares_operator, slant_distances
 from .constants import FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS, FUSED_MAX_SCENES
 from .correction import CORRECTION_MODELS
-from .measurement import NAVIGATION, SCENE_FIELDS
+from .measurement import COMPILED_OUTPUTS, NAVIGATION, SCENE_FIELDS
 from .rotation import attitude_matrix
 
 #: Outputs the fused loop computes; any other requested output uses the numpy model.
-FUSED_OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind")
+FUSED_OUTPUTS = COMPILED_OUTPUTS
 _INS_ANGLES = ("heading", "pitch", "roll", "cog")
 
 

@@ -59,6 +59,8 @@ SCENE_FIELDS = ("wind_speed", "wind_direction", "vertical_wind", "shear", "refer
                 "sog", "cog", "heading", "pitch", "roll", "heave", "lidar_height",
                 "half_cone", "misalignment")
 OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity", "gate_height")
+#: The outputs the compiled model (:mod:`uq.fused`) computes.
+COMPILED_OUTPUTS = OUTPUTS[:3]
 NAVIGATION = ("heading", "pitch", "roll", "sog", "cog", "heave")
 ANGULAR_NAVIGATION = ("heading", "pitch", "roll", "cog")
 
@@ -225,9 +227,10 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
         shape (n, *S, n_gates); ``radial_velocity`` [m s-1] (n, *S, n_beams, n_gates), the
         motion-corrected radial velocity along the beam the correction believes in.
     """
-    from . import fused                     # (imports this module's constants)
-    if compiled and fused.applicable(scene, outputs, errors, scene_draws):
-        return fused.measurement_model(scene, outputs, **errors)   # the same, compiled
+    if compiled and not scene_draws and set(outputs) <= set(COMPILED_OUTPUTS):
+        from . import fused                 # (numba: imported only where it may apply)
+        if fused.applicable(scene, outputs, errors, scene_draws):
+            return fused.measurement_model(scene, outputs, **errors)   # the same, compiled
     n = _sample_count(errors)
     scenes = scene.shape if scene_draws else (1,) * len(scene.shape)
     err = {name: _error_shape(np.asarray(errors.get(name, 0.0)), name, scenes, scene_draws)

@@ -122,8 +122,8 @@ def scenes_per_chunk(scenario):
 def _compiled(scenario):
     """Will the Monte Carlo trials run the compiled model (:func:`uq.fused.applicable`:
     wind outputs only, one INS reading per scan)?"""
-    from .fused import FUSED_OUTPUTS
-    return set(scenario.settings["outputs"]) <= set(FUSED_OUTPUTS) and \
+    from .measurement import COMPILED_OUTPUTS
+    return set(scenario.settings["outputs"]) <= set(COMPILED_OUTPUTS) and \
         scenario.settings["ins"]["correlation"] == "scan"
 
 
