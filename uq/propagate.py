@@ -14,9 +14,8 @@ import xarray as xr
 
 from . import controlvariate, gum
 from .constants import (ADAPTIVE_MAX_SAMPLES, BATCH_SIZE, COVERAGE_PROBABILITY,
-                        VALIDATION_TOLERANCE_FRACTION,
                         DEFAULT_BLOCKS_PER_CHUNK, DEFAULT_DIGITS, FULL_CIRCLE_DEG,
-                        MODEL_SLICE_VALUES, RNG_BLOCK_SIZE)
+                        MODEL_SLICE_VALUES, RNG_BLOCK_SIZE, VALIDATION_TOLERANCE_FRACTION)
 from .inputs import input_set
 from .sampling import PROPAGATION_METHODS, new_seed, normal_scores
 from .stopping import STOPPING_RULES, gum_validated, may_stop
@@ -289,12 +288,20 @@ class _Runner:
         result = self.stats[q].result(kind=self.interval)
         if self.control:
             moments = self.linear[q]
-            result["u"] = controlvariate.controlled_u(self.control[q][1], result["u"] ** 2,
-                                                      moments.variance())
+            result["u"] = self.u(q)
             result["mean"] = result["mean"] - moments.mean
             if self.references[q] is not None:
                 result["mean"] = np.mod(result["mean"], FULL_CIRCLE_DEG)
         return result
+
+    def u(self, q):
+        """u of output q so far (control variate applied), from the moments alone: no
+        coverage interval (its order statistics cost a pass over every kept value)."""
+        u = np.sqrt(self.stats[q].moments.variance())
+        if self.control:
+            u = controlvariate.controlled_u(self.control[q][1], u ** 2,
+                                            self.linear[q].variance())
+        return u
 
     def u_standard_error(self, q):
         """Standard error of u from its spread over the h independent batches (NaN < 2)."""
@@ -356,7 +363,7 @@ class _Runner:
         """Every output's mean, u and endpoints stable to `fraction` of the tolerance of
         `digits` under the rule."""
         return all(may_stop(stopping, [np.array(self.batches[q][key]) for key in _BATCH_KEYS],
-                            fraction * gum.numerical_tolerance(self.result(q)["u"], digits),
+                            fraction * gum.numerical_tolerance(self.u(q), digits),
                             check)
                    for q in self.stats)
 
