@@ -40,7 +40,7 @@ from . import fusedkernels as kernels
 from .beams import least_squares_operator, slant_distances
 from .constants import FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS, FUSED_MAX_SCENES
 from .correction import CORRECTION_MODELS
-from .measurement import COMPILED_OUTPUTS, NAVIGATION, SCENE_FIELDS
+from .measurement import COMPILED_OUTPUTS, NAVIGATION, SCENE_FIELDS, _sample_count
 from .rotation import attitude_matrix
 
 #: Outputs the fused loop computes; any other requested output uses the numpy model.
@@ -74,7 +74,7 @@ def measurement_model(scene, outputs, **errors):
     of scenes of shape S). The scenes of a batch are evaluated one after the other,
     each with the same draws (common random numbers)."""
     shape, gates = scene.shape, len(scene.ranges)
-    n = max([len(np.atleast_1d(v)) for v in errors.values()] + [1])
+    n = _sample_count(errors)
     result = {q: np.empty((n,) + shape + (gates,)) for q in FUSED_OUTPUTS if q in outputs}
     scratch = {q: np.empty((n, gates)) for q in FUSED_OUTPUTS if q not in outputs}
     for index in np.ndindex(*shape):
@@ -186,11 +186,10 @@ def _scene_constants(scene):
     operator = least_squares_operator(scene.nominal_unit_vectors())           # (3, b)
     slant = slant_distances(scene.ranges, scene.half_cone, len(azimuths),
                             scene.vertical_beam)                             # (b, g)
-    head = [len(azimuths), int(scene.vertical_beam), len(scene.ranges), scene.half_cone,
-            scene.misalignment, scene.lidar_height, scene.wind_speed, scene.reference_height,
-            scene.shear, -math.cos(scene.wind_direction), -math.sin(scene.wind_direction),
-            scene.vertical_wind, scene.sog, scene.cog, scene.heave, scene.heading,
-            scene.pitch, scene.roll]
+    head = {"n_slanted": len(azimuths), "vertical_beam": int(scene.vertical_beam),
+            "n_gates": len(scene.ranges), "to_north": -math.cos(scene.wind_direction),
+            "to_east": -math.sin(scene.wind_direction)}      # (wind "from": blows to -e)
+    head = [head[name] if name in head else getattr(scene, name) for name in kernels.HEAD]
     attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
     return np.concatenate([np.asarray(head, dtype=float), np.cos(azimuths),
                            np.sin(azimuths), attitude.ravel(),

@@ -86,30 +86,37 @@ def _hypot(x, y):
     return radius if HYPOT_SAFE_MIN < radius < HYPOT_SAFE_MAX else math.hypot(x, y)
 
 
-# the scene vector (uq.fused.scene_constants): 18 scalars, the azimuths' cosines then
-# sines, the true attitude (3 x 3), the least-squares operator (3 x b), slant ranges (b x g)
+#: The scene vector (:func:`uq.fused.scene_constants`) starts with these scalars, by
+#: index; then come the azimuths' cosines and sines, the true attitude (3 x 3), the
+#: least-squares operator (3 x b) and the slant ranges (b x g).
+HEAD = ("n_slanted", "vertical_beam", "n_gates", "lidar_height", "wind_speed",
+        "reference_height", "to_north", "to_east", "vertical_wind", "sog", "cog", "heave",
+        "heading")
+_HEAD = len(HEAD)
+
+
 @njit(cache=True)
 def _azimuths(constants):
-    return constants[18:18 + 2 * int(constants[0])]
+    return constants[_HEAD:_HEAD + 2 * int(constants[0])]
 
 
 @njit(cache=True)
 def _attitude(constants):
-    at = 18 + 2 * int(constants[0])
+    at = _HEAD + 2 * int(constants[0])
     return constants[at:at + 9].reshape(3, 3)
 
 
 @njit(cache=True)
 def _operator(constants):
     n_beams = int(constants[0]) + int(constants[1])
-    at = 27 + 2 * int(constants[0])
+    at = _HEAD + 9 + 2 * int(constants[0])
     return constants[at:at + 3 * n_beams].reshape(3, n_beams)
 
 
 @njit(cache=True)
 def _slant(constants):
     n_beams = int(constants[0]) + int(constants[1])
-    at = 27 + 2 * int(constants[0]) + 3 * n_beams
+    at = _HEAD + 9 + 2 * int(constants[0]) + 3 * n_beams
     return constants[at:at + n_beams * int(constants[2])].reshape(n_beams, int(constants[2]))
 
 
@@ -150,7 +157,7 @@ def geometry(constants, cone, misalignment, height_error, start, rows, shear, be
     the power law). ``cone`` and ``misalignment`` hold (cos, sin) rows from
     :func:`angle_trig`. Without ``shear`` the ratio is not needed: 1 (or NaN)."""
     n_slanted, vertical_beam, n_gates = int(constants[0]), int(constants[1]), int(constants[2])
-    lidar_height, reference_height = constants[5], constants[7]
+    lidar_height, reference_height = constants[3], constants[5]
     azimuths, attitude, slant = _azimuths(constants), _attitude(constants), _slant(constants)
     for j in range(rows):
         base = lidar_height + height_error[start + j if height_error.shape[0] > 1 else 0]
@@ -190,8 +197,8 @@ def wind(constants, beams, profile, rows, trig, sog_error, heave_error, noise, m
     """
     n_slanted, vertical_beam, n_gates = int(constants[0]), int(constants[1]), int(constants[2])
     n_beams = n_slanted + vertical_beam
-    speed_ref, to_north, to_east, w = constants[6], constants[9], constants[10], constants[11]
-    sog0, cog0, heave0, heading0 = constants[12], constants[13], constants[14], constants[15]
+    speed_ref, to_north, to_east, w = constants[4], constants[6], constants[7], constants[8]
+    sog0, cog0, heave0, heading0 = constants[9], constants[10], constants[11], constants[12]
     true_ship = (sog0 * math.cos(cog0), sog0 * math.sin(cog0), heave0)
     operator = _operator(constants)
     nominal = (math.cos(heading0), math.sin(heading0))

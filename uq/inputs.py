@@ -168,16 +168,14 @@ def _is_normal(distribution):
 
 
 def _inverse_cdf(distribution, z):
-    """Input values with normal scores `z`; exact in both tails.
+    """Values of a non-normal input with normal scores `z`; exact in both tails.
 
-    Normal inputs are ``loc + scale z`` (no round trip through probabilities), uniform
-    ones ``a + w Phi(z)``. Others use
-    ``ppf(Phi(z))`` for z <= 0 and ``isf(Phi(-z))`` for z > 0, so that upper-tail
-    probabilities keep their relative precision.
+    (Normal inputs are ``loc + scale z``, made for all of them at once by
+    :meth:`InputSet.values`: no round trip through probabilities.) Uniform inputs are
+    ``a + w Phi(z)``. Others use ``ppf(Phi(z))`` for z <= 0 and ``isf(Phi(-z))`` for
+    z > 0, so that upper-tail probabilities keep their relative precision.
     """
     family = getattr(getattr(distribution, "dist", None), "name", None)
-    if family == "norm":
-        return distribution.mean() + distribution.std() * z
     if family == "uniform":
         # ppf(p) = a + w p, written out (scipy's generic ppf makes several argument-
         # checking passes). One tail is enough here: the value's absolute error is

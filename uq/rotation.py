@@ -45,7 +45,6 @@ References
 import numpy as np
 
 
-
 def _matrix(rows):
     """Stack nested lists of broadcastable arrays into shape (..., 3, 3)."""
     arrays = np.broadcast_arrays(*[np.asarray(e) for row in rows for e in row])
