@@ -239,11 +239,20 @@ class StreamingStatistics:
         return column[np.isfinite(column)]
 
     def _symmetric(self, j, m, probability):
-        """JCGM 101 7.7.2 endpoints of element j from all stored values: just the two
-        order statistics (:func:`uq.orderstats.order_statistics`), no sorted tails."""
+        """JCGM 101 7.7.2 endpoints of element j: just the two order statistics
+        (:func:`uq.orderstats.order_statistics`) of the stored values or of the tails,
+        no sorting (NaN when the tails hold too few values, as in coverage_interval)."""
         ranks = _symmetric_ranks(m, probability)
-        return tuple(order_statistics(self._stored_column(j), ranks)) if ranks \
-            else (np.nan, np.nan)
+        if not ranks:
+            return np.nan, np.nan
+        if self._stored is not None:
+            return tuple(order_statistics(self._stored_column(j), ranks))
+        low_values, high_values = self._low[j].values(), -self._high[j].values()
+        high_index = ranks[1] - (m - len(high_values))      # the high tail's top ranks
+        if ranks[0] >= len(low_values) or high_index < 0:
+            return np.nan, np.nan
+        return (order_statistics(low_values, [ranks[0]])[0],
+                order_statistics(high_values, [high_index])[0])
 
     def _extremes(self, j):
         """(smallest, largest) kept values of element j, each ascending, and their count."""
@@ -273,7 +282,7 @@ class StreamingStatistics:
         mean = np.where(count > 0, self.moments.mean, np.nan)
         low, high = np.full(self.shape, np.nan), np.full(self.shape, np.nan)
         for j, m in enumerate(count.reshape(-1)):
-            if kind == "symmetric" and self._stored is not None:
+            if kind == "symmetric":
                 bounds = self._symmetric(j, int(m), probability)
             else:
                 bounds = coverage_interval(*self._extremes(j), int(m), probability, kind)
