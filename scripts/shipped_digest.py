@@ -1,0 +1,82 @@
+"""Digest of every shipped scenario's results, to show that a change alters no number.
+
+    python scripts/shipped_digest.py > before.json      # on the old version
+    python scripts/shipped_digest.py --compare before.json   # on the new one
+
+Each scenario runs as shipped (``uq run``'s code path, ``uq golden`` for golden
+configurations); the digest is a SHA-256 of every variable's and coordinate's bytes and
+of the attributes that are not timings. Bit-identical results give identical digests.
+"""
+import argparse
+import contextlib
+import io
+import hashlib
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+VOLATILE = ("runtime_s", "history", "uq_version")
+
+
+def digest(dataset):
+    """Variable name -> SHA-256 of its dtype, shape and bytes (and its attributes)."""
+    out = {}
+    for name in sorted(dataset.variables):
+        values = np.ascontiguousarray(dataset.variables[name].values)
+        h = hashlib.sha256(f"{values.dtype}{values.shape}".encode())
+        h.update(values.tobytes() if values.dtype != object else repr(values.tolist()).encode())
+        h.update(repr(sorted(dataset.variables[name].attrs.items(), key=str)).encode())
+        out[name] = h.hexdigest()[:16]
+    attrs = {k: v for k, v in dataset.attrs.items() if k not in VOLATILE}
+    out["attrs"] = hashlib.sha256(repr(sorted(attrs.items(), key=str)).encode()).hexdigest()[:16]
+    return out
+
+
+def shipped():
+    """Name -> digest of every shipped scenario's results."""
+    import uq
+    from uq.cli import main
+    results = {}
+    for path in sorted(SCENARIOS.glob("*.yaml")):
+        text = path.read_text()
+        if "golden:" in text:
+            if "synthetic" not in text and "comparisons" not in text:
+                continue
+            with tempfile.TemporaryDirectory() as folder:
+                with contextlib.redirect_stdout(io.StringIO()):
+                    main(["golden", str(path), "-o", str(Path(folder) / "g")])
+                nc = next((Path(folder) / "g").glob("*.nc"))
+                with xr.open_dataset(nc) as ds:
+                    results[path.stem] = digest(ds.load())
+            continue
+        print(f"running {path.name}", file=sys.stderr)
+        results[path.stem] = digest(uq.run(str(path)))
+    return results
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--compare", help="digest file of the earlier version")
+    args = parser.parse_args()
+    now = shipped()
+    if not args.compare:
+        json.dump(now, sys.stdout, indent=1)
+        return 0
+    before = json.loads(Path(args.compare).read_text())
+    differ = [(s, v) for s in before for v in before[s]
+              if now.get(s, {}).get(v) != before[s][v]]
+    differ += [(s, v) for s in now for v in now[s] if v not in before.get(s, {})]
+    for s, v in differ:
+        print(f"differs: {s} {v}")
+    print(f"{len(before)} scenarios, {sum(map(len, before.values()))} variables: "
+          f"{'bit-identical' if not differ else f'{len(differ)} differ'}")
+    return 1 if differ else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
