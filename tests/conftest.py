@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from uq.pipeline import scene_from_settings
-from uq.scenario import load_scenario
+from uq.pipeline.runner import scene_from_settings
+from uq.pipeline.scenario import load_scenario
 
 
 def make_scene(**changes):

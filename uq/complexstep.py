@@ -16,7 +16,7 @@ References
 """
 import numpy as np
 
-from .constants import HYPOT_SAFE_MAX, HYPOT_SAFE_MIN
+from uq.constants import HYPOT_SAFE_MAX, HYPOT_SAFE_MIN
 
 
 def arctan2(y, x):

@@ -47,7 +47,7 @@ HALF_CIRCLE_DEG = 180.0
 SWEEP_CHUNK_ELEMENTS = 2**20
 
 #: Trial x scene x gate x output values of one sweep evaluation by the compiled model
-#: [1] (:mod:`uq.fused`: it holds no per-beam temporaries): 2^22 doubles = 32 MB of
+#: [1] (:mod:`uq.physics.fused`: it holds no per-beam temporaries): 2^22 doubles = 32 MB of
 #: outputs, a few times that in the statistics' copies. Fewer, larger chunks draw the
 #: shared random numbers fewer times (a 2^16-trial sweep of floating_lidar_full: 7
 #: scenes per chunk instead of 1).
@@ -119,14 +119,14 @@ HYPOT_SAFE_MIN, HYPOT_SAFE_MAX = 1e-150, 1e150
 MODEL_SLICE_VALUES = 2**18
 
 #: Output values per statistic kept whole before only the tails are kept [1]
-#: (:class:`uq.statistics.StreamingStatistics`): 2^23 doubles = 64 MB. Below it the
+#: (:class:`uq.engine.statistics.StreamingStatistics`): 2^23 doubles = 64 MB. Below it the
 #: interval endpoints come from one partition at the end (exact, the same order
 #: statistics), which is ~3x cheaper than maintaining the tails batch by batch; above it
 #: memory stays bounded (10^8 trials).
 STORED_VALUES = 2**23
 
 #: Largest |angular error| [rad] whose sine and cosine the compiled model takes from
-#: their Taylor polynomials (sin to x^15, cos to x^16; :mod:`uq.fusedkernels`) [1].
+#: their Taylor polynomials (sin to x^15, cos to x^16; :mod:`uq.physics.fusedkernels`) [1].
 #: The first omitted terms relative to the result, x^16/17! = 6.5e-25 (sin x ~ x) and
 #: x^18/18! = 1.1e-26 (cos x > 0.96) at 0.25 rad, are far below half an ulp (1.1e-16),
 #: so the polynomials are as exact as libm. Larger errors use libm (14 deg covers INS
@@ -140,6 +140,6 @@ SMALL_ANGLE = 0.25
 FUSED_BLOCK_TRIALS = 2**12
 
 #: Size of the strided sample that brackets an order statistic [1]
-#: (:mod:`uq.orderstats`): its sort costs ~20 us; the brackets it gives hold ~1 % of
+#: (:mod:`uq.engine.orderstats`): its sort costs ~20 us; the brackets it gives hold ~1 % of
 #: the values around each wanted rank. [1] Floyd and Rivest (1975), sample selection.
 ORDER_SAMPLE = 1024

@@ -1,12 +1,50 @@
-"""Exceptions with messages meant for users."""
+"""Exceptions with messages meant for users: one hierarchy for every kind of bad input.
+
+:class:`InputError` is the base: the command line prints ``str(error)`` on one line and
+exits with status 2 (no traceback, no output file). Its subclasses say what was bad:
+
+* :class:`ScenarioError`: a scenario or configuration file (YAML), a ``--set`` value or a
+  command-line argument;
+* :class:`DataFileError`: a data file the tool reads (results netCDF, CSV tables, the
+  records of a golden-lidar campaign);
+* :class:`CheckpointError`: the checkpoint folder of an interrupted run;
+* :class:`OutputError`: an output the tool may not write (a name that is a path, a
+  target it did not create, a folder it cannot write).
+
+Each names the source (file or option), the key (dotted scenario key, column, path) and
+what is allowed.
+"""
 
 
-class ScenarioError(ValueError):
-    """Bad input: names the file, the key and what is allowed.
+class InputError(ValueError):
+    """Bad input: names the source, the key and what is allowed.
 
-    The command line prints ``str(error)`` on one line and exits with status 2.
+    Parameters
+    ----------
+    source : str
+        The file or command-line option the bad value came from.
+    key : str
+        The dotted key, column or path inside it ('' when the whole source is bad).
+    problem : str
+        What is wrong and what is allowed.
     """
 
     def __init__(self, source, key, problem):
         self.source, self.key, self.problem = source, key, problem
         super().__init__(f"{source}: {key}: {problem}" if key else f"{source}: {problem}")
+
+
+class ScenarioError(InputError):
+    """A scenario or configuration (YAML), a ``--set`` value or a command-line argument."""
+
+
+class DataFileError(InputError):
+    """A data file the tool reads: results, CSV tables, campaign records."""
+
+
+class CheckpointError(InputError):
+    """The checkpoint folder of an interrupted run (``--resume``)."""
+
+
+class OutputError(InputError):
+    """An output the tool may not write or replace."""

@@ -13,7 +13,7 @@ Dimensions: ``comparison`` (``unit-reference``), ``height`` [m], ``bin`` (centre
 import numpy as np
 import xarray as xr
 
-from ..errors import ScenarioError
+from uq.errors import ScenarioError
 from . import binning, calibration, classification, kpi
 from .records import align, load_records
 

@@ -11,7 +11,7 @@ References
 """
 import numpy as np
 
-from ..constants import GOLDEN_BIN_WIDTH, GOLDEN_MIN_RECORDS, GOLDEN_REQUIRED_RANGE
+from uq.constants import GOLDEN_BIN_WIDTH, GOLDEN_MIN_RECORDS, GOLDEN_REQUIRED_RANGE
 
 
 def bin_index(speed, width=GOLDEN_BIN_WIDTH):

@@ -26,13 +26,13 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from ..constants import FULL_CIRCLE_DEG
-from ..data import brightwind_mast
-from ..inputs import Input
-from ..measurement import measurement_model
-from ..pipeline import error_inputs, scene_from_settings
-from ..scenario import load_scenario
-from ..statistics import circular_mean_deg
+from uq.constants import FULL_CIRCLE_DEG
+from uq.data import brightwind_mast
+from uq.engine.inputs import Input
+from uq.physics.measurement import measurement_model
+from uq.pipeline.runner import error_inputs, scene_from_settings
+from uq.pipeline.scenario import load_scenario
+from uq.engine.statistics import circular_mean_deg
 
 #: brightwind demo mast: height [m] -> (speed, its standard deviation, vane) columns.
 MAST_COLUMNS = {80.0: ("Spd80mN", "Spd80mNStd", "Dir78mS"),

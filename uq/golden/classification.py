@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from ..constants import GOLDEN_SIGNIFICANCE
+from uq.constants import GOLDEN_SIGNIFICANCE
 
 PERCENT = 100.0
 RECTANGULAR_DIVISOR = np.sqrt(3.0)       # JCGM 100:2008, 4.3.7: u = a / sqrt(3)

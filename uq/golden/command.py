@@ -5,8 +5,9 @@ The folder (default ``results/<name>/``) holds ``<name>.nc`` (every table),
 ``tables/per_bin.csv``, ``tables/sensitivity.csv``, ``tables/kpi.csv``, ``figures/*.png``,
 ``report.html`` (self-contained) and ``report.md``; for a synthetic campaign also
 ``data/`` (the generated records and their ``campaign.yaml``, the form a real campaign's
-configuration takes). Everything is written into ``.<name>.partial/`` beside it and
-renamed at the end, so a failure leaves no half-written folder.
+configuration takes). Everything is written into a fresh temporary folder beside it and
+renamed into place at the end (:func:`uq.files.replace_folder`), so a failure leaves no
+half-written folder, and a folder uq did not write is never replaced.
 """
 import shutil
 import sys
@@ -14,7 +15,8 @@ from pathlib import Path
 
 import matplotlib
 
-from ..io import write_results
+from uq.files import (check_target, new_partial_folder, replace_folder, save_figure,
+                      write_netcdf, write_text)
 from .analysis import analyse
 from .config import load_golden_config
 from .findings import thin_bins
@@ -40,8 +42,9 @@ def run_golden(config_path, output=None, stream=None, errors=None):
     stream, errors = stream or sys.stdout, errors or sys.stderr
     config = load_golden_config(config_path)
     folder = Path(output) if output else Path("results") / config.name
-    partial = folder.with_name(f".{folder.name}.partial")
-    shutil.rmtree(partial, ignore_errors=True)
+    if folder.exists() and not folder.is_dir():
+        check_target(folder)                  # a file at the target: refused
+    partial = new_partial_folder(folder)
     try:
         if config.synthetic is not None:
             from .campaign import generate_campaign
@@ -51,8 +54,7 @@ def run_golden(config_path, output=None, stream=None, errors=None):
     except BaseException:
         shutil.rmtree(partial, ignore_errors=True)
         raise
-    shutil.rmtree(folder, ignore_errors=True)
-    partial.rename(folder)
+    replace_folder(partial, folder, kind="golden")
     for key, height, bins in thin_bins(ds):
         print(f"uq golden: warning: {key} at {height:g} m: required bins with too few "
               f"records: {', '.join(f'{b:g} m/s ({n})' for b, n in bins)}", file=errors)
@@ -68,7 +70,7 @@ def _write(ds, folder, name):
     import matplotlib.pyplot as plt
     (folder / "tables").mkdir(parents=True, exist_ok=True)
     (folder / "figures").mkdir(exist_ok=True)
-    write_results(ds, folder / f"{name}.nc")
+    write_netcdf(ds, folder / f"{name}.nc")
     for table, frame in golden_tables(ds).items():
         frame.to_csv(folder / "tables" / f"{table}.csv", float_format="%.6g")
     height = float(ds["height"].max())
@@ -82,12 +84,12 @@ def _write(ds, folder, name):
     for stem, (draw, caption) in drawings.items():
         fig = draw(ds, height)
         path = folder / "figures" / f"{stem}.png"
-        fig.savefig(path, dpi=90)
+        save_figure(fig, path, dpi=90)
         plt.close(fig)
         figures[f"{caption}, {height:g} m"] = path
     blocks = report_blocks(ds, figures, height)
-    (folder / "report.md").write_text(render_markdown(blocks))
-    (folder / "report.html").write_text(render_html(blocks))
+    write_text(folder / "report.md", render_markdown(blocks))
+    write_text(folder / "report.html", render_html(blocks))
 
 
 def golden_tables(ds):

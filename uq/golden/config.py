@@ -10,10 +10,11 @@ and what is allowed.
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..constants import (GOLDEN_BIN_WIDTH, GOLDEN_MIN_RECORDS, GOLDEN_REQUIRED_RANGE,
+from uq.constants import (GOLDEN_BIN_WIDTH, GOLDEN_MIN_RECORDS, GOLDEN_REQUIRED_RANGE,
                          GOLDEN_SIGNIFICANCE, KPI_AVAILABILITY)
-from ..errors import ScenarioError
-from ..scenario import Checker, read_yaml
+from uq.errors import ScenarioError
+from uq.files import check_name
+from uq.pipeline.scenario import Checker, read_yaml
 
 TOP_KEYS = ("name", "description", "instruments", "comparisons", "smc", "classification",
             "bins", "kpi", "synthetic")
@@ -81,7 +82,7 @@ def validate_golden(raw, check, base):
     `base`."""
     check.mapping(raw, "golden")
     check.keys(raw, "golden", TOP_KEYS)
-    settings = {"name": check.text(raw.get("name", "golden"), "golden.name"),
+    settings = {"name": check_name(raw.get("name", "golden"), check.source, "golden.name"),
                 "source": check.source,
                 "description": check.text(raw.get("description", ""), "golden.description")}
     settings.update(_bins(check, raw.get("bins") or {}))

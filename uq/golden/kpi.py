@@ -22,7 +22,7 @@ minimum bound only, ``fail`` otherwise, ``no data`` when it cannot be computed.
 """
 import numpy as np
 
-from ..constants import (FULL_CIRCLE_DEG, HALF_CIRCLE_DEG, KPI_DIRECTION_OFFSET_DEG,
+from uq.constants import (FULL_CIRCLE_DEG, HALF_CIRCLE_DEG, KPI_DIRECTION_OFFSET_DEG,
                          KPI_DIRECTION_R2, KPI_DIRECTION_SLOPE, KPI_SPEED_R2,
                          KPI_SPEED_SLOPE)
 

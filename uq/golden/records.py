@@ -6,7 +6,7 @@ The result has dimensions ``time`` and ``height`` [m] and variables ``speed`` [m
 environmental variable. Values that are not numbers become NaN and are counted in the
 attribute ``n_invalid``; nothing is dropped silently.
 
-Checks (each a one-line :class:`uq.errors.ScenarioError` naming the file and the key):
+Checks (each a one-line :class:`uq.errors.DataFileError` naming the file and the key):
 missing file or column, unreadable or repeated timestamps, records not 10 min apart,
 negative speeds or speeds that look like km/h or knots, directions outside [-360, 360] or
 that look like radians.
@@ -17,8 +17,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from ..constants import FULL_CIRCLE_DEG
-from ..errors import ScenarioError
+from uq.constants import FULL_CIRCLE_DEG
+from uq.errors import DataFileError
 
 RECORD_MINUTES = 10
 #: Largest plausible median 10-min wind speed [m s-1]: a median above this is a unit
@@ -32,7 +32,7 @@ def read_table(instrument):
     """The file's table (pandas) with a DatetimeIndex named ``time``."""
     path, source = instrument.file, str(instrument.file)
     if not path.exists():
-        raise ScenarioError(source, f"instruments.{instrument.name}.file",
+        raise DataFileError(source, f"instruments.{instrument.name}.file",
                             "no such file; allowed: a CSV or netCDF file of 10-min records")
     if path.suffix == ".nc":
         with xr.open_dataset(path) as ds:
@@ -41,14 +41,14 @@ def read_table(instrument):
         table = pd.read_csv(path)
     key = f"instruments.{instrument.name}.time"
     if instrument.time not in table.columns:
-        raise ScenarioError(source, key, f"no column {instrument.time!r}; allowed: "
+        raise DataFileError(source, key, f"no column {instrument.time!r}; allowed: "
                             f"{_listing(table.columns)}")
     with warnings.catch_warnings():      # pandas warns when it parses element by element
         warnings.simplefilter("ignore", UserWarning)
         time = pd.to_datetime(table[instrument.time], errors="coerce")
     if time.isna().any():
         row = int(np.flatnonzero(time.isna())[0])
-        raise ScenarioError(source, key, f"timestamp {table[instrument.time].iloc[row]!r} "
+        raise DataFileError(source, key, f"timestamp {table[instrument.time].iloc[row]!r} "
                             f"(row {row + 1}) is not a date and time")
     table.index = pd.DatetimeIndex(time, name="time")
     _check_times(table.index, source, key)
@@ -87,10 +87,10 @@ def align(unit, reference):
     heights = np.intersect1d(unit["height"].values, reference["height"].values)
     names = f"{unit.attrs['instrument']} and {reference.attrs['instrument']}"
     if len(heights) == 0:
-        raise ScenarioError(unit.attrs["file"], "heights", f"{names} share no height "
+        raise DataFileError(unit.attrs["file"], "heights", f"{names} share no height "
                             f"({_heights(unit)} against {_heights(reference)})")
     if len(times) == 0:
-        raise ScenarioError(unit.attrs["file"], "time", f"{names} share no timestamp "
+        raise DataFileError(unit.attrs["file"], "time", f"{names} share no timestamp "
                             f"({_span(unit)} against {_span(reference)}); check the period "
                             "and the time zone")
     counts = {"only_unit": unit.sizes["time"] - len(times),
@@ -118,7 +118,7 @@ def _numbers(table, column, source, key):
     if column is None:
         return np.full(len(table), np.nan), 0
     if column not in table.columns:
-        raise ScenarioError(source, key, f"no column {column!r}; allowed: "
+        raise DataFileError(source, key, f"no column {column!r}; allowed: "
                             f"{_listing(table.columns)}")
     values = pd.to_numeric(table[column], errors="coerce").to_numpy(dtype=float)
     bad = int(np.sum(np.isnan(values)) - np.sum(table[column].isna()))
@@ -127,22 +127,22 @@ def _numbers(table, column, source, key):
 
 def _check_times(index, source, key):
     if index.has_duplicates:
-        raise ScenarioError(source, key, f"timestamp {index[index.duplicated()][0]} repeats; "
+        raise DataFileError(source, key, f"timestamp {index[index.duplicated()][0]} repeats; "
                             "allowed: one record per 10-min period")
     if len(index) > 1:
         steps = np.diff(index.sort_values().values) / np.timedelta64(1, "m")
         if np.median(steps) != RECORD_MINUTES:
-            raise ScenarioError(source, key, f"records are {np.median(steps):g} min apart "
+            raise DataFileError(source, key, f"records are {np.median(steps):g} min apart "
                                 "(median); allowed: 10-min records")
 
 
 def _check_speed(speed, source, key):
     finite = speed[np.isfinite(speed)]
     if finite.size and finite.min() < 0:
-        raise ScenarioError(source, key, f"negative wind speed {finite.min():g}; allowed: "
+        raise DataFileError(source, key, f"negative wind speed {finite.min():g}; allowed: "
                             "speeds >= 0 [m s-1]")
     if finite.size and np.median(finite) > MAX_MEDIAN_SPEED:
-        raise ScenarioError(source, key, f"median wind speed {np.median(finite):.1f} looks "
+        raise DataFileError(source, key, f"median wind speed {np.median(finite):.1f} looks "
                             "like km/h or knots; allowed: m s-1")
 
 
@@ -150,11 +150,11 @@ def _checked_direction(direction, source, key):
     finite = direction[np.isfinite(direction)]
     outside = finite[np.abs(finite) > FULL_CIRCLE_DEG]
     if outside.size:
-        raise ScenarioError(source, key, f"direction {outside[0]:g} is out of range; "
+        raise DataFileError(source, key, f"direction {outside[0]:g} is out of range; "
                             "allowed: degrees in [-360, 360]")
     if finite.size > 1 and finite.min() >= 0 and finite.max() <= 2 * np.pi \
             and np.ptp(finite) > RADIAN_SPREAD:
-        raise ScenarioError(source, key, f"directions span {finite.min():.2f}-"
+        raise DataFileError(source, key, f"directions span {finite.min():.2f}-"
                             f"{finite.max():.2f}: radians? allowed: degrees")
     return (("time", "height"), np.mod(direction, FULL_CIRCLE_DEG))
 

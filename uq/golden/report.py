@@ -9,6 +9,7 @@ import html
 
 import numpy as np
 
+from uq.files import SIGNATURE
 from .findings import chain_roles, reference_comparison, thin_bins
 
 STYLE = """body{font-family:system-ui,sans-serif;max-width:1150px;margin:2em auto;color:#222}
@@ -177,7 +178,8 @@ def render_markdown(blocks):
 def render_html(blocks):
     """One self-contained HTML page (figures embedded as base64 PNG)."""
     title = next(b[1] for b in blocks if b[0] == "h1")
-    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{_e(title)}</title>"
+    parts = [f"<!DOCTYPE html><!-- {SIGNATURE} --><html><head><meta charset='utf-8'>"
+             f"<title>{_e(title)}</title>"
              f"<style>{STYLE}</style></head><body>"]
     for block in blocks:
         kind = block[0]

@@ -1,0 +1,44 @@
+"""uq bench: the time-to-target rule on a hand-made result, and a tiny real run."""
+import numpy as np
+import xarray as xr
+
+from uq.bench import methods as bench
+
+
+def synthetic(errors, times):
+    """One scene, two methods, three sizes, four repeats."""
+    return xr.Dataset({"relative_error": (("scene", "method", "n", "repeat"), errors),
+                       "time_s": (("scene", "method", "n", "repeat"), times)},
+                      coords={"scene": ["s"], "method": ["mc", "x"], "n": [1, 4, 16],
+                              "repeat": range(4)})
+
+
+def test_time_to_target_picks_the_first_size_and_extrapolates_otherwise():
+    errors = np.zeros((1, 2, 3, 4))
+    errors[0, 0] = [[8e-3] * 4, [4e-3] * 4, [2e-3] * 4]         # mc: never <= 1e-3
+    errors[0, 1] = [[5e-3] * 4, [5e-4] * 4, [1e-4] * 4]         # x: reached at n = 4
+    times = np.broadcast_to(np.array([1.0, 2.0, 4.0])[None, None, :, None], (1, 2, 3, 4))
+    rows = bench.time_to_target(synthetic(errors, np.array(times)))
+    assert rows["s", "x"] == (2.0, False)
+    # error 2e-3 at the largest n, falling as n^-1/2: 4x the samples, so 4x the time
+    assert rows["s", "mc"] == (16.0, True)
+
+
+def test_quantile_not_median_decides():
+    errors = np.full((1, 2, 3, 4), 1e-4)
+    errors[0, 1, 0, 3] = 5e-3                  # one bad run in four at the smallest n
+    rows = bench.time_to_target(synthetic(errors, np.ones((1, 2, 3, 4))))
+    assert rows["s", "x"] == (1.0, False) and rows["s", "mc"] == (1.0, False)
+    errors[0, 1, 0, :2] = 5e-3                 # half the runs bad: the next size
+    times = np.broadcast_to(np.array([1.0, 2.0, 4.0])[None, None, :, None], (1, 2, 3, 4))
+    assert bench.time_to_target(synthetic(errors, np.array(times)))["s", "x"] == (2.0, False)
+
+
+def test_measure_gives_errors_against_the_reference(monkeypatch):
+    monkeypatch.setattr(bench, "REFERENCE_SAMPLES", 2**17)
+    monkeypatch.setattr(bench, "SCENES", {"rubio2022_case_i": bench.SCENES["rubio2022_case_i"]})
+    result = bench.measure([2**12], repeats=2)
+    assert dict(result.sizes) == {"scene": 1, "method": 5, "n": 1, "repeat": 2}
+    # plain mc at 4096 trials: relative error of u ~ 1/sqrt(2 n) = 1.1 %; 10 % is > 8 sigma
+    assert np.all(result["relative_error"] < 0.1) and np.all(result["time_s"] > 0)
+    assert float(result["reference_relative_error"].max()) < 1e-3

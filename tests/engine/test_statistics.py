@@ -1,0 +1,135 @@
+"""Streaming statistics equal their in-memory definitions."""
+import numpy as np
+import pytest
+
+from uq.engine.statistics import (StreamingStatistics, batch_statistics, coverage_interval, tail_capacity, unwrap)
+
+
+def direct_interval(values, p=0.95):
+    m = len(values)
+    s = np.sort(values)
+    q = int(np.floor(p * m + 0.5))
+    r = (m - q) // 2 if (m - q) % 2 == 0 else (m - q + 1) // 2
+    return s[r - 1], s[r + q - 1]
+
+
+@pytest.mark.parametrize("m", [20, 21, 40, 41, 1000, 12345])
+def test_symmetric_interval_is_jcgm101_ranks(m, rng):
+    values = rng.standard_normal(m)
+    s = np.sort(values)
+    assert coverage_interval(s, s, m) == direct_interval(values)
+
+
+@pytest.mark.parametrize("m", [1, 2, 19])
+def test_no_interval_from_too_few_values(m):
+    assert np.isnan(coverage_interval(np.arange(m), np.arange(m), m)).all()
+
+
+# every value kept / tails from the start / tails taking over after 15000 of 20000 values
+STORED = [2**23, 0, 15_000]
+
+
+@pytest.mark.parametrize("stored", STORED)
+@pytest.mark.parametrize("chunk", [1, 7, 100, 5000])
+def test_streaming_equals_in_memory(chunk, stored, rng):
+    values = rng.gamma(2.0, size=(10_000, 2))
+    stats = StreamingStatistics((2,), tail_capacity(len(values)) + 1, stored_values=stored)
+    for start in range(0, len(values), chunk):
+        stats.update(values[start:start + chunk])
+    result = stats.result()
+    np.testing.assert_allclose(result["mean"], values.mean(axis=0), rtol=1e-13)
+    np.testing.assert_allclose(result["u"], values.std(axis=0, ddof=1), rtol=1e-12)
+    for j in range(2):
+        assert (result["low"][j], result["high"][j]) == direct_interval(values[:, j])
+
+
+@pytest.mark.parametrize("stored", STORED)
+def test_shortest_interval(stored, rng):
+    values = rng.exponential(size=4000)
+    stats = StreamingStatistics((), tail_capacity(4000), stored_values=stored // 5)
+    for start in range(0, 4000, 1000):
+        stats.update(values[start:start + 1000])
+    low, high = stats.result(kind="shortest")["low"], stats.result(kind="shortest")["high"]
+    s = np.sort(values)
+    q = int(np.floor(0.95 * 4000 + 0.5))
+    widths = s[q:] - s[:4000 - q]
+    assert high - low == pytest.approx(widths.min())
+
+
+def test_moments_stay_accurate_with_a_large_offset(rng):
+    values = 1e8 + rng.standard_normal(200_000)
+    stats = StreamingStatistics((), 10)
+    for chunk in np.split(values, 100):
+        stats.update(chunk)
+    assert stats.result()["u"] == pytest.approx(values.std(ddof=1), rel=1e-7)
+
+
+def test_unwrap():
+    np.testing.assert_allclose(unwrap(np.array([359.0, 1.0, 180.0]), 0.0), [-1.0, 1.0, 180.0])
+    np.testing.assert_allclose(unwrap(np.array([1.0]), 359.0), [361.0])
+
+
+@pytest.mark.parametrize("stored", STORED)
+def test_nan_excluded_and_counted(stored, rng):
+    stats = StreamingStatistics((), 100)
+    stats.update(np.array([1.0, np.nan, 3.0]))
+    result = stats.result()
+    assert result["n_valid"] == 2 and result["mean"] == 2.0
+    # intervals of the finite values only, whichever way they are kept
+    values = rng.normal(size=4000)
+    values[::7] = np.nan
+    values[::11] = np.inf
+    stats = StreamingStatistics((), tail_capacity(4000) + 1, stored_values=stored // 5)
+    for start in range(0, 4000, 500):
+        stats.update(values[start:start + 500])
+    finite = values[np.isfinite(values)]
+    result = stats.result()
+    assert result["n_valid"] == finite.size
+    assert (result["low"], result["high"]) == direct_interval(finite)
+    values[1::13] = -np.inf
+    batch = batch_statistics(values)
+    finite = values[np.isfinite(values)]
+    assert (batch["low"], batch["high"]) == direct_interval(finite)
+
+
+@pytest.mark.parametrize("m", [40, 999, 16384])
+def test_batch_statistics_partition_equals_sorted_interval(m):
+    """The one-partition path picks exactly the order statistics of coverage_interval."""
+    from uq.engine.statistics import batch_statistics, coverage_interval
+    values = np.random.default_rng(m).standard_normal((m, 3))
+    batch = batch_statistics(values)
+    for j in range(3):
+        ordered = np.sort(values[:, j])
+        assert (batch["low"][j], batch["high"][j]) == coverage_interval(ordered, ordered, m)
+
+
+def test_numerical_error_of_a_direction_at_north_is_not_a_wrap_artefact():
+    """Batch means of a direction near 0/360 must not be wrapped apart (359.9 vs 0.1):
+    the numerical error is of the order u / sqrt(N), not ~100 deg."""
+    import scipy.stats as st
+    import uq
+    out = uq.propagate(lambda x: np.mod(x, 360.0), {"x": st.norm(0.0, 0.5)}, n=2**17, seed=1,
+                       circular=("y",))
+    # 2 s of 8 batch means of 2^14 trials: about 2 * 0.5 / sqrt(2^17) = 0.003 deg
+    assert float(out["y_mc_numerical_error"]) < 0.02
+
+
+def test_batch_statistics_do_not_keep_the_batch_alive():
+    """Endpoints returned as views would keep every 2^14-trial batch in memory (8 bytes
+    per trial: 800 MB at 10^8 trials); they must own their data."""
+    from uq.engine.statistics import batch_statistics
+    result = batch_statistics(np.random.default_rng(1).standard_normal((2**14, 3)))
+    assert all(result[key].base is None or result[key].base.size <= 3
+               for key in ("low", "high"))
+
+
+def test_tail_buffer_keeps_exactly_the_smallest():
+    from uq.engine.statistics import _Tail
+    rng = np.random.default_rng(4)
+    tail, seen = _Tail(500), []
+    for size in (100, 3000, 10, 7000, 1):
+        values = rng.standard_normal(size)
+        seen.append(values)
+        tail.add(values[values < tail.threshold])
+    expected = np.sort(np.concatenate(seen))[:500]
+    np.testing.assert_array_equal(np.sort(tail.values()), expected)

@@ -1,0 +1,112 @@
+"""The shipped synthetic campaign (scenarios/golden_campaign.yaml) end to end: the seed's
+finding, the physics of the lidars' shear sensitivity, and the written report."""
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import xarray as xr
+
+from uq.cli import main
+from uq.golden.findings import reference_comparison
+
+ROOT = Path(__file__).resolve().parents[2]
+CONFIG = ROOT / "scenarios" / "golden_campaign.yaml"
+
+
+@pytest.fixture(scope="module")
+def campaign(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("golden") / "out"
+    assert main(["golden", str(CONFIG), "-o", str(folder)]) == 0
+    return folder, xr.open_dataset(folder / "golden_campaign.nc").load()
+
+
+def test_folder_holds_report_tables_figures_and_data(campaign):
+    folder, _ = campaign
+    for name in ("report.html", "report.md", "tables/per_bin.csv", "tables/kpi.csv",
+                 "tables/sensitivity.csv", "figures/scatter.png", "figures/deviation.png",
+                 "figures/uncertainty_terms.png", "data/campaign.yaml", "data/mast.csv"):
+        assert (folder / name).stat().st_size > 0, name
+    assert not list(folder.parent.glob(".*partial"))
+    per_bin = pd.read_csv(folder / "tables" / "per_bin.csv")
+    assert {"comparison", "height", "framework", "bin", "calibration"} <= set(per_bin.columns)
+
+
+def test_seed_finding_same_type_reference_has_the_smaller_deviation_term(campaign):
+    """FLSa against FLSb (same type, collocated) against FLSa against the mast: the mean
+    deviation term over the required bins is smaller with FLSb, under both frameworks and
+    at every height. The mast's comparison carries the site separation (2 % per record,
+    shared by the buoys) and the type's shear bias; FLSb's only what differs between the
+    units, so the margin (a factor ~2 IEC, ~3 LUSR) is far beyond the bin-to-bin noise."""
+    _, ds = campaign
+    for row in reference_comparison(ds, "flsa", "flsb", "mast"):
+        assert row["bins"] == 25                          # 4-16 m/s, all sufficient
+        assert row["deviation_golden"] < row["deviation_mast"], row
+
+
+def test_chain_keeps_both_classification_terms(campaign):
+    _, ds = campaign
+    required = ds["required"].values
+    chain = ds.sel(comparison="flsa-flsb").isel(bin=np.flatnonzero(required))
+    assert (chain["reference_classification"] > 0).all()        # u_class,FLSb inside u_cal
+    assert (chain["classification"] > 0).all()                   # u_class,FLSa in the total
+    own = ds.sel(comparison="flsb-mast").isel(bin=np.flatnonzero(required))
+    np.testing.assert_allclose(chain["reference_classification"].isel(framework=0),
+                               own["classification"], rtol=1e-12)
+    np.testing.assert_allclose(chain["reference_calibration"], own["calibration"],
+                               rtol=1e-12)
+
+
+@pytest.mark.parametrize("key, height_error", [("flsa-mast", -2.5), ("flsb-mast", -1.0)])
+def test_shear_sensitivity_is_the_height_error(campaign, key, height_error):
+    """A lidar riding e lower reads v (1 + e/h)^alpha: the percentage deviation against
+    shear has slope 100 ln(1 + e/h) per unit of shear. Tolerance 4 standard errors of the
+    regression (the site separation and the lidars' noise are independent of shear)."""
+    _, ds = campaign
+    for height in ds["height"].values:
+        s = ds.sel(comparison=key, height=height, variable="shear")
+        expected = 100 * np.log(1 + height_error / height)
+        assert abs(float(s["slope"]) - expected) < 4 * float(s["slope_standard_error"])
+        assert bool(s["slope_significant"])
+
+
+def test_same_type_reference_sees_a_smaller_slope(campaign):
+    """Seed Fig. 2: FLSa's slope against FLSb is smaller in magnitude than against the
+    mast (the type's own sensitivity cancels)."""
+    _, ds = campaign
+    shear = ds["slope"].sel(variable="shear")
+    assert (abs(shear.sel(comparison="flsa-flsb")) < abs(shear.sel(comparison="flsa-mast"))).all()
+
+
+def test_report_states_the_finding_with_numbers(campaign):
+    folder, ds = campaign
+    text = (folder / "report.md").read_text()
+    row = [r for r in reference_comparison(ds, "flsa", "flsb", "mast")
+           if r["height"] == 80.0 and r["framework"] == "iec"][0]
+    assert (f"the deviation term of flsa is {row['deviation_golden']:.4f} m/s with flsb as "
+            f"reference and {row['deviation_mast']:.4f} m/s with the mast") in text
+    assert "The chain keeps both classification terms" in text
+    assert "<img src='data:image/png;base64," in (folder / "report.html").read_text()
+
+
+def test_kpis_of_the_synthetic_units(campaign):
+    """FLSa's compass reads 0.8 deg low and FLSb's 0.3 deg high: the direction offset of
+    FLSa against FLSb is about -1.1 deg (the regression's intercept, with a slope ~1)."""
+    _, ds = campaign
+    offset = ds["direction_offset"].sel(comparison="flsa-flsb")
+    # per-record heading noise averages out over ~13,000 records (< 0.01 deg); the
+    # intercept also absorbs (slope - 1) x mean direction, |4e-4 x 200| < 0.1 deg
+    assert np.all(np.abs(offset + 1.1) < 0.3)
+    assert (ds["speed_slope_verdict"] == "best practice").all()
+    # 2 % outage: binomial sd sqrt(0.02 x 0.98 / 13248) = 0.0012, so 0.01 is 8 sd
+    assert np.all(np.abs(ds["availability"] - 0.98) < 0.01)
+
+
+def test_bad_config_exits_2_and_writes_nothing(tmp_path, capsys):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("golden: {name: x, synthetic: {lidars: {unit: nowhere.yaml}}}\n")
+    assert main(["golden", str(bad), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("uq: error: ") and "golden.synthetic.lidars" in err
+    assert len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists() and not list(tmp_path.glob(".*partial"))

@@ -1,0 +1,172 @@
+"""Acceptance on rubio2022_case_i: the paper's model, the physical GUM and Monte Carlo.
+
+Independent evaluation of the paper: Eqs. 8-11 are written out here again, and the
+Vh and Theta sensitivities (Eqs. 19-20) are taken by complex-step differentiation of Eq. 17
+and of the corrected Eq. 18 (not from the module's Appendix A formulas).
+
+Monte Carlo tolerances come from the sample size: the standard error of a sample
+standard deviation, u sqrt((kurtosis_excess + 2) / (4 N)), times K. The output is
+close to normal (excess ~ 0), so se = u / sqrt(2 N). Where the model is curved, Monte
+Carlo also carries the second-order term of |u + du| that the first-order GUM omits:
+var = var_GUM + s_t^4 / (2 Vh^2), s_t the spread of the wind error across the wind
+(s_t = Vh u(Theta) in radians), which follows from expanding the norm to second order
+for Gaussian errors.
+"""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import uq
+
+ROOT = Path(__file__).resolve().parents[2]
+K = 4.5
+N = 100_000
+d = np.deg2rad
+
+
+@pytest.fixture(scope="module")
+def case_i():
+    scenario = uq.load_scenario(ROOT / "scenarios" / "rubio2022_case_i.yaml",
+                                {"sweep.wind.direction": {"start": 0, "stop": 360, "step": 30},
+                                 "sampling.n": N})
+    return {mode: uq.run(scenario.with_values({"ins.correlation": mode}))
+            for mode in ("scan", "beam")}
+
+
+def independent_paper_model(direction_deg):
+    """Eqs. 6, 8-11, 17-20 (corrected) of Rubio & Gottschall (2022), written out again."""
+    vh, sog, cog, yaw, theta = 5.0, 2.0, 0.0, 0.0, d(28)
+    u_yaw, u_sog, u_cog = d(0.1), 0.1, d(0.1)
+    direction = d(direction_deg)
+    phi = d(np.array([0.0, 90.0, 180.0, 270.0]))
+    radial = -np.sin(theta) * (vh * np.cos(direction - phi - yaw) + sog * np.cos(cog - phi - yaw))
+    u_radial = np.sqrt((u_yaw * np.sin(theta) * (vh * np.sin(direction - phi - yaw)
+                                                  + sog * np.sin(cog - phi - yaw))) ** 2
+                       + (u_sog * np.sin(theta) * np.cos(cog - phi - yaw)) ** 2
+                       + (u_cog * np.sin(theta) * sog * np.sin(cog - phi - yaw)) ** 2)
+
+    def vh_theta(v):                 # Eq. 17 and corrected Eq. 18 (via Eq. 16)
+        ns, ew = v[0] - v[2], v[1] - v[3]
+        speed = np.sqrt(ns**2 + ew**2 + 4 * np.sin(theta)**2 * sog**2 + 4 * np.sin(theta) * sog
+                        * (ns * np.cos(yaw - cog) + ew * np.sin(cog - yaw))) / (2 * np.sin(theta))
+        north = (np.cos(yaw) * ns - np.sin(yaw) * ew) / (2 * np.sin(theta)) + sog * np.cos(cog)
+        east = (np.sin(yaw) * ns + np.cos(yaw) * ew) / (2 * np.sin(theta)) + sog * np.sin(cog)
+        return speed, north, east
+
+    c_speed, c_direction = [], []
+    for i in range(4):
+        v = radial.astype(complex)
+        v[i] += 1e-30j
+        speed, north, east = vh_theta(v)
+        c_speed.append(speed.imag / 1e-30)
+        n, e = north.real, east.real
+        c_direction.append((n * east.imag - e * north.imag) / 1e-30 / (n**2 + e**2))
+    return (np.sqrt(np.sum((u_radial * c_speed) ** 2)),
+            np.rad2deg(np.sqrt(np.sum((u_radial * c_direction) ** 2))))
+
+
+def test_paper_u_equals_independent_evaluation(case_i):
+    ds = case_i["scan"]
+    for direction in ds["wind_direction"].values:
+        speed_u, direction_u = independent_paper_model(direction)
+        point = ds.sel(wind_direction=direction)
+        assert float(point.wind_speed_paper_u) == pytest.approx(speed_u, rel=1e-12)
+        assert float(point.wind_direction_paper_u) == pytest.approx(direction_u, rel=1e-12)
+    # the paper's model does not depend on the INS correlation setting
+    np.testing.assert_array_equal(case_i["beam"].wind_speed_paper_u, ds.wind_speed_paper_u)
+
+
+def expected_mc_u(first_order_speed_u, first_order_direction_u):
+    """First-order u plus the second-order term of the norm (module docstring)."""
+    across = 5.0 * np.deg2rad(first_order_direction_u)
+    return np.sqrt(first_order_speed_u**2 + across**4 / (2 * 5.0**2))
+
+
+def test_monte_carlo_beam_matches_paper(case_i):
+    ds = case_i["beam"]
+    expected = expected_mc_u(ds.wind_speed_paper_u.values, ds.wind_direction_paper_u.values)
+    assert np.all(np.abs(ds.wind_speed_mc_u.values - expected) < K * expected / np.sqrt(2 * N))
+    direction = ds.wind_direction_paper_u.values
+    assert np.all(np.abs(ds.wind_direction_mc_u.values - direction) < K * direction / np.sqrt(2 * N)
+                  + 0.002 * direction)   # + second order of atan2 at u(Theta) <= 0.02 rad
+
+
+def test_monte_carlo_scan_matches_physical_gum(case_i):
+    ds = case_i["scan"]
+    expected = expected_mc_u(ds.wind_speed_gum_u.values, ds.wind_direction_gum_u.values)
+    assert np.all(np.abs(ds.wind_speed_mc_u.values - expected) < K * expected / np.sqrt(2 * N))
+
+
+def test_first_order_beam_mode_gum_equals_paper(case_i):
+    """Point-wise correction with independent readings is, to first order, the paper's model."""
+    ds = case_i["beam"]
+    np.testing.assert_allclose(ds.wind_speed_gum_u, ds.wind_speed_paper_u, rtol=1e-9)
+    np.testing.assert_allclose(ds.wind_direction_gum_u, ds.wind_direction_paper_u, rtol=1e-9)
+
+
+def test_paper_against_physical_ratio(case_i):
+    """The ratio reported in the README (direction-averaged u over the sweep)."""
+    ds = case_i["scan"]
+    ratio = float(ds.wind_speed_paper_u.mean() / ds.wind_speed_gum_u.mean())
+    assert 0.5 < ratio < 1.0      # the paper under-states u(Vh) for one reading per scan
+
+
+def test_contract_names_units_and_attributes(case_i):
+    ds = case_i["scan"]
+    for q in ("wind_speed", "wind_direction", "vertical_wind"):
+        for s in ("true", "nominal", "mc_mean", "mc_bias", "mc_u", "mc_low", "mc_high", "gum_u",
+                  "gum_valid", "paper_u", "budget"):
+            assert f"{q}_{s}" in ds
+    for name in ("scenario", "uq_version", "sampling_method", "n_samples", "seed", "runtime_s"):
+        assert name in ds.attrs
+    for name, variable in ds.data_vars.items():
+        assert variable.dtype == bool or "units" in variable.attrs, name
+    assert set(ds["input"].values) == {"ins.heading", "ins.sog", "ins.cog"}
+
+
+def test_result_round_trips_through_netcdf(case_i, tmp_path):
+    from uq.files import write_netcdf
+    from uq.pipeline.results import read_results
+    path = write_netcdf(case_i["scan"], tmp_path / "r.nc")
+    back = read_results(path)
+    np.testing.assert_array_equal(back.wind_speed_mc_u, case_i["scan"].wind_speed_mc_u)
+    assert back.wind_speed_gum_valid.dtype == bool
+    assert not list(tmp_path.glob(".*.part"))
+
+
+def test_floating_lidar_full_runs_with_ranges_and_every_error():
+    ds = uq.run(uq.load_scenario(ROOT / "scenarios" / "floating_lidar_full.yaml",
+                                 {"sampling.n": 20_000}))
+    assert ds.sizes["range"] == 3 and ds.sizes["beam"] == 5
+    assert len(ds["input"]) == 9
+    assert np.all(np.isnan(ds.wind_speed_paper_u))          # the paper has no 'full' model
+    # shear: the true speed grows with height as the power law says
+    heights = 3.0 + ds["range"].values
+    np.testing.assert_allclose(ds.wind_speed_true, 8.0 * (heights / 100.0) ** 0.12, rtol=1e-12)
+    assert int(ds.wind_speed_mc_n_invalid.sum()) == 0
+
+
+def test_result_says_what_was_skipped():
+    case = uq.run(uq.load_scenario(ROOT / "scenarios" / "rubio2022_case_i.yaml",
+                                   {"sampling.n": 1000, "sweep": {}}))
+    full = uq.run(uq.load_scenario(ROOT / "scenarios" / "floating_lidar_full.yaml",
+                                   {"sampling.n": 1000}))
+    assert "computed once per scene" in case.attrs["skipped"]
+    assert "input not sampled (no error declared): ins.pitch" in case.attrs["skipped"]
+    assert "output not requested, not computed: radial_velocity" in case.attrs["skipped"]
+    # every error but the lidar's height declared, every output requested
+    assert full.attrs["skipped"] == "input not sampled (no error declared): lidar.errors.height"
+
+
+def test_lidar_height_error_budget_is_the_power_law_slope():
+    """lidar.errors.height (draft, tide): a level lidar's speed at gate height z is
+    V (z / z_ref)^alpha, so the GUM budget of u(h) is (alpha V(z) / z)^2 u(h)^2."""
+    ds = uq.run(uq.load_scenario({"name": "h", "wind": {"shear": 0.2, "speed": 8.0},
+                                  "lidar": {"height": 20.0, "ranges": [100.0],
+                                            "errors": {"height": {"dist": "normal", "u": 0.5}}},
+                                  "sampling": {"n": 2000}}))
+    speed = 8.0 * (120.0 / 100.0) ** 0.2
+    budget = ds.wind_speed_budget.sel(input="lidar.errors.height")
+    # complex-step Jacobian: exact to rounding; 1e-6 leaves room for the budget units only
+    assert float(budget) == pytest.approx((0.2 * speed / 120.0 * 0.5) ** 2, rel=1e-6)

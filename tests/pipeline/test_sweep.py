@@ -1,0 +1,165 @@
+"""Sweeps: vectorised chunks equal scene-by-scene runs, common random numbers, linked
+keys, GUM-only grids, checkpoints and resume, dask scale-out."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import uq
+import uq.pipeline.sweep
+from uq.pipeline.checkpoint import Checkpoint
+from uq.errors import CheckpointError, ScenarioError
+from uq.pipeline.sweep import sweep_plan
+
+ROOT = Path(__file__).resolve().parents[2]
+FLOATING = ROOT / "scenarios" / "floating_lidar_full.yaml"
+# Scene-by-scene and vectorised evaluation do the same arithmetic element by element; only
+# the order of a few matrix-product sums may differ, a few ulps of the terms.
+RTOL = 1e-10
+
+
+def small(path=FLOATING, **changes):
+    return uq.load_scenario(path, {"sampling.n": 3000, **changes})
+
+
+def data_equal(a, b):
+    """Every variable and coordinate identical (attributes such as runtime_s aside)."""
+    xr.testing.assert_equal(a.drop_attrs(), b.drop_attrs())
+
+
+def test_vector_sweep_equals_scene_by_scene():
+    sweep = {"wind.direction": [10.0, 200.0], "lidar.misalignment": [0.0, 45.0],
+             "ship.pitch": [-4.0, 6.0]}
+    scenario = small(**{"ins.correlation": "beam", "sweep": sweep})
+    swept = uq.run(scenario)
+    assert swept["wind_speed_mc_u"].dims == ("wind_direction", "lidar_misalignment",
+                                             "ship_pitch", "range")
+    for direction in sweep["wind.direction"]:
+        for misalignment in sweep["lidar.misalignment"]:
+            for pitch in sweep["ship.pitch"]:
+                one = uq.run(small(**{"ins.correlation": "beam", "wind.direction": direction,
+                                      "lidar.misalignment": misalignment, "ship.pitch": pitch}))
+                point = swept.sel(wind_direction=direction, lidar_misalignment=misalignment,
+                                  ship_pitch=pitch)
+                for name in one.data_vars:
+                    np.testing.assert_allclose(point[name].values, one[name].values,
+                                               rtol=RTOL, atol=1e-13, err_msg=name)
+
+
+def test_compiled_sweep_equals_the_numpy_model_in_single_scene_chunks(monkeypatch):
+    """Wind outputs, scan INS: the compiled model, several scenes per chunk. The numpy
+    model scene by scene gives the same results to the ulps of two implementations."""
+    sweep = {"wind.direction": [0.0, 120.0, 359.0], "ship.pitch": [-4.0, 6.0]}
+    scenario = small(**{"sampling.n": 2**14, "sweep": sweep,
+                        "outputs": ["wind_speed", "wind_direction", "vertical_wind"]})
+    assert uq.pipeline.sweep.scenes_per_chunk(scenario) > 1
+    compiled = uq.run(scenario)
+    monkeypatch.setattr(uq.pipeline.sweep, "SWEEP_CHUNK_ELEMENTS_COMPILED", 1)       # 1 per chunk
+    monkeypatch.setattr("uq.physics.fused.applicable", lambda *args, **kwargs: False)
+    assert uq.pipeline.sweep.scenes_per_chunk(scenario) == 1
+    plain = uq.run(scenario)
+    for name in plain.data_vars:
+        np.testing.assert_allclose(compiled[name].values, plain[name].values,
+                                   rtol=RTOL, atol=1e-12, err_msg=name)
+
+
+def test_common_random_numbers_across_scenes_and_groups():
+    """Identical scenes in a sweep, whether vectorised (wind.direction) or in separate
+    groups (ins.sog.u), see the same draws: identical results, not ~1/sqrt(N) apart."""
+    sweep = {"ins.sog.u": [0.02, 0.02], "wind.direction": [30.0, 30.0]}
+    result = uq.run(small(**{"sweep": sweep}))["wind_speed_mc_u"].values
+    assert np.all(result == result[0, 0])
+    other_seed = uq.run(small(**{"sweep": sweep, "sampling.seed": 7}))["wind_speed_mc_u"]
+    assert np.all(other_seed.values != result)       # the check can fail: seeds matter
+
+
+def test_structural_sweep_keys_keep_file_order():
+    sweep = {"ins.heading.u": [0.1, 1.0], "wind.direction": [0.0, 90.0, 180.0]}
+    result = uq.run(small(**{"sweep": sweep}))
+    assert result["wind_speed_mc_u"].dims[:2] == ("ins_heading_u", "wind_direction")
+    one = uq.run(small(**{"ins.heading.u": 1.0, "wind.direction": 90.0}))
+    np.testing.assert_allclose(result["wind_speed_gum_u"].sel(ins_heading_u=1.0,
+                                                              wind_direction=90.0),
+                               one["wind_speed_gum_u"], rtol=RTOL)
+
+
+def test_linked_key_follows_its_leader():
+    sweep = {"ship.cog": [0.0, 90.0], "ship.heading": {"same_as": "ship.cog"}}
+    result = uq.run(small(**{"sweep": sweep}))
+    assert "ship_heading" in result.coords and result["ship_heading"].dims == ("ship_cog",)
+    one = uq.run(small(**{"ship.cog": 90.0, "ship.heading": 90.0}))
+    np.testing.assert_allclose(result["wind_speed_gum_u"].sel(ship_cog=90.0),
+                               one["wind_speed_gum_u"], rtol=RTOL)
+
+
+@pytest.mark.parametrize("sweep, key", [
+    ({"ship.heading": {"same_as": "ship.cog"}}, "sweep.ship.heading.same_as"),
+    ({"ship.cog": [0, 90], "lidar.errors.misalignment.u": {"same_as": "ship.cog"}},
+     "sweep.lidar.errors.misalignment.u.same_as")])
+def test_bad_links_are_rejected(sweep, key):
+    with pytest.raises(ScenarioError, match=key.replace(".", r"\.")):
+        small(**{"sweep": sweep})
+
+
+def test_gum_only_grid_has_no_monte_carlo():
+    sweep = {"wind.direction": [0.0, 120.0, 240.0]}
+    gum_only = uq.run(small(**{"sweep": sweep, "sampling.method": "none"}))
+    sampled = uq.run(small(**{"sweep": sweep}))
+    assert not [name for name in gum_only.data_vars if "_mc_" in name or "valid" in name]
+    assert np.all(gum_only["mc_n_samples"] == 0)
+    for name in ("wind_speed_gum_u", "wind_direction_gum_u", "wind_speed_budget",
+                 "wind_speed_true", "wind_speed_nominal"):
+        np.testing.assert_allclose(gum_only[name], sampled[name], rtol=RTOL)
+
+
+def test_results_do_not_depend_on_sampling_chunk_size():
+    sweep = {"wind.direction": [0.0, 90.0]}
+    a = uq.run(small(**{"sweep": sweep, "sampling.n": 140_000}))
+    b = uq.run(small(**{"sweep": sweep, "sampling.n": 140_000, "sampling.chunk_size": 1}))
+    data_equal(a, b)
+
+
+@pytest.fixture
+def many_chunks(monkeypatch):
+    """One scene per chunk, so a short sweep has several chunks."""
+    monkeypatch.setattr(uq.pipeline.sweep, "SWEEP_CHUNK_ELEMENTS", 1)
+    return small(**{"sweep": {"wind.direction": [0.0, 90.0, 180.0, 270.0],
+                              "ins.heading.u": [0.2, 0.5]}, "sampling.seed": None})
+
+
+def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path, many_chunks):
+    assert len(sweep_plan(many_chunks).chunks) == 8
+    directory = tmp_path / "out.nc.partial"
+
+    def interrupt_after_three(done, total):
+        if done == 3:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        uq.run(many_chunks, progress=interrupt_after_three, checkpoint=Checkpoint(directory))
+    assert len(list(directory.glob("chunk-*.nc"))) == 3
+    seen = []
+    resumed = uq.run(many_chunks, progress=lambda done, total: seen.append(done),
+                     checkpoint=Checkpoint(directory, resume=True))
+    assert seen == [3, 4, 5, 6, 7, 8]                # only the missing chunks computed
+    seed = resumed.attrs["seed"]                    # drawn fresh, kept by the checkpoint
+    data_equal(resumed, uq.run(many_chunks.with_values({"sampling.seed": seed})))
+
+
+def test_resume_refuses_a_checkpoint_of_another_run(tmp_path, many_chunks):
+    directory = tmp_path / "out.nc.partial"
+    uq.run(many_chunks.with_values({"sampling.seed": 1}), checkpoint=Checkpoint(directory))
+    with pytest.raises(CheckpointError, match="different scenario"):
+        uq.run(many_chunks.with_values({"sampling.seed": 2}),
+               checkpoint=Checkpoint(directory, resume=True))
+
+
+def test_distributed_run_is_identical_to_single_process(many_chunks):
+    from dask import distributed         # the 'test' extra installs it: no silent skip
+    scenario = many_chunks.with_values({"sampling.seed": 11})
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  host="127.0.0.1", dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        remote = uq.run(scenario, client=client)
+    data_equal(remote, uq.run(scenario))

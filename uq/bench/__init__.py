@@ -1,0 +1,1 @@
+"""Wing: benchmarks (``uq bench``; ``python -m uq.bench.sweep``)."""

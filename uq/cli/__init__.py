@@ -1,0 +1,42 @@
+"""Command line: ``uq run``, ``uq check``, ``uq plot``, ``uq report``, ``uq bench``,
+``uq fit``, ``uq golden``, ``uq --version``; one module per subcommand.
+
+The command line dispatches; it computes nothing. Each subcommand module adds its
+parser and imports what it needs only when it runs, so ``uq --help`` and ``uq --version``
+load neither scipy, xarray, pandas, matplotlib nor numba.
+
+Exit status: 0 success; 2 bad input (one line naming the file, the key and what is
+allowed; no traceback; no output file); 1 anything else; 130 interrupted (Ctrl-C).
+"""
+import sys
+
+from uq._version import __version__
+from uq.cli import bench, check, fit, golden, plot, report, run
+from uq.cli.common import (EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK,  # noqa: F401
+                           Parser, parse_overrides)
+from uq.errors import InputError
+
+SUBCOMMANDS = (run, check, plot, report, bench, fit, golden)
+
+
+def build_parser():
+    parser = Parser(prog="uq", description="Uncertainty of ship-based and floating "
+                    "Doppler wind lidar: Monte Carlo beside the GUM.")
+    parser.add_argument("--version", action="version", version=f"uq {__version__}")
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    for module in SUBCOMMANDS:
+        module.add_parser(commands)
+    return parser
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    try:
+        return args.handler(args)
+    except InputError as error:
+        print(f"uq: error: {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,16 @@
+"""``uq bench [-o OUT.nc] [--quick]``."""
+from uq.cli.common import EXIT_OK
+
+
+def add_parser(commands):
+    bench = commands.add_parser("bench", help="benchmark: error in u(wind speed) against "
+                                "wall time for every sampling method (results/bench.nc)")
+    bench.add_argument("-o", "--output", default="results/bench.nc", help="results file")
+    bench.add_argument("--quick", action="store_true", help="fewer sizes and repeats (~1 min)")
+    bench.set_defaults(handler=command)
+
+
+def command(args):
+    from uq.bench.command import run_bench
+    run_bench(args.output, quick=args.quick)
+    return EXIT_OK

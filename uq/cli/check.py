@@ -1,0 +1,32 @@
+"""``uq check SCENARIO``: validate a scenario or a golden-lidar configuration."""
+from uq.cli.common import EXIT_OK, parse_overrides
+
+
+def add_parser(commands):
+    check = commands.add_parser("check", help="validate a scenario (or a golden-lidar "
+                                "configuration) without running it")
+    check.add_argument("scenario", help="scenario YAML file, or the name of a shipped "
+                       "scenario")
+    check.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    check.set_defaults(handler=command)
+
+
+def command(args):
+    from uq.pipeline.scenario import load_scenario, read_yaml
+    from uq.pipeline.shipped import scenario_path
+    path = scenario_path(args.scenario)
+    raw = read_yaml(path)
+    if isinstance(raw, dict) and "golden" in raw:
+        from uq.golden.config import load_golden_config
+        config = load_golden_config(path)
+        what = "synthetic campaign" if config.synthetic else \
+            f"{len(config.comparisons)} comparison(s)"
+        print(f"{args.scenario}: ok (golden-lidar configuration {config.name}: {what})")
+        return EXIT_OK
+    scenario = load_scenario(path, parse_overrides(args.set))
+    scenes = 1
+    for _, values in scenario.sweep:
+        scenes *= len(values)
+    print(f"{args.scenario}: ok ({scenario.name}: {scenes} scene(s), outputs "
+          f"{', '.join(scenario.outputs)})")
+    return EXIT_OK

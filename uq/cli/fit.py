@@ -1,0 +1,21 @@
+"""``uq fit RESULTS.nc | TABLE.csv [-c CONFIG] [-o OUT.nc] [--set fit.k=v]``."""
+from uq.cli.common import parse_overrides
+
+
+def add_parser(commands):
+    fit = commands.add_parser("fit", help="fit a wind profile with emcee, beside least "
+                              "squares: posterior summary, predictive band, corner plot, chain")
+    fit.add_argument("input", help="results of uq run (.nc) with range gates and the "
+                     "gate_height output, or a CSV of heights and speeds (.csv)")
+    fit.add_argument("-c", "--config", help="YAML file with a 'fit' section (default: the "
+                     "results' scenario's fit section, else the defaults)")
+    fit.add_argument("-o", "--output", help="fit results (.nc; default beside the input, "
+                     "<name>_fit.nc); figures beside it")
+    fit.add_argument("--set", action="append", default=[], metavar="fit.KEY=VALUE",
+                     help="override a fit setting (dotted key, YAML value); repeatable")
+    fit.set_defaults(handler=command)
+
+
+def command(args):
+    from uq.fit.command import run_fit
+    return run_fit(args.input, args.config, args.output, parse_overrides(args.set))

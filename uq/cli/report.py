@@ -1,0 +1,33 @@
+"""``uq report RESULTS.nc [-o REPORT.html] [--target U]``."""
+from pathlib import Path
+
+from uq.cli.common import EXIT_OK
+from uq.cli.plot import open_results
+from uq.errors import ScenarioError
+
+
+def add_parser(commands):
+    report = commands.add_parser("report", help="write a self-contained HTML report of a "
+                                 "results file: scenario, figures, tables, planning answers")
+    report.add_argument("results", help="results file of uq run (netCDF)")
+    report.add_argument("-o", "--output", help="report file (default: beside the results, "
+                        "<name>_report.html)")
+    report.add_argument("--target", type=float, action="append", metavar="U",
+                        help="target u(wind speed) [m s-1] for the largest velocity ratio; "
+                        "repeatable (default 0.05, 0.06 and 0.07)")
+    report.set_defaults(handler=command)
+
+
+def command(args):
+    from uq.outputs.report import write_report
+    path, dataset = open_results(args.results)
+    output = Path(args.output) if args.output else path.with_name(f"{path.stem}_report.html")
+    if output.suffix not in (".html", ".htm"):
+        raise ScenarioError("-o", str(output), "the report file must end in .html")
+    for target in args.target or []:
+        if not target > 0:
+            raise ScenarioError("--target", str(target), "allowed: a positive number [m s-1]")
+    write_report(dataset, output, source=path,
+                 **({"targets": tuple(args.target)} if args.target else {}))
+    print(f"wrote {output}")
+    return EXIT_OK

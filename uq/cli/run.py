@@ -1,0 +1,79 @@
+"""``uq run SCENARIO [-o OUT.nc] [--set k=v] [--resume] [--workers N]``."""
+import contextlib
+import sys
+from pathlib import Path
+
+from uq.cli.common import EXIT_INTERRUPTED, EXIT_OK, parse_overrides
+from uq.errors import ScenarioError
+
+
+def add_parser(commands):
+    run = commands.add_parser("run", help="run a scenario and write its results (netCDF)")
+    run.add_argument("scenario", help="scenario YAML file, or the name of a shipped "
+                     "scenario (e.g. rubio2022_case_i)")
+    run.add_argument("-o", "--output", help="output file (default results/<name>.nc)")
+    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                     help="override a scenario value (dotted key, YAML value); repeatable")
+    run.add_argument("--quiet", action="store_true", help="no summary table or progress")
+    run.add_argument("--resume", action="store_true",
+                     help="continue an interrupted run: reuse the finished chunks kept in "
+                     "OUT.nc.partial/ and compute only the missing scenes")
+    scale = run.add_mutually_exclusive_group()
+    scale.add_argument("--workers", type=int, metavar="N",
+                       help="run the sweep on a local dask cluster of N processes "
+                       "(needs the 'dask' extra); same numbers as a single process")
+    scale.add_argument("--scheduler", metavar="ADDRESS",
+                       help="run the sweep on the dask scheduler at ADDRESS "
+                       "(e.g. tcp://host:8786)")
+    run.set_defaults(handler=command)
+
+
+def command(args):
+    from uq.files import write_netcdf
+    from uq.outputs.summary import summary_table
+    from uq.pipeline.checkpoint import Checkpoint, checkpoint_directory
+    from uq.pipeline.progress import ProgressBar
+    from uq.pipeline.runner import run
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.shipped import scenario_path
+    scenario = load_scenario(scenario_path(args.scenario), parse_overrides(args.set))
+    output = Path(args.output) if args.output else Path("results") / f"{scenario.name}.nc"
+    if output.suffix != ".nc":
+        raise ScenarioError("-o", str(output), "the output file must end in .nc")
+    progress = None if args.quiet else ProgressBar()
+    checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume)
+    try:
+        with dask_client(args) as client:
+            dataset = run(scenario, progress=progress, client=client, checkpoint=checkpoint)
+    except KeyboardInterrupt:
+        print(f"\nuq: interrupted; finished chunks are kept in {checkpoint.directory}; "
+              "run the same command with --resume to continue", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    write_netcdf(dataset, output)
+    checkpoint.clear()
+    if not args.quiet:
+        print(summary_table(dataset))
+        print(f"wrote {output}")
+    return EXIT_OK
+
+
+@contextlib.contextmanager
+def dask_client(args):
+    """A dask.distributed Client for --workers / --scheduler, else None."""
+    if args.workers is None and args.scheduler is None:
+        yield None
+        return
+    if args.workers is not None and args.workers < 1:
+        raise ScenarioError("--workers", str(args.workers), "allowed: an integer >= 1")
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        raise ScenarioError("--workers/--scheduler", "dask", "dask.distributed is not "
+                            "installed; allowed: pip install 'uq[dask]'") from None
+    if args.scheduler:
+        with Client(args.scheduler) as client:
+            yield client
+        return
+    with LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        yield client

@@ -1,0 +1,1 @@
+"""The model-agnostic JCGM 101 + GUM engine (knows no lidar)."""

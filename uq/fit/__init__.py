@@ -1,0 +1,1 @@
+"""Wing: Bayesian and least-squares wind-profile fits (uq fit)."""

@@ -1,0 +1,337 @@
+"""Bayesian wind-profile fit with emcee: posterior of the profile parameters.
+
+Likelihood. The measured speeds y (n gates) are Gaussian about the profile f(z; theta)
+with covariance
+
+    Sigma = Sigma_meas + diag(f'(z)^2) . Sigma_z + sigma^2 I
+
+* ``Sigma_meas``: the measurement covariance of the speeds; full when errors are common
+  to the gates (INS or mounting errors), not only its diagonal;
+* ``Sigma_z``: the covariance of the gates' true heights, carried into speed to first
+  order through the profile's slope f'(z) (``diag(f') Sigma_z diag(f')``);
+* ``sigma = exp(ln_sigma)``: a free extra scatter (turbulence), optional.
+
+Priors are uniform within bounds (:data:`DEFAULT_PRIORS`, documented there),
+log-uniform where marked, or normal ``(mean, u, "normal")`` when configured. The posterior is sampled by emcee's affine-invariant ensemble
+(Foreman-Mackey et al. 2013) in several independent ensembles, each started in a small
+ball about the maximum a posteriori and seeded through emcee's State random_state.
+Convergence is decided, and failure raised, from the integrated autocorrelation time
+(each chain longer than 50 tau; burn-in 2 tau and thinning tau/2 derived from it) and
+the rank-normalised split R-hat across ensembles (Vehtari et al. 2021, < 1.01).
+
+References
+----------
+.. [1] Foreman-Mackey, D. et al. (2013). emcee: The MCMC Hammer. PASP 125, 306.
+.. [2] Vehtari, A. et al. (2021). Rank-normalization, folding, and localization: an
+   improved R-hat. Bayesian Analysis 16(2), 667-718.
+.. [3] Peelle, R. W. (1987). Peelle's pertinent puzzle. Informal memorandum, Oak Ridge
+   National Laboratory; see Zhao, Z. and Perey, F. G. (1992), ORNL/TM-12106.
+"""
+from dataclasses import dataclass
+
+import emcee
+import numpy as np
+from scipy.optimize import minimize
+from scipy.special import ndtri
+from scipy.stats import rankdata
+
+from uq.constants import COMPLEX_STEP, MIN_WALKERS
+from uq.fit.profilefit import least_squares_profile
+from uq.physics.profiles import PROFILES
+
+#: Prior bounds per parameter: (low, high, "uniform" | "log_uniform"). Wide enough for any
+#: atmospheric profile over sea (shear -0.5 ... 1; u* up to 3 m/s; z0 from 1 um to 1 m);
+#: ln_sigma from e^-10 (no scatter) to e^2 = 7.4 m/s (more than any 10-min scatter).
+DEFAULT_PRIORS = {
+    "reference_speed": (0.0, 60.0, "uniform"),
+    "shear": (-0.5, 1.0, "uniform"),
+    "friction_velocity": (0.0, 3.0, "uniform"),
+    "roughness_length": (1e-6, 1.0, "log_uniform"),
+    "ln_sigma": (-10.0, 2.0, "uniform"),
+}
+#: Chains must be longer than this many autocorrelation times [2].
+TAU_FACTOR = 50
+#: Largest acceptable rank-normalised split R-hat [2].
+RHAT_LIMIT = 1.01
+#: Relative radius of the starting ball about the MAP [1]: small against any posterior
+#: width here, large enough that the walkers are not degenerate.
+BALL = 1e-4
+
+
+class NotConverged(RuntimeError):
+    """The chains did not converge within the allowed number of steps."""
+
+
+@dataclass(frozen=True)
+class ProfileData:
+    """What is fitted: heights [m], speeds [m s-1] and their covariances."""
+
+    heights: np.ndarray
+    speeds: np.ndarray
+    speed_covariance: np.ndarray       # (n, n) [m2 s-2]
+    height_covariance: np.ndarray      # (n, n) [m2]
+
+
+def profile_data(heights, speeds, speed_covariance=None, height_covariance=None):
+    """ProfileData with zero covariances where none are given (1-D input = std devs)."""
+    heights, speeds = np.asarray(heights, float), np.asarray(speeds, float)
+    return ProfileData(heights, speeds, _covariance(speed_covariance, len(heights)),
+                       _covariance(height_covariance, len(heights)))
+
+
+def _covariance(value, n):
+    if value is None:
+        return np.zeros((n, n))
+    value = np.asarray(value, float)
+    return np.diag(value**2) if value.ndim == 1 else value
+
+
+class ProfilePosterior:
+    """log posterior of (profile parameters, [ln_sigma]) given ProfileData."""
+
+    def __init__(self, name, data, fixed=None, scatter=True, priors=None, relative=False):
+        self.function, self.names, _, _ = PROFILES[name]
+        self.name, self.data, self.fixed = name, data, dict(fixed or {})
+        self.scatter = scatter
+        self.parameter_names = tuple(self.names) + (("ln_sigma",) if scatter else ())
+        self.priors = {**DEFAULT_PRIORS, **(priors or {})}
+        # relative: speed_covariance is of U / f (multiplicative errors), scaled by the
+        # profile at theta: Sigma = diag(f) R diag(f); an absolute covariance estimated
+        # from data with multiplicative errors biases the fit low (Peelle's puzzle [3])
+        self.relative = relative
+        self.diagonal = all(np.count_nonzero(c - np.diag(np.diag(c))) == 0
+                            for c in (data.speed_covariance, data.height_covariance))
+
+    def model(self, heights, *parameters):
+        return self.function(heights, *parameters, **self.fixed)
+
+    def log_prior(self, theta):
+        """log prior of parameter vectors theta (..., k) (0 or -inf for uniform bounds)."""
+        theta = np.asarray(theta, float)
+        total = np.zeros(theta.shape[:-1])
+        for k, name in enumerate(self.parameter_names):
+            total = total + _log_prior_density(theta[..., k], *self.priors[name])
+        return total
+
+    def covariance(self, theta):
+        """Total covariance of the speeds at theta (..., k) [m2 s-2], shape (..., n, n)."""
+        theta = np.asarray(theta, float)
+        k = len(self.names)
+        slope = self._slope(theta[..., :k])
+        speed = self.data.speed_covariance
+        if self.relative:
+            profile = self._profile(self.data.heights, theta[..., :k])
+            speed = profile[..., :, None] * speed * profile[..., None, :]
+        total = speed + slope[..., :, None] * self.data.height_covariance * slope[..., None, :]
+        if self.scatter:
+            total = total + np.exp(2 * theta[..., k])[..., None, None] * np.eye(
+                len(self.data.heights))
+        return total
+
+    def _slope(self, parameters):
+        """dU/dz at the gate heights, by complex step [s-1], shape (..., n)."""
+        step = COMPLEX_STEP
+        return np.imag(self._profile(self.data.heights + 1j * step, parameters)) / step
+
+    def _profile(self, heights, parameters):
+        """Profile at `heights` (n,) for parameter vectors (..., k): shape (..., n)."""
+        columns = [parameters[..., j, None] for j in range(parameters.shape[-1])]
+        return self.model(heights, *columns)
+
+    def log_likelihood(self, theta):
+        """Gaussian log likelihood of parameter vectors theta (..., k); -inf where the
+        covariance is not positive definite or the profile is undefined."""
+        theta = np.atleast_1d(np.asarray(theta, float))
+        k = len(self.names)
+        residual = self.data.speeds - self._profile(self.data.heights, theta[..., :k])
+        if self.diagonal and not self.relative:
+            return self._independent_log_likelihood(theta, residual)
+        covariance = self.covariance(theta)
+        result = np.full(theta.shape[:-1], -np.inf)
+        usable = np.all(np.isfinite(residual), axis=-1) & np.all(np.isfinite(covariance),
+                                                                   axis=(-2, -1))
+        if not np.any(usable):
+            return result
+        eigenvalues = np.linalg.eigvalsh(covariance[usable])
+        positive = np.all(eigenvalues > 0, axis=-1)
+        index = np.flatnonzero(usable)[positive]
+        factor = np.linalg.cholesky(covariance[index])
+        whitened = np.linalg.solve(factor, residual[index][..., None])[..., 0]
+        result[index] = -0.5 * np.sum(whitened**2, axis=-1) \
+            - np.sum(np.log(np.diagonal(factor, axis1=-2, axis2=-1)), axis=-1) \
+            - 0.5 * residual.shape[-1] * np.log(2 * np.pi)
+        return result
+
+    def gate_variances(self, parameters):
+        """Variances of the speeds at the gates without the scatter [m2 s-2]: the diagonal
+        of :meth:`covariance` for profile parameters (..., k), shape (..., n)."""
+        speed = np.diag(self.data.speed_covariance)
+        if self.relative:
+            speed = speed * self._profile(self.data.heights, parameters) ** 2
+        return speed + self._slope(parameters) ** 2 * np.diag(self.data.height_covariance)
+
+    def _independent_log_likelihood(self, theta, residual):
+        """The same for diagonal covariances: no factorisation, O(n) per walker."""
+        k = len(self.names)
+        variance = self.gate_variances(theta[..., :k])
+        if self.scatter:
+            variance = variance + np.exp(2 * theta[..., k, None])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            result = -0.5 * np.sum(residual**2 / variance + np.log(2 * np.pi * variance),
+                                   axis=-1)
+        return np.where(np.isfinite(result), result, -np.inf)
+
+    def log_probability(self, thetas):
+        """log posterior of walkers (W, k), for emcee's ``vectorize=True``; shape (W,)."""
+        thetas = np.asarray(thetas, float)
+        prior = self.log_prior(thetas)
+        result = np.full(thetas.shape[:-1], -np.inf)
+        inside = np.isfinite(prior)
+        if np.any(inside):
+            result[inside] = prior[inside] + self.log_likelihood(thetas[inside])
+        return result
+
+    def __call__(self, theta):
+        return float(self.log_probability(np.asarray(theta, float)[None, :])[0])
+
+
+def _log_prior_density(value, a, b, kind):
+    """Unnormalised log density of one prior: uniform / log_uniform on [a, b] (-inf
+    outside), or normal with mean a and standard deviation b."""
+    if kind == "normal":
+        return -0.5 * ((value - a) / b) ** 2
+    inside = (a <= value) & (value <= b)
+    log_density = -np.log(np.where(inside, value, 1.0)) if kind == "log_uniform" else 0.0
+    return np.where(inside, log_density, -np.inf)
+
+
+def maximum_a_posteriori(posterior):
+    """MAP by Nelder-Mead from the least-squares fit (and the residual scatter)."""
+    data = posterior.data
+    start = least_squares_profile(posterior.name, data.heights, data.speeds,
+                                  fixed=posterior.fixed)
+    theta = list(start["parameters"])
+    if posterior.scatter:
+        low, _, kind = posterior.priors["ln_sigma"]
+        floor = np.exp(low + 1) if kind != "normal" else np.exp(low)   # inside the prior
+        theta.append(np.log(max(start["residual_std"], floor)))
+    result = minimize(lambda t: -posterior(t), np.array(theta), method="Nelder-Mead",
+                      options={"xatol": 1e-10, "fatol": 1e-10, "maxiter": 20000})
+    return result.x
+
+
+def rank_rhat(chains):
+    """Rank-normalised split R-hat [2] of one parameter; chains shape (m, n) -> float.
+
+    The larger of the bulk (rank-normalised draws) and tail (rank-normalised folded
+    draws |x - median|) split R-hat.
+    """
+    def split_rhat(values):
+        half = values.shape[1] // 2
+        split = np.concatenate([values[:, :half], values[:, half:2 * half]])
+        n = split.shape[1]
+        within = np.mean(np.var(split, axis=1, ddof=1))
+        between = n * np.var(np.mean(split, axis=1), ddof=1)
+        return np.sqrt(((n - 1) / n * within + between / n) / within)
+
+    def normalised(values):
+        ranks = rankdata(values, method="average").reshape(values.shape)
+        return ndtri((ranks - 3 / 8) / (values.size + 1 / 4))
+
+    chains = np.asarray(chains, float)
+    folded = np.abs(chains - np.median(chains))
+    return max(split_rhat(normalised(chains)), split_rhat(normalised(folded)))
+
+
+def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=2000,
+                     max_steps=50000):
+    """Sample with several independent emcee ensembles until converged.
+
+    The ensembles run in rounds of `steps`, all to the same length, until that length is
+    above TAU_FACTOR times the largest autocorrelation time (or `max_steps`); then
+    burn-in (2 tau) is dropped, the chains are thinned (tau / 2) and R-hat is taken
+    across ensembles.
+
+    Parameters
+    ----------
+    posterior : ProfilePosterior
+    seed : int or numpy.random.Generator
+        Same seed, same chains.
+
+    Returns
+    -------
+    dict
+        ``samples`` (ensembles, draws, parameters) after burn-in and thinning, ``chain``
+        (ensembles, steps, walkers, parameters) in full, ``tau``, ``burn``, ``thin``,
+        ``rhat`` per parameter, ``map``, ``names``.
+
+    Raises
+    ------
+    NotConverged
+        With tau, the chain length and R-hat, when either criterion fails.
+    """
+    if walkers < MIN_WALKERS:
+        raise ValueError(f"walkers must be >= {MIN_WALKERS}, got {walkers}")
+    entropy = seed.integers(2**63) if isinstance(seed, np.random.Generator) else seed
+    streams = np.random.SeedSequence(entropy).spawn(ensembles + 1)
+    centre = maximum_a_posteriori(posterior)
+    ball = np.random.default_rng(streams[-1])
+    samplers, states = [], []
+    for stream in streams[:-1]:
+        start = _starting_ball(posterior, centre, ball, walkers)
+        states.append(emcee.State(start, random_state=np.random.RandomState(
+            np.random.MT19937(stream)).get_state()))
+        samplers.append(emcee.EnsembleSampler(walkers, centre.size, posterior.log_probability,
+                                              vectorize=True))
+    chains, taus = _run_until_converged(samplers, states, steps, max_steps)
+    tau = np.max(taus, axis=0)
+    burn, thin = int(np.ceil(2 * tau.max())), max(1, int(tau.min() / 2))
+    chains = np.array(chains)                           # (ensembles, steps, walkers, k)
+    samples = chains[:, burn::thin].reshape(len(chains), -1, centre.size)
+    rhat = np.array([rank_rhat(samples[:, :, k]) for k in range(centre.size)])
+    length = chains.shape[1]
+    if length < TAU_FACTOR * tau.max() or np.any(rhat > RHAT_LIMIT):
+        raise NotConverged(
+            f"the chains did not converge: length {length} steps against {TAU_FACTOR} x tau "
+            f"= {TAU_FACTOR * tau.max():.0f} (tau {np.round(tau, 1).tolist()}), rank R-hat "
+            f"{np.round(rhat, 4).tolist()} (limit {RHAT_LIMIT}); allowed: more steps "
+            "(max_steps), more walkers, or narrower priors")
+    return {"samples": samples, "chain": chains, "tau": tau,
+            "burn": burn, "thin": thin, "rhat": rhat, "map": centre,
+            "names": posterior.parameter_names}
+
+
+def _starting_ball(posterior, centre, rng, walkers):
+    """Walkers in a small ball about the MAP, pulled towards it until each lies inside
+    the prior's support (the MAP may sit on a bound, e.g. no scatter: ln_sigma low)."""
+    if not np.isfinite(posterior(centre)):
+        raise NotConverged(f"the maximum a posteriori {np.round(centre, 6).tolist()} has zero "
+                           "posterior density; allowed: priors that contain the data's fit")
+    offsets = BALL * rng.standard_normal((walkers, centre.size)) * np.where(centre == 0, 1.0,
+                                                                            np.abs(centre))
+    for _ in range(60):
+        bad = ~np.isfinite(posterior.log_probability(centre + offsets))
+        if not np.any(bad):
+            break
+        offsets[bad] *= 0.5
+    return centre + offsets
+
+
+def _run_until_converged(samplers, states, steps, max_steps):
+    """Run every ensemble in rounds of `steps`, all to the same length, until that length
+    is above TAU_FACTOR x the largest tau of any ensemble (or `max_steps`)."""
+    while True:
+        states = [sampler.run_mcmc(state, steps, progress=False)
+                  for sampler, state in zip(samplers, states)]
+        taus = [sampler.get_autocorr_time(tol=0) for sampler in samplers]
+        iteration = samplers[0].iteration
+        if iteration > TAU_FACTOR * np.max(taus) or iteration >= max_steps:
+            return [sampler.get_chain() for sampler in samplers], taus
+
+
+def posterior_summary(samples, names):
+    """Median and the 68 % and 95 % central credible intervals of each parameter."""
+    flat = samples.reshape(-1, samples.shape[-1])
+    quantiles = np.quantile(flat, [0.025, 0.16, 0.5, 0.84, 0.975], axis=0)
+    return {name: dict(zip(("low95", "low68", "median", "high68", "high95"), quantiles[:, k]))
+            for k, name in enumerate(names)}

@@ -1,0 +1,116 @@
+"""``uq fit``: read the input and the fit settings, fit, write netCDF and figures.
+
+I/O and orchestration only; the fit is :mod:`uq.fit.fitting`, the figures
+:mod:`uq.fit.plots`.
+"""
+import sys
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from uq.fit.bayesfit import NotConverged
+from uq.errors import ScenarioError
+from uq.fit.fitting import (combine_fits, fit_profile, profile_from_results, profile_from_table,
+                      true_parameters)
+from uq.files import save_figure, write_netcdf
+from uq.pipeline.results import open_results
+from uq.pipeline.scenario import assign_dotted, load_fit_settings
+
+EXIT_OK, EXIT_FAILURE = 0, 1
+
+
+def run_fit(input_path, config_path=None, output=None, overrides=None):
+    """Fit `input_path` (.nc results or .csv table); returns the exit status."""
+    path = Path(input_path)
+    if path.suffix not in (".nc", ".csv"):
+        raise ScenarioError(str(path), "", "allowed: results of uq run (.nc) or a CSV table "
+                            "(.csv)")
+    output = Path(output) if output else path.with_name(f"{path.stem}_fit.nc")
+    if output.suffix != ".nc":
+        raise ScenarioError("-o", str(output), "the output file must end in .nc")
+    results = open_results(path) if path.suffix == ".nc" else None
+    scenario = None if results is None else yaml.safe_load(results.attrs["scenario"]) or {}
+    config = fit_settings(config_path, scenario, overrides or {})
+    try:
+        dataset = _fit_input(path, results, scenario, config)
+    except NotConverged as error:
+        print(f"uq: fit failed: {error}", file=sys.stderr)
+        return EXIT_FAILURE
+    write_netcdf(dataset, output)
+    from uq.fit.plots import plot_corner, plot_profile_fit
+    figures = [output.with_name(f"{output.stem}_profile.png"),
+               output.with_name(f"{output.stem}_corner.png")]
+    save_figure(plot_profile_fit(dataset), figures[0], dpi=120)
+    save_figure(plot_corner(dataset), figures[1], dpi=100, bbox_inches="tight")
+    print(fit_table(dataset))
+    print(f"wrote {output}, {figures[0].name}, {figures[1].name}")
+    return EXIT_OK
+
+
+def fit_settings(config_path, scenario, overrides):
+    """FitConfig from -c FILE's fit section, else the results' scenario's (a mapping),
+    then --set."""
+    source, raw = "defaults", {}
+    if config_path:
+        source = str(config_path)
+        try:
+            document = yaml.safe_load(Path(config_path).read_text()) or {}
+        except (OSError, yaml.YAMLError) as error:
+            raise ScenarioError(source, "", f"cannot read it as YAML ({error})") from None
+        if not isinstance(document, dict) or "fit" not in document:
+            raise ScenarioError(source, "fit", "no 'fit' section; allowed: a YAML mapping "
+                                "with a top-level 'fit' key")
+        raw = document["fit"] or {}
+    elif scenario is not None:
+        source = "scenario of the results"
+        raw = scenario.get("fit") or {}
+    raw = {"fit": dict(raw)}
+    for key, value in overrides.items():
+        if not key.startswith("fit."):
+            raise ScenarioError("--set", key, "allowed: fit.<key>=<value>")
+        assign_dotted(raw, key, value, "--set")
+    return load_fit_settings(raw["fit"], source)
+
+
+def _fit_input(path, results, scenario, config):
+    if results is None:
+        import pandas
+        try:
+            table = pandas.read_csv(path)
+        except (OSError, ValueError) as error:
+            raise ScenarioError(str(path), "", f"cannot read it as CSV ({error})") from None
+        data, dropped = profile_from_table(table, config.columns, source=str(path))
+        dataset = combine_fits({"data": fit_profile(data, config)})
+        dataset.attrs["rows_dropped_not_finite"] = dropped
+        if dropped:
+            print(f"uq: {dropped} row(s) with a missing value not fitted", file=sys.stderr)
+    else:
+        fits = {kind: fit_profile(profile_from_results(results, kind, str(path)), config)
+                for kind in ("propagated", "naive")}
+        dataset = combine_fits(fits, true_parameters(scenario, config))
+    dataset.attrs.update(source=str(path), fit_settings=yaml.safe_dump(config.to_dict()))
+    return dataset
+
+
+def fit_table(dataset):
+    """Posterior median [95 % interval] beside least squares, per fit and parameter."""
+    lines = [f"{'fit':<12}{'parameter':<18}{'median':>10}{'95 % credible':>24}"
+             f"{'least squares':>14}{'95 % confidence':>24}{'true':>9}"]
+    for fit in dataset["fit"].values:
+        row = dataset.sel(fit=fit)
+        for name in dataset["parameter"].values:
+            p = row.sel(parameter=name)
+            truth = float(dataset["true_value"].sel(parameter=name)) \
+                if "true_value" in dataset else np.nan
+            lines.append(
+                f"{fit:<12}{name:<18}{float(p.posterior_median):>10.4g}"
+                f"{_interval(p.posterior_low95, p.posterior_high95):>24}"
+                f"{float(p.least_squares_value):>14.4g}"
+                f"{_interval(p.least_squares_low95, p.least_squares_high95):>24}"
+                f"{truth:>9.4g}")
+    return "\n".join(lines)
+
+
+def _interval(low, high):
+    return f"[{float(low):.4g}, {float(high):.4g}]"

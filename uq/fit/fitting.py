@@ -1,0 +1,196 @@
+"""The fit orchestrator: profile data -> least squares and emcee posterior -> Dataset.
+
+Inputs (:func:`profile_from_results`, :func:`profile_from_table`):
+
+* ``uq run`` results with range gates: the observed speeds are the Monte Carlo means
+  per gate (the expected measurement), fitted twice:
+
+  - ``propagated``: at the propagated mean gate heights (``gate_height_mc_mean``) with
+    the full Monte Carlo covariance of the speeds between gates
+    (``wind_speed_mc_covariance``), which already holds what the height errors do to
+    the speeds (the model measures at the true heights), so no separate height term;
+  - ``naive``: at the nominal heights ``lidar height + range`` with independent errors
+    (the diagonal only), as if each gate's error were its own.
+
+* a table of heights and speeds (e.g. 10-min mast records, several per height), with
+  optional standard uncertainties of speed and height.
+
+Each fit gives the posterior summary (median, 68 % and 95 % central credible
+intervals), the posterior predictive band, the least-squares (``curve_fit``) estimate
+with its delta-method intervals beside it, and the chains.
+
+References
+----------
+.. [1] Matavar, A. (2024). Wind field reconstruction from floating lidars. MSc thesis,
+   TU Delft, Sec. 5.2.2 and App. A.11.
+"""
+import numpy as np
+import xarray as xr
+
+from uq.errors import DataFileError
+from uq.fit.bayesfit import ProfilePosterior, posterior_summary, profile_data, sample_posterior
+from uq.fit.profilefit import least_squares_profile
+from uq.physics.profiles import PROFILES
+
+#: Heights of the bands: this many points between the lowest and highest gate.
+GRID_POINTS = 60
+#: Posterior draws used for the bands (thinned, all ensembles).
+BAND_DRAWS = 4000
+SUMMARY_KEYS = ("low95", "low68", "median", "high68", "high95")
+
+
+def profile_from_results(dataset, kind="propagated", source="results"):
+    """ProfileData of a results Dataset with range gates; `kind` propagated | naive."""
+    _check_results(dataset, source)
+    speeds = dataset["wind_speed_mc_mean"].values
+    if kind == "naive":
+        heights = dataset["gate_height_true"].values
+        return profile_data(heights, speeds, speed_covariance=dataset["wind_speed_mc_u"].values)
+    return profile_data(dataset["gate_height_mc_mean"].values, speeds,
+                        speed_covariance=dataset["wind_speed_mc_covariance"].values)
+
+
+def _check_results(dataset, source):
+    extra = [d for d in dataset["mc_n_samples"].dims]
+    if extra:
+        raise DataFileError(source, "sweep", f"results of a sweep ({', '.join(extra)}); "
+                            "allowed: results of one scene (run without sweep)")
+    if dataset.sizes.get("range", 1) < 3:
+        raise DataFileError(source, "lidar.ranges", f"{dataset.sizes.get('range', 1)} range "
+                            "gate(s); allowed: at least 3 gates to fit a profile")
+    missing = [v for v in ("wind_speed_mc_mean", "wind_speed_mc_covariance",
+                           "gate_height_mc_mean") if v not in dataset]
+    if missing:
+        raise DataFileError(source, "outputs", f"no {', '.join(missing)}; allowed: results "
+                            "of a scenario whose outputs include wind_speed and gate_height")
+
+
+def profile_from_table(table, columns, source="table"):
+    """ProfileData from a mapping/DataFrame of columns (height, speed[, speed_u, height_u]);
+    rows with a missing value are dropped and counted (returned second)."""
+    missing = [columns[k] for k in ("height", "speed") if columns[k] not in table]
+    if missing:
+        raise DataFileError(source, "fit.columns", f"no column {', '.join(missing)}; allowed: "
+                            f"the file's columns ({', '.join(map(str, table))})")
+    names = {k: columns[k] for k in ("height", "speed", "speed_u", "height_u") if k in columns}
+    values = {k: np.asarray(table[c], float) for k, c in names.items() if c in table}
+    finite = np.all([np.isfinite(v) for v in values.values()], axis=0)
+    values = {k: v[finite] for k, v in values.items()}
+    if np.any(values["height"] <= 0):
+        raise DataFileError(source, columns["height"], "heights must be > 0 m")
+    return profile_data(values["height"], values["speed"], values.get("speed_u"),
+                        values.get("height_u")), int(np.sum(~finite))
+
+
+def fit_profile(data, config, seed=None):
+    """Least squares and the emcee posterior of one ProfileData; a Dataset.
+
+    Parameters
+    ----------
+    data : uq.fit.bayesfit.ProfileData
+    config : uq.pipeline.fitconfig.FitConfig
+    seed : int, optional
+        Overrides ``config.seed``.
+    """
+    posterior = ProfilePosterior(config.profile, data, fixed=config.fixed,
+                                 scatter=config.scatter, priors=config.priors)
+    chains = sample_posterior(posterior, config.seed if seed is None else seed,
+                              walkers=config.walkers, ensembles=config.ensembles,
+                              max_steps=config.max_steps)
+    grid = np.linspace(data.heights.min(), data.heights.max(), GRID_POINTS)
+    known = np.all(np.diag(data.speed_covariance) > 0) and not config.scatter
+    # with a free scatter the least-squares reference estimates it from the residuals
+    least = least_squares_profile(config.profile, data.heights, data.speeds,
+                                  sigma=data.speed_covariance if known else None,
+                                  fixed=config.fixed, grid=grid)
+    return _fit_dataset(data, posterior, chains, least, grid)
+
+
+def _fit_dataset(data, posterior, chains, least, grid):
+    names = list(posterior.parameter_names)
+    summary = posterior_summary(chains["samples"], names)
+    bands = predictive_bands(posterior, chains["samples"], grid)
+    k = len(posterior.names)
+    ds = xr.Dataset(
+        {f"posterior_{key}": ("parameter", [summary[n][key] for n in names])
+         for key in SUMMARY_KEYS},
+        coords={"parameter": names, "point": np.arange(grid.size),
+                "gate": np.arange(data.heights.size)})
+    ds["grid_height"] = ("point", grid)
+    ls = np.full(len(names), np.nan)
+    ds["least_squares_value"] = ("parameter", _pad(least["parameters"], ls))
+    ds["least_squares_standard_error"] = ("parameter", _pad(least["standard_errors"], ls))
+    ds["least_squares_low95"] = ("parameter", _pad(least["parameter_low"], ls))
+    ds["least_squares_high95"] = ("parameter", _pad(least["parameter_high"], ls))
+    for key in ("fit", "confidence_low", "confidence_high", "prediction_low", "prediction_high"):
+        ds[f"least_squares_{key}"] = ("point", least[key])
+    for key, values in bands.items():
+        ds[key] = ("point", values)
+    ds["observed_height"] = ("gate", data.heights)
+    ds["observed_speed"] = ("gate", data.speeds)
+    ds["observed_speed_u"] = ("gate", np.sqrt(np.diag(data.speed_covariance)))
+    ds["chain"] = (("ensemble", "step", "walker", "parameter"), chains["chain"])
+    ds["tau"] = ("parameter", chains["tau"])
+    ds["rhat"] = ("parameter", chains["rhat"])
+    ds["maximum_a_posteriori"] = ("parameter", chains["map"])
+    ds.attrs.update(burn=chains["burn"], thin=chains["thin"], profile=posterior.name,
+                    profile_parameters=k)
+    return ds
+
+
+def _pad(values, template):
+    out = template.copy()
+    out[:len(values)] = values
+    return out
+
+
+def predictive_bands(posterior, samples, grid, probability=0.95):
+    """Credible band of the mean profile and posterior predictive band at `grid`.
+
+    The predictive draw at height z is f(z; theta) + e, e ~ N(0, s_meas(z)^2 + sigma^2):
+    s_meas^2 is the gates' variance (:meth:`ProfilePosterior.gate_variances`),
+    interpolated between gates; sigma the scatter of the draw (0 without scatter).
+    One predictive draw per posterior draw, from a generator seeded by the samples'
+    size, so the band is reproducible.
+    """
+    flat = samples.reshape(-1, samples.shape[-1])
+    step = max(1, len(flat) // BAND_DRAWS)
+    flat = flat[::step]
+    k = len(posterior.names)
+    profiles = posterior.model(grid[None, :], *[flat[:, j, None] for j in range(k)])
+    variance = posterior.gate_variances(flat[:, :k])
+    order = np.argsort(posterior.data.heights)
+    heights = posterior.data.heights[order]
+    noise = np.array([np.interp(grid, heights, v[order]) for v in variance])
+    if posterior.scatter:
+        noise = noise + np.exp(2 * flat[:, k, None])
+    rng = np.random.default_rng(len(flat))
+    predictive = profiles + rng.standard_normal(profiles.shape) * np.sqrt(noise)
+    tail = (1 - probability) / 2
+    low, median, high = np.quantile(profiles, [tail, 0.5, 1 - tail], axis=0)
+    p_low, p_high = np.quantile(predictive, [tail, 1 - tail], axis=0)
+    return {"profile_median": median, "profile_low95": low, "profile_high95": high,
+            "predictive_low95": p_low, "predictive_high95": p_high}
+
+
+def true_parameters(scenario_settings, config):
+    """The scenario's true profile parameters (power law only), else None."""
+    wind = scenario_settings["wind"]
+    if config.profile != "power_law":
+        return None
+    speed = wind["speed"] * (config.reference_height / wind["reference_height"]) ** wind["shear"]
+    return {"reference_speed": speed, "shear": wind["shear"]}
+
+
+def combine_fits(fits, truth=None):
+    """Fits by name -> one Dataset with dimension ``fit`` (chains padded with NaN)."""
+    steps = max(ds.sizes["step"] for ds in fits.values())
+    padded = [ds.reindex(step=np.arange(steps)) for ds in fits.values()]
+    combined = xr.concat(padded, dim="fit", combine_attrs="drop_conflicts")
+    combined = combined.assign_coords(fit=list(fits))
+    combined["burn"] = ("fit", [ds.attrs["burn"] for ds in fits.values()])
+    combined["thin"] = ("fit", [ds.attrs["thin"] for ds in fits.values()])
+    if truth is not None:
+        combined["true_value"] = ("parameter", [truth.get(p, np.nan)
+                                                for p in combined["parameter"].values])
+    return combined

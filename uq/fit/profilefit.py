@@ -1,0 +1,112 @@
+"""Least-squares fit of a wind profile, with confidence and prediction intervals.
+
+The reference for the Bayesian fit: ``scipy.optimize.curve_fit`` (Levenberg-Marquardt)
+gives the parameters and their covariance; the bands follow from the delta method,
+``var f(z) = g(z)^T C g(z)`` with g the exact (complex-step) gradient of the profile with
+respect to the parameters:
+
+* confidence band of the mean profile: ``f +- t_{(1+p)/2, n-k} sqrt(g^T C g)`` (the
+  normal quantile when the speeds' uncertainties are given, i.e. known);
+* prediction band of a new measurement: ``f +- t sqrt(g^T C g + s^2)``, s^2 the residual
+  variance (or the given measurement variance when ``sigma`` is absolute).
+
+For a model linear in its parameters these are the textbook regression intervals
+exactly (the tests check it); for the power law they are first-order, as in Matavar
+(2024, App. A.11), who used Matlab's nlinfit.
+
+References
+----------
+.. [1] Seber, G. A. F. and Wild, C. J. (2003). Nonlinear Regression, Wiley, Sec. 5.1.
+.. [2] Matavar, A. (2024). Wind field reconstruction from floating lidars. MSc thesis,
+   TU Delft, App. A.11.
+"""
+import numpy as np
+from scipy.optimize import curve_fit
+from scipy.stats import t as student_t
+
+from uq.constants import COMPLEX_STEP
+from uq.physics.profiles import PROFILES
+
+#: Prediction probability of Matavar (2024, App. A.11): the 68 % prediction interval.
+DEFAULT_PREDICTION = 0.68
+
+
+def least_squares_profile(name, heights, speeds, sigma=None, fixed=None, confidence=0.95,
+                          prediction=DEFAULT_PREDICTION, grid=None):
+    """Fit profile `name` of :data:`uq.physics.profiles.PROFILES` by least squares.
+
+    Parameters
+    ----------
+    name : str
+    heights, speeds : array_like, shape (n,)
+        [m], [m s-1].
+    sigma : array_like, shape (n,) or (n, n), optional
+        Standard uncertainties of the speeds [m s-1], or their covariance matrix
+        [m2 s-2] (generalised least squares, as ``curve_fit`` takes it), taken as
+        absolute; without them the scatter is estimated from the residuals.
+    fixed : dict, optional
+        Fixed keyword arguments of the profile (e.g. ``reference_height``).
+    confidence, prediction : float
+        Probabilities of the confidence and prediction intervals.
+    grid : array_like, optional
+        Heights of the bands [m] (default: `heights`).
+
+    Returns
+    -------
+    dict
+        ``parameters``, ``standard_errors``, ``parameter_low``/``high`` (confidence),
+        ``covariance``, ``names``, ``units``, ``dof``, ``residual_std`` [m s-1], ``grid``,
+        ``fit``, ``confidence_low``/``high``, ``prediction_low``/``high`` [m s-1].
+    """
+    function, names, units, guess = PROFILES[name]
+    fixed = dict(fixed or {})
+    heights, speeds = np.asarray(heights, float), np.asarray(speeds, float)
+    dof = len(heights) - len(names)
+    if dof < 1:
+        raise ValueError(f"{len(heights)} points cannot fit {len(names)} parameters with a "
+                         "residual: need at least one more point")
+
+    def model(z, *parameters):
+        return function(z, *parameters, **fixed)
+
+    absolute = sigma is not None
+    parameters, covariance = curve_fit(model, heights, speeds, p0=guess(heights, speeds, **fixed),
+                                       sigma=sigma, absolute_sigma=absolute)
+    residuals = speeds - model(heights, *parameters)
+    residual_variance = float(np.sum(residuals**2) / dof)
+    grid = heights if grid is None else np.asarray(grid, float)
+    gradient = parameter_gradient(model, grid, parameters)
+    mean_variance = np.einsum("gk,kl,gl->g", gradient, covariance, gradient)
+    noise = np.interp(grid, heights, _variances(sigma)) if absolute else residual_variance
+    # known (absolute) variances: normal quantiles; estimated scatter: Student t, n - k dof
+    quantile_dof = np.inf if absolute else dof
+    t_confidence = student_t.ppf((1 + confidence) / 2, quantile_dof)
+    t_prediction = student_t.ppf((1 + prediction) / 2, quantile_dof)
+    errors = np.sqrt(np.diag(covariance))
+    fit = model(grid, *parameters)
+    return {"names": names, "units": units, "parameters": parameters, "standard_errors": errors,
+            "parameter_low": parameters - t_confidence * errors,
+            "parameter_high": parameters + t_confidence * errors,
+            "covariance": covariance, "dof": dof, "residual_std": np.sqrt(residual_variance),
+            "grid": grid, "fit": fit,
+            "confidence_low": fit - t_confidence * np.sqrt(mean_variance),
+            "confidence_high": fit + t_confidence * np.sqrt(mean_variance),
+            "prediction_low": fit - t_prediction * np.sqrt(mean_variance + noise),
+            "prediction_high": fit + t_prediction * np.sqrt(mean_variance + noise)}
+
+
+def _variances(sigma):
+    """Variances of the speeds from standard uncertainties (n,) or a covariance (n, n)."""
+    sigma = np.asarray(sigma, float)
+    return np.diag(sigma) if sigma.ndim == 2 else sigma**2
+
+
+def parameter_gradient(model, heights, parameters):
+    """d model / d parameters at `heights` by complex step, shape (n_heights, k)."""
+    columns = []
+    for k in range(len(parameters)):
+        shifted = np.array(parameters, dtype=complex)
+        step = COMPLEX_STEP * max(1.0, abs(parameters[k]))
+        shifted[k] += 1j * step
+        columns.append(np.imag(model(heights, *shifted)) / step)
+    return np.stack(columns, axis=-1)

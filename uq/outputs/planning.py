@@ -1,0 +1,287 @@
+"""Campaign-planning answers from a finished results Dataset.
+
+Pure functions of a Dataset (no I/O, no plotting) that return plain numbers and short
+verdicts: the best misalignment, the largest velocity ratio that keeps u(Vh) under a
+target, the dominant inputs of the uncertainty budget, where the paper's analytic model
+and sampling disagree, the bias of the correction, and whether the stated findings of
+Rubio & Gottschall (2022, Sec. 3) hold in each model. Averages over wind direction (and
+over any other swept dimension not asked about) are plain means over the grid.
+
+References
+----------
+.. [1] Rubio, H. and Gottschall, J. (2022). J. Phys.: Conf. Ser. 2362 012034.
+"""
+import numpy as np
+
+from uq.constants import FULL_CIRCLE_DEG
+
+MODEL_NAMES = {"paper_u": "paper (Rubio & Gottschall 2022)", "gum_u": "GUM, physical",
+               "mc_u": "Monte Carlo, physical"}
+#: Targets of the velocity-ratio answer when the user gives none [m s-1]: around the
+#: u(Vh) of the paper's Table B2 set-up (0.045-0.07 m/s), so the answer is informative.
+DEFAULT_TARGETS = (0.05, 0.06, 0.07)
+#: Velocity ratios VR = sog / Vh of the paper's Fig. 4 [1].
+VELOCITY_RATIOS = (0.5, 1.0, 2.0)
+#: Relative size under which two uncertainties count as equal in a finding [1]: 0.5 %, far
+#: above the GUM's rounding and below any effect the paper discusses (2 % and more).
+EQUAL_WITHIN = 0.005
+
+
+def models(dataset, quantity):
+    """Uncertainty variables of `quantity` present and not all NaN, as suffixes."""
+    return [m for m in MODEL_NAMES if f"{quantity}_{m}" in dataset
+            and np.isfinite(dataset[f"{quantity}_{m}"].values).any()]
+
+
+def mean_over(dataset, name, keep):
+    """Mean of `name` over every grid dimension except `keep` (and range gates)."""
+    variable = dataset[name]
+    drop = [d for d in variable.dims if d not in keep]
+    return variable.mean(drop)
+
+
+def misalignment_answer(dataset, quantity="wind_speed"):
+    """Best and worst misalignment per model, from u averaged over everything else.
+
+    Returns
+    -------
+    dict
+        model -> {"best", "worst" [deg], "u_best", "u_worst", "gain" (1 - u_best/u_worst)}.
+    """
+    answer = {}
+    for model in models(dataset, quantity):
+        curve = mean_over(dataset, f"{quantity}_{model}", ("lidar_misalignment",))
+        best, worst = int(np.argmin(curve.values)), int(np.argmax(curve.values))
+        x = dataset["lidar_misalignment"].values
+        answer[model] = {"best": float(x[best]), "worst": float(x[worst]),
+                         "u_best": float(curve[best]), "u_worst": float(curve[worst]),
+                         "gain": float(1 - curve[best] / curve[worst])}
+    return answer
+
+
+def velocity_ratio_answer(dataset, target, quantity="wind_speed"):
+    """Largest velocity ratio VR = sog / Vh that keeps the direction-averaged u(Vh) at or
+    under `target` for every swept wind speed (per model). The ratio is found on the
+    swept sog grid: at each Vh, the largest swept sog up to which u stays <= target.
+
+    Returns
+    -------
+    dict
+        model -> {"ratio": float (inf if never exceeded, NaN if exceeded at sog 0),
+        "limiting_speed": the Vh that sets it [m s-1]}.
+    """
+    answer = {}
+    speeds, sogs = dataset["wind_speed"].values, dataset["ship_sog"].values
+    for model in models(dataset, quantity):
+        grid = mean_over(dataset, f"{quantity}_{model}", ("wind_speed", "ship_sog"))
+        grid = grid.transpose("wind_speed", "ship_sog").values
+        ratios = []
+        for speed, row in zip(speeds, grid):
+            over = np.flatnonzero(row > target)
+            if over.size == 0:
+                ratios.append(np.inf)
+            else:
+                ratios.append(np.nan if over[0] == 0 else sogs[over[0] - 1] / speed)
+        ratios = np.array(ratios)
+        limiting = int(np.nanargmin(ratios)) if np.isfinite(ratios).any() else 0
+        answer[model] = {"ratio": float(np.min(ratios)), "limiting_speed": float(speeds[limiting])}
+    return answer
+
+
+def budget_answer(dataset, quantity="wind_speed"):
+    """Each input's share of the GUM variance, averaged over the grid, largest first.
+
+    Returns
+    -------
+    list of (input, share [1])
+    """
+    budget = dataset[f"{quantity}_budget"]
+    total = budget.sum("input")
+    share = (budget / total.where(total > 0)).mean([d for d in budget.dims if d != "input"])
+    pairs = [(str(name), float(value)) for name, value in zip(dataset["input"].values, share.values)]
+    return sorted(pairs, key=lambda pair: -np.nan_to_num(pair[1]))
+
+
+def disagreement_answer(dataset, quantity="wind_speed", reference="mc_u"):
+    """The paper's u against sampling (or the GUM): ratio paper / reference over the grid.
+
+    Returns
+    -------
+    dict or None
+        {"median", "min", "max" of the ratio, "where_max": {dim: value} of the largest
+        |ratio - 1|, "scenes": number compared}; None outside the paper's model.
+    """
+    reference = reference if f"{quantity}_{reference}" in dataset else "gum_u"
+    if "paper_u" not in models(dataset, quantity):
+        return None
+    ratio = dataset[f"{quantity}_paper_u"] / dataset[f"{quantity}_{reference}"]
+    valid = np.isfinite(ratio.values)
+    if not valid.any():
+        return None
+    flat = int(np.nanargmax(np.abs(np.where(valid, ratio.values, np.nan) - 1)))
+    where = dict(zip(ratio.dims, np.unravel_index(flat, ratio.shape)))
+    return {"reference": reference, "median": float(np.nanmedian(ratio.values)),
+            "min": float(np.nanmin(ratio.values)), "max": float(np.nanmax(ratio.values)),
+            "where_max": {d: _value(ratio[d].values[i]) if d in ratio.coords else int(i)
+                          for d, i in where.items()},
+            "scenes": int(valid.sum())}
+
+
+def bias_answer(dataset, quantity="wind_speed"):
+    """Systematic error of the correction (nominal - true) and the Monte Carlo bias.
+
+    Returns
+    -------
+    dict
+        {"correction": largest |nominal - true| and where, "mc": largest |mc_bias| and
+        where, "significant": share of scenes where |mc_bias| > 3 standard errors
+        (u / sqrt(N)), or None without Monte Carlo}.
+    """
+    truth, nominal = dataset[f"{quantity}_true"], dataset[f"{quantity}_nominal"]
+    difference = nominal - truth
+    if quantity == "wind_direction":
+        difference = (difference + FULL_CIRCLE_DEG / 2) % FULL_CIRCLE_DEG - FULL_CIRCLE_DEG / 2
+    answer = {"correction": _largest(difference)}
+    if f"{quantity}_mc_bias" in dataset:
+        bias = dataset[f"{quantity}_mc_bias"]
+        error = dataset[f"{quantity}_mc_u"] / np.sqrt(dataset["mc_n_samples"])
+        answer["mc"] = _largest(bias)
+        answer["significant"] = float((np.abs(bias) > 3 * error).mean())
+    return answer
+
+
+def _largest(variable):
+    values = np.abs(variable.values)
+    if not np.isfinite(values).any():
+        return {"value": float("nan"), "where": {}}
+    flat = int(np.nanargmax(values))
+    index = np.unravel_index(flat, variable.shape)
+    return {"value": float(variable.values.flat[flat]),
+            "where": {d: _value(variable[d].values[i]) if d in variable.coords else int(i)
+                      for d, i in zip(variable.dims, index)}}
+
+
+def _value(value):
+    return float(value) if np.issubdtype(np.asarray(value).dtype, np.number) else str(value)
+
+
+def paper_findings(dataset):
+    """The findings of Rubio & Gottschall (2022, Sec. 3) that the result can test.
+
+    Returns
+    -------
+    list of dict
+        {"finding", "model", "holds" (bool), "evidence" (str)} per finding and model.
+    """
+    dims = set(dataset["mc_n_samples"].dims)
+    rows = []
+    if {"lidar_misalignment", "wind_direction"} <= dims:
+        rows += _misalignment_findings(dataset)
+    if {"wind_speed", "ship_sog", "wind_direction"} <= dims:
+        rows += _velocity_ratio_findings(dataset)
+    if {"ship_pitch", "ship_roll", "wind_direction"} <= dims:
+        rows += _tilt_findings(dataset)
+    if {"lidar_half_cone", "wind_direction"} <= dims:
+        rows += _half_cone_findings(dataset)
+    return rows
+
+
+def _half_cone_findings(dataset):
+    """Fig. 7 [1]: u(Vh) falls as the half-cone angle grows."""
+    rows = []
+    for model in models(dataset, "wind_speed"):
+        curve = mean_over(dataset, f"wind_speed_{model}", ("lidar_half_cone",)).values
+        change = curve[-1] / curve[0] - 1
+        cones = dataset["lidar_half_cone"].values
+        rows.append({"finding": "u(Vh) falls as the half-cone angle grows",
+                     "model": MODEL_NAMES[model],
+                     "holds": bool(np.all(np.diff(curve) <= 0) and change < -EQUAL_WITHIN),
+                     "evidence": f"{curve[0]:.4g} m/s at {cones[0]:g} deg, {curve[-1]:.4g} m/s "
+                     f"at {cones[-1]:g} deg ({100 * change:+.1f} %)"})
+    return rows
+
+
+def _misalignment_findings(dataset):
+    """Fig. 2 [1]: per ship direction (each panel), the direction-averaged u(Vh) is lowest
+    at misalignment 0/±90 deg and highest at ±45 deg."""
+    rows = []
+    x = dataset["lidar_misalignment"].values % FULL_CIRCLE_DEG
+    on_beams, diagonal = np.isclose(x % 90.0, 0.0), np.isclose(x % 90.0, 45.0)
+    if not (on_beams.any() and diagonal.any()):
+        return rows
+    for model in models(dataset, "wind_speed"):
+        keep = ("lidar_misalignment", "ship_cog") if "ship_cog" in dataset.dims \
+            else ("lidar_misalignment",)
+        curves = mean_over(dataset, f"wind_speed_{model}", keep)
+        curves = curves.transpose(..., "lidar_misalignment").values.reshape(-1, len(x))
+        verdicts = [_extremes_on(curve, on_beams, diagonal) for curve in curves]
+        spread = np.max([(c.max() - c.min()) / c.mean() for c in curves])
+        rows.append({"finding": "u(Vh) averaged over wind direction is lowest at misalignment "
+                     "0/±90 deg and highest at ±45 deg (every ship direction)",
+                     "model": MODEL_NAMES[model],
+                     "holds": bool(all(verdicts) and spread > EQUAL_WITHIN),
+                     "evidence": (f"extremes as stated for {sum(verdicts)} of {len(verdicts)} "
+                                  "ship directions; " if spread > EQUAL_WITHIN else
+                                  "no effect: the same u at every misalignment; ")
+                     + f"u = {curves[:, on_beams].mean():.4g} m/s at 0/±90 deg, "
+                     f"{curves[:, diagonal].mean():.4g} m/s at ±45 deg; largest spread over "
+                     f"misalignment {100 * spread:.2f} %"})
+    return rows
+
+
+def _extremes_on(curve, minima, maxima):
+    """Is the curve's minimum at one of `minima` and its maximum at one of `maxima`?"""
+    return bool(np.isclose(curve.min(), curve[minima].min(), rtol=1e-9)
+                and np.isclose(curve.max(), curve[maxima].max(), rtol=1e-9))
+
+
+def velocity_ratio_line(dataset, name, ratio):
+    """Direction-averaged `name` along sog = ratio * Vh (linear interpolation in sog), at
+    the swept wind speeds whose sog stays inside the swept range: (speeds, values)."""
+    grid = mean_over(dataset, name, ("wind_speed", "ship_sog"))
+    speeds = dataset["wind_speed"].values
+    speeds = speeds[ratio * speeds <= dataset["ship_sog"].values.max()]
+    return speeds, np.array([float(grid.sel(wind_speed=v).interp(ship_sog=ratio * v))
+                             for v in speeds])
+
+
+def _velocity_ratio_findings(dataset):
+    rows = []
+    for model in models(dataset, "wind_speed"):
+        lines = {ratio: velocity_ratio_line(dataset, f"wind_speed_{model}", ratio)
+                 for ratio in VELOCITY_RATIOS}
+        common = np.intersect1d(lines[0.5][0], lines[2.0][0])
+        pick = lambda r: lines[r][1][np.isin(lines[r][0], common)]   # noqa: E731
+        ordered = np.all(pick(0.5) <= pick(1.0)) and np.all(pick(1.0) <= pick(2.0))
+        gain = float(np.mean(pick(2.0) / pick(0.5) - 1))
+        rows.append({"finding": "a higher velocity ratio VR = sog/Vh gives a higher u(Vh)",
+                     "model": MODEL_NAMES[model], "holds": bool(ordered and gain > EQUAL_WITHIN),
+                     "evidence": f"u(VR = 2) / u(VR = 0.5) - 1 = {100 * gain:+.2f} % on average "
+                     f"over Vh = {common.min():g}-{common.max():g} m/s"})
+    return rows
+
+
+def _tilt_findings(dataset):
+    rows = []
+    for quantity in ("wind_speed", "wind_direction"):
+        for model in models(dataset, quantity):
+            grid = mean_over(dataset, f"{quantity}_{model}", ("ship_pitch", "ship_roll"))
+            level = float(grid.sel(ship_pitch=0.0, ship_roll=0.0))
+            tilted = grid.where((grid["ship_pitch"] != 0) | (grid["ship_roll"] != 0))
+            change = float(tilted.max() / level - 1), float(tilted.min() / level - 1)
+            holds = change[0] < EQUAL_WITHIN and change[1] < -EQUAL_WITHIN
+            symbol = "u(Vh)" if quantity == "wind_speed" else "u(Theta)"
+            rows.append({"finding": f"tilt lowers {symbol}", "model": MODEL_NAMES[model],
+                         "holds": bool(holds),
+                         "evidence": f"level {level:.4g}; tilted scenes {100 * change[1]:+.1f} % "
+                         f"to {100 * change[0]:+.1f} %"})
+    return rows
+
+
+def gum_validity_answer(dataset, quantity="wind_speed"):
+    """Share of scenes whose GUM interval Monte Carlo validates (JCGM 101 clause 8), and
+    the share where that verdict is conclusive; None without Monte Carlo."""
+    if f"{quantity}_gum_valid" not in dataset:
+        return None
+    return {"valid": float(dataset[f"{quantity}_gum_valid"].mean()),
+            "conclusive": float(dataset[f"{quantity}_gum_validation_conclusive"].mean())}

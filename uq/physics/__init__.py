@@ -1,0 +1,1 @@
+"""Pure lidar physics: numpy array functions and the compiled kernels."""

@@ -1,0 +1,157 @@
+"""Motion-corrected DBS wind reconstruction: the four correction models.
+
+The lidar measures radial velocities in its own (ship-fixed) frame. The correction uses
+the navigation data the INS reports (which carry errors) and the lidar's configured
+(nominal) geometry, and returns the earth-frame wind (north, east, up) [m s-1].
+
+Correction models (``model``):
+
+``none``
+    No motion correction: lidar frame assumed level and at the scene's nominal heading;
+    ship velocity not removed. ``u = Rz(heading_nominal) A^+ v``.
+``yaw``
+    Rubio & Gottschall (2022) case i: heading plus horizontal ship velocity,
+    ``u = Rz(heading) A^+ v + (sog cos cog, sog sin cog, 0)`` (Eq. 16 [1]).
+``tilt2d``
+    Their Eq. 13 as written: the full rotation applied to the horizontal DBS components
+    only, ``u_h = [R(heading, pitch, roll) P A^+ v]_h + s_h`` with ``P = diag(1, 1, 0)``;
+    the lidar-frame vertical component is dropped from the rotation.
+``full``
+    The full rotation applied to all three lidar-frame components, plus the ship
+    velocity including heave: ``u = R A^+ v + (sog cos cog, sog sin cog, heave)``.
+
+The vertical wind of ``none``, ``yaw`` and ``tilt2d`` is the lidar-frame vertical
+component (no heave or tilt correction); that of ``full`` is the corrected one.
+
+INS correlation
+---------------
+Navigation arrays have shape (..., 1) for ``scan`` (one reading for all beams) or
+(..., n_beams) for ``beam`` (each beam corrected point-wise with its own reading,
+Matavar 2024, Sec. 3.2 [2]). Point-wise correction: beam i's radial velocity is freed
+of the ship motion along the direction the correction believes the beam points,
+``b_i = v_i + n_i . s_i`` with ``n_i = R_i n_i^lidar``, and the wind is the least-squares
+solution of ``n_i . u = b_i``. With all readings equal this is exactly the scan formula
+above (least squares commutes with a common rotation); the tests check it. For
+``tilt2d`` the point-wise ``full`` estimate is then projected as in Eq. 13 with the
+attitude and ship velocity of the beams' mean reading.
+
+To first order, point-wise correction with independent readings gives exactly the
+variance of Rubio & Gottschall's Eqs. 8 and 19 (independent radial-velocity errors
+``dv_i = dn_i . (u - s) - n_i . ds_i``), which is why ``beam`` is the physical model
+that their analytic model approximates.
+
+References
+----------
+.. [1] Rubio, H. and Gottschall, J. (2022). J. Phys.: Conf. Ser. 2362 012034.
+.. [2] Matavar, A. (2024). Wind field reconstruction from floating lidars. MSc thesis,
+   TU Delft.
+"""
+import numpy as np
+
+from uq.physics.rotation import apply_matrix, attitude_matrix, rotation_about_vertical
+
+CORRECTION_MODELS = ("none", "yaw", "tilt2d", "full")
+
+
+def correction_rotation(model, heading, pitch, roll, nominal_heading):
+    """Lidar-to-earth rotation the correction model believes [rad in, (..., 3, 3) out]."""
+    if model == "none":
+        return rotation_about_vertical(np.asarray(nominal_heading) + 0 * heading)
+    if model == "yaw":
+        return rotation_about_vertical(heading)
+    return attitude_matrix(heading, pitch, roll)
+
+
+def correction_ship_velocity(model, sog, cog, heave):
+    """Ship velocity (north, east, up) [m s-1] the model removes; shape (..., 3)."""
+    zero = 0 * sog
+    if model == "none":
+        return np.stack([zero, zero, zero], axis=-1)
+    vertical = heave + zero if model == "full" else zero + 0 * heave
+    return np.stack(np.broadcast_arrays(sog * np.cos(cog), sog * np.sin(cog), vertical),
+                    axis=-1)
+
+
+def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navigation,
+                     nominal_heading=0.0):
+    """Earth-frame wind from radial velocities under a correction model.
+
+    Parameters
+    ----------
+    radial_velocity : ndarray, shape (..., n_beams, n_gates)
+        Measured radial velocities [m s-1].
+    model : {"none", "yaw", "tilt2d", "full"}
+    lidar_unit_vectors : ndarray, shape (*S, n_beams, 3)
+        Nominal beam vectors in the lidar/ship frame (S: scenes, may be empty).
+    operator : ndarray, shape (*S, 3, n_beams)
+        Least-squares operator of `lidar_unit_vectors`
+        (:func:`uq.beams.least_squares_operator`).
+    navigation : dict of ndarray, each shape (..., k)
+        INS readings ``heading``, ``pitch``, ``roll`` [rad], ``sog`` [m s-1], ``cog``
+        [rad], ``heave`` [m s-1]; k = 1 (scan) or n_beams (beam, point-wise).
+    nominal_heading : float or ndarray
+        Heading assumed by ``none`` [rad], broadcastable to the navigation arrays.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, n_gates)
+        Wind (north, east, up) [m s-1].
+    """
+    nav = navigation
+    rotation = correction_rotation(model, nav["heading"], nav["pitch"], nav["roll"],
+                                   nominal_heading)
+    ship = correction_ship_velocity(model, nav["sog"], nav["cog"], nav["heave"])
+    if rotation.shape[-3] == 1:
+        return _scan_correction(radial_velocity, model, operator, rotation[..., 0, :, :],
+                                ship[..., 0, :])
+    wind = _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship)
+    if model != "tilt2d":
+        return wind
+    mean = {key: np.mean(value, axis=-1) for key, value in nav.items()}
+    mean_rotation = attitude_matrix(mean["heading"], mean["pitch"], mean["roll"])
+    mean_ship = correction_ship_velocity(model, mean["sog"], mean["cog"], mean["heave"])
+    lidar_relative = np.swapaxes(mean_rotation, -1, -2) @ (wind - mean_ship[..., :, None])
+    return _horizontal_rotation(mean_rotation, lidar_relative, mean_ship)
+
+
+def _scan_correction(radial_velocity, model, operator, rotation, ship_velocity):
+    """Eq. 13 [1]: u = R P u_lidar + s, with one navigation reading per scan."""
+    if rotation.size == 9:
+        # one rotation for every sample (no heading or attitude error): folded into the
+        # least-squares operator, one matrix product per sample instead of two
+        return apply_matrix(_earth_operator(model, rotation.reshape(3, 3), operator),
+                            radial_velocity) + ship_velocity[..., :, None]
+    lidar_wind = apply_matrix(operator, radial_velocity)        # Eqs. 14-15, (..., 3, g)
+    if model == "full":
+        return apply_matrix(rotation, lidar_wind) + ship_velocity[..., :, None]
+    return _horizontal_rotation(rotation, lidar_wind, ship_velocity)
+
+
+def _earth_operator(model, rotation, operator):
+    """Radial velocities -> earth-frame wind for a fixed rotation, shape (*S, 3, b):
+    ``R A^+`` (full) or the horizontal rows ``R_hh A^+_h`` over the lidar-frame
+    vertical row (Eq. 13 [1], as :func:`_horizontal_rotation`)."""
+    if model == "full":
+        return rotation @ operator
+    horizontal = rotation[:2, :2] @ operator[..., :2, :]
+    return np.concatenate([horizontal, operator[..., 2:3, :]], axis=-2)
+
+
+def _horizontal_rotation(rotation, lidar_wind, ship_velocity):
+    """Eq. 13 [1] on the horizontal lidar components; keeps the lidar-frame vertical.
+
+    ``[R P u]_h = R[:2, :2] u_h`` since P = diag(1, 1, 0) drops the third column of R.
+    """
+    earth = apply_matrix(rotation[..., :2, :2], lidar_wind[..., :2, :]) \
+        + ship_velocity[..., :2, None]
+    vertical = np.broadcast_to(lidar_wind[..., 2:3, :], earth.shape[:-2] + (1, earth.shape[-1]))
+    return np.concatenate([earth, vertical], axis=-2)
+
+
+def _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship_velocity):
+    """Least squares on point-wise corrected beams, each with its own reading."""
+    beams = (rotation @ lidar_unit_vectors[..., None])[..., 0]     # (..., b, 3)
+    ship_along_beam = np.sum(beams * ship_velocity, axis=-1)       # (..., b)
+    corrected = radial_velocity + ship_along_beam[..., None]       # (..., b, g)
+    beams_t = np.swapaxes(beams, -1, -2)                           # (..., 3, b)
+    return np.linalg.solve(beams_t @ beams, beams_t @ corrected)

@@ -1,0 +1,270 @@
+"""The ship-lidar measurement model: true scene -> measured radial velocities -> wind.
+
+One function, :func:`measurement_model`, is the model the Monte Carlo engine and the GUM
+propagate. Its random inputs are *errors* (deviations from the nominal scene):
+
+===========================  ===============  ========================================
+input                        shape            meaning
+===========================  ===============  ========================================
+``ins_heading``              (n, k)           INS heading error [deg]
+``ins_pitch``, ``ins_roll``  (n, k)           INS attitude errors [deg]
+``ins_sog``, ``ins_heave``   (n, k)           INS velocity errors [m s-1]
+``ins_cog``                  (n, k)           INS course error [deg]
+``lidar_half_cone``          (n,)             true minus configured half-cone [deg]
+``lidar_misalignment``       (n,)             true minus configured misalignment [deg]
+``lidar_radial_velocity``    (n, beams, gates) radial-velocity noise [m s-1]
+``lidar_height``             (n,)             true minus configured height of the lidar
+                                              above sea level [m] (draft, ballast, tide)
+===========================  ===============  ========================================
+
+k = 1 when INS errors are shared by the beams of a scan (``scan``) and k = n_beams when
+each beam has its own reading (``beam``). Missing inputs are zero.
+
+By default every scene of a batch sees the same draws (common random numbers). With
+``scene_draws=True`` the errors carry the scene axes instead, shape (n, *S, ...) (INS
+errors (n, *S, k)): independent draws per scene, as for the records of a measurement
+campaign (:mod:`uq.golden.campaign`).
+
+A height error moves every range gate with the lidar: the reconstruction still believes
+the configured heights, so under shear it reads the wind of another height.
+
+The *true* radial velocities use the true attitude and ship velocity, the true
+geometry (configured + error), and the true wind at each beam's true height (power-law
+shear; the heights follow from the attitude). Reconstruction uses the INS readings
+(true + error) and the configured geometry, under the chosen correction model
+(:mod:`uq.physics.correction`).
+
+The function is vectorised over samples and complex-step safe, so the GUM Jacobian is
+exact (:mod:`uq.engine.gum`). It is also vectorised over *scenes*: the numeric fields of a
+:class:`Scene` may be arrays of one common shape S (a batch of scenes that share their
+structure: beams, gates, correction). Outputs then have shape (n, *S, ...), and every
+scene sees the same error draws (common random numbers). Quantities that do not depend
+on the errors (nominal beam vectors, least-squares operator, slant distances) are
+computed once per scene, not per sample.
+
+The output ``gate_height`` is the mean true height of the slanted beams at each range
+gate [m]: the height the reconstructed horizontal wind belongs to, which a tilted lidar
+or a half-cone error moves away from the nominal ``lidar_height + range``.
+"""
+import numpy as np
+
+from uq import complexstep
+
+from uq.physics import wind
+from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
+from uq.physics.correction import correction_rotation, correction_ship_velocity, reconstruct_wind
+from uq.physics.rotation import attitude_matrix, rotate_vectors
+from uq.physics.scene import (ANGULAR_NAVIGATION, COMPILED_OUTPUTS, NAVIGATION, OUTPUTS,  # noqa: F401
+                              SCENE_FIELDS, Scene, sample_count)
+
+def true_wind(scene, heights, trailing=1):
+    """True wind (north, east, up) [m s-1] at `heights` [m] of shape (..., *S, *T) with
+    `trailing` = len(T) dimensions after the scenes'; shape heights.shape + (3,)."""
+    field = lambda name: scene.field(name, trailing)       # noqa: E731
+    speed = wind.power_law_speed(field("wind_speed"), heights, field("reference_height"),
+                                 field("shear"))
+    north, east = wind.wind_components(speed, complexstep.degrees(field("wind_direction")))
+    up = np.zeros_like(north) + field("vertical_wind")
+    return np.stack([north, east, up], axis=-1)
+
+
+def beam_heights(scene, beams_earth, height_error=0.0):
+    """True height above sea level of every beam's range gates [m].
+
+    The lidar places gate g at the slant distance ``range_g / cos(half_cone)`` along its
+    (configured) cone; the true height follows from the true earth-frame beam and the
+    lidar's true height (configured + `height_error`).
+
+    Parameters
+    ----------
+    beams_earth : ndarray, shape (..., *S, n_beams, 3)
+    height_error : float or ndarray, shape (n, *S) or (n, *1)
+        True minus configured lidar height [m].
+
+    Returns
+    -------
+    ndarray, shape (..., *S, n_beams, n_gates)
+    """
+    slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
+                            scene.vertical_beam)                        # (*S, b, g)
+    lidar = scene.field("lidar_height", 2) + np.asarray(height_error)[..., None, None]
+    return lidar + slant * beams_earth[..., 2:3]
+
+
+def true_radial_velocity(scene, beams_earth, ship_velocity, height_error=0.0):
+    """Radial velocities of the true wind seen from the moving lidar [m s-1].
+
+    Parameters
+    ----------
+    scene : Scene
+    beams_earth : ndarray, shape (..., *S, n_beams, 3)
+        True earth-frame beam unit vectors.
+    ship_velocity : ndarray, shape (*S, 3)
+        True ship velocity (north, east, up) [m s-1].
+    height_error : float or ndarray
+        True minus configured lidar height [m] (:func:`beam_heights`).
+
+    Returns
+    -------
+    radial : ndarray, shape (..., n_beams, n_gates)
+        ``n . (u_wind(z) - u_ship)`` (Eq. 2 of Rubio & Gottschall 2022, point-wise).
+    wind_only : ndarray, shape (..., n_beams, n_gates)
+        ``n . u_wind(z)``, the motion-free radial wind.
+    """
+    heights = beam_heights(scene, beams_earth, height_error)            # (..., *S, b, g)
+    field = lambda name, trailing: scene.field(name, trailing)          # noqa: E731
+    speed = wind.power_law_speed(field("wind_speed", 2), heights,
+                                 field("reference_height", 2), field("shear", 2))
+    # n . u(z) = U(z) (n_h . e_wind) + n_up w: the direction of the horizontal wind is the
+    # same at every height, so only its speed is evaluated per beam and gate (no stacked
+    # (..., b, g, 3) wind vectors)
+    to_north, to_east = wind.wind_components(1.0, complexstep.degrees(
+        field("wind_direction", 1)))                                    # (*S, 1)
+    north, east, up = (beams_earth[..., k] for k in range(3))           # (..., *S, b)
+    along_wind = north * to_north + east * to_east
+    ship = np.asarray(ship_velocity)[..., None, :]                      # (*S, 1, 3)
+    ship_along = north * ship[..., 0] + east * ship[..., 1] + up * ship[..., 2]
+    wind_only = speed * along_wind[..., None] + (up * field("vertical_wind", 1))[..., None]
+    return wind_only - ship_along[..., None], wind_only
+
+
+def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, **errors):
+    """Propagate errors through measurement and correction; see the module docstring.
+
+    `scene_draws` (bool): the errors carry the scene axes (independent draws per scene).
+    `compiled` (bool): where it applies (:func:`uq.fused.applicable`: one scene, real
+    errors, wind outputs), evaluate with the compiled loop of :mod:`uq.physics.fused`, which
+    gives the same values to 1e-12; False forces the numpy arrays below.
+
+    Returns
+    -------
+    dict
+        ``wind_speed`` [m s-1], ``wind_direction`` [deg], ``vertical_wind`` [m s-1], each
+        shape (n, *S, n_gates); ``radial_velocity`` [m s-1] (n, *S, n_beams, n_gates), the
+        motion-corrected radial velocity along the beam the correction believes in.
+    """
+    if compiled and not scene_draws and set(outputs) <= set(COMPILED_OUTPUTS):
+        from uq.physics import fused  # (numba: imported only where it may apply)
+        if fused.applicable(scene, outputs, errors, scene_draws):
+            return fused.measurement_model(scene, outputs, **errors)   # the same, compiled
+    n = sample_count(errors)
+    scenes = scene.shape if scene_draws else (1,) * len(scene.shape)
+    err = {name: _error_shape(np.asarray(errors.get(name, 0.0)), name, scenes, scene_draws)
+           for name in _ERROR_NAMES}
+    measured, navigation, beams_earth = _measure(scene, err, (n,) + scenes)
+    unit_vectors = scene.nominal_unit_vectors()
+    operator = least_squares_operator(unit_vectors)
+    wind_vector = reconstruct_wind(measured, scene.correction, unit_vectors, operator,
+                                   navigation, scene.field("heading", 1))
+    result = _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors)
+    if "gate_height" in outputs:
+        result["gate_height"] = _gate_height(scene, beams_earth, err["lidar_height"])
+    return _full_shape(result, (n,) + scene.shape, scene.n_beams)
+
+
+def _error_shape(value, name, scenes, scene_draws):
+    """An error array shaped to broadcast against (n, *S, ...): the scene axes follow the
+    sample axis, as ones (common draws) or as given (`scene_draws`)."""
+    if value.ndim == 0:          # a missing error stays a scalar: no per-sample rotations
+        return value if not name.startswith("ins_") else value + np.zeros((1,) * (
+            len(scenes) + 2))
+    if scene_draws:
+        return value
+    if name.startswith("ins_"):                      # INS errors to shape (n, *1, k)
+        value = value[:, None] if value.ndim == 1 else value
+    return value.reshape(value.shape[:1] + scenes + value.shape[1:])
+
+
+def _full_shape(result, leading, n_beams):
+    """Outputs broadcast to leading + (gates,) or leading + (beams, gates): a scene value
+    an output does not depend on (e.g. heave for the true wind) still gives it the axis."""
+    return {q: np.broadcast_to(v, leading + ((n_beams,) if q == "radial_velocity" else ())
+                               + v.shape[-1:]) for q, v in result.items()}
+
+
+_ERROR_NAMES = tuple(f"ins_{key}" for key in NAVIGATION) + (
+    "lidar_half_cone", "lidar_misalignment", "lidar_radial_velocity", "lidar_height")
+
+
+def _measure(scene, err, batch):
+    """True radial velocities plus noise, and the INS readings (true + error)."""
+    # Without geometry errors the true beams, and so the true radial velocities, are the
+    # same for every sample: computed once per scene, shape (*S, b, 3), not (n, *S, b, 3).
+    geometry_errors = np.ndim(err["lidar_half_cone"]) + np.ndim(err["lidar_misalignment"])
+    zero = np.zeros(batch) if geometry_errors else 0.0                     # (n, *1)
+    half_cone = scene.half_cone + complexstep.radians(err["lidar_half_cone"]) + zero
+    misalignment = scene.misalignment + complexstep.radians(err["lidar_misalignment"]) + zero
+    true_beams = beam_unit_vectors(half_cone, np.asarray(scene.azimuths), misalignment,
+                                   scene.vertical_beam)                    # ([n], *S, b, 3)
+    attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)    # (*S, 3, 3)
+    beams_earth = rotate_vectors(attitude, true_beams)
+    radial, _ = true_radial_velocity(scene, beams_earth, _ship_velocity(scene),
+                                     err["lidar_height"])
+    measured = radial + err["lidar_radial_velocity"]
+    navigation = {}
+    for key in NAVIGATION:
+        error = err[f"ins_{key}"]
+        error = complexstep.radians(error) if key in ANGULAR_NAVIGATION else error
+        navigation[key] = scene.field(key, 1) + error                     # (n, *S, k)
+    return measured, navigation, beams_earth
+
+
+def _gate_height(scene, beams_earth, height_error):
+    """Mean true height of the slanted beams per gate [m], shape ([n], *S, n_gates)."""
+    slanted = len(scene.azimuths)
+    heights = beam_heights(scene, beams_earth, height_error)
+    return np.mean(heights[..., :slanted, :], axis=-2)
+
+
+def _ship_velocity(scene):
+    """True ship velocity (north, east, up) [m s-1], shape (*S, 3)."""
+    sog, cog, heave = np.broadcast_arrays(scene.sog, scene.cog, scene.heave)
+    return np.stack([sog * np.cos(cog), sog * np.sin(cog), heave], axis=-1)
+
+
+def _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors):
+    result = {}
+    north, east, up = wind_vector[..., 0, :], wind_vector[..., 1, :], wind_vector[..., 2, :]
+    if "wind_speed" in outputs:
+        result["wind_speed"] = wind.wind_speed(north, east)
+    if "wind_direction" in outputs:
+        result["wind_direction"] = wind.wind_direction(north, east)
+    if "vertical_wind" in outputs:
+        result["vertical_wind"] = up
+    if "radial_velocity" in outputs:
+        result["radial_velocity"] = _corrected_radial(scene, measured, navigation,
+                                                      unit_vectors)
+    return result
+
+
+def _corrected_radial(scene, measured, navigation, unit_vectors):
+    """Radial velocity freed of the believed ship motion, along the believed beam."""
+    nav = navigation
+    rotation = correction_rotation(scene.correction, nav["heading"], nav["pitch"],
+                                   nav["roll"], scene.field("heading", 1))
+    ship = correction_ship_velocity(scene.correction, nav["sog"], nav["cog"], nav["heave"])
+    beams = (rotation @ unit_vectors[..., None])[..., 0]               # (n, *S, k|b, 3)
+    return measured + np.sum(beams * ship, axis=-1)[..., None]
+
+
+def true_values(scene):
+    """The wind the lidar should measure at each nominal gate height.
+
+    Returns
+    -------
+    dict
+        ``wind_speed``, ``wind_direction`` [deg], ``vertical_wind``, shape (*S, n_gates);
+        ``radial_velocity`` (*S, n_beams, n_gates): the motion-free radial wind along the
+        true beams at their true heights; ``gate_height`` [m], the nominal gate heights
+        ``lidar_height + range`` at which the true wind is given.
+    """
+    wind_vector = true_wind(scene, scene.gate_heights())
+    attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
+    beams_earth = scene.nominal_unit_vectors() @ np.swapaxes(attitude, -1, -2)
+    _, wind_only = true_radial_velocity(scene, beams_earth, np.zeros(scene.shape + (3,)))
+    north, east = wind_vector[..., 0], wind_vector[..., 1]
+    return _full_shape({"gate_height": scene.gate_heights() + 0.0 * north,
+                        "wind_speed": wind.wind_speed(north, east),
+                        "wind_direction": wind.wind_direction(north, east),
+                        "vertical_wind": wind_vector[..., 2],
+                        "radial_velocity": wind_only}, scene.shape, scene.n_beams)

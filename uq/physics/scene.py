@@ -1,0 +1,105 @@
+"""The nominal scene of one measurement (or a batch of scenes): what the ship, the lidar
+and the wind truly are, in SI units and radians.
+
+Conventions (as in the README): earth frame (north, east, up); angles clockwise from
+north; wind direction meteorological ("from"); ship attitude in the marine convention of
+:mod:`uq.physics.rotation` (heading clockwise from north, pitch positive bow up, roll
+positive starboard down).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from uq.physics.beams import beam_unit_vectors
+
+SCENE_FIELDS = ("wind_speed", "wind_direction", "vertical_wind", "shear", "reference_height",
+                "sog", "cog", "heading", "pitch", "roll", "heave", "lidar_height",
+                "half_cone", "misalignment")
+OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity", "gate_height")
+#: The outputs the compiled model (:mod:`uq.physics.fused`) computes.
+COMPILED_OUTPUTS = OUTPUTS[:3]
+NAVIGATION = ("heading", "pitch", "roll", "sog", "cog", "heave")
+ANGULAR_NAVIGATION = ("heading", "pitch", "roll", "cog")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Nominal (true) scene of one measurement, SI units and radians.
+
+    Attributes
+    ----------
+    wind_speed : float
+        Horizontal wind speed at `reference_height` [m s-1].
+    wind_direction : float
+        Meteorological direction ("from"), clockwise from north [rad].
+    vertical_wind : float
+        [m s-1], positive up.
+    shear : float
+        Power-law exponent [1].
+    reference_height : float
+        [m] above sea level.
+    sog, cog, heading, pitch, roll, heave : float
+        True ship motion: [m s-1], [rad] x4 (marine convention, :mod:`uq.physics.rotation`),
+        [m s-1].
+    lidar_height : float
+        [m] above sea level.
+    ranges : tuple of float
+        Range-gate heights above a level lidar [m].
+    half_cone, misalignment : float
+        Configured geometry [rad].
+    azimuths : tuple of float
+        Slanted-beam azimuths from the reference beam [rad].
+    vertical_beam : bool
+    correction : str
+        One of :data:`uq.physics.correction.CORRECTION_MODELS`.
+    """
+
+    wind_speed: float
+    wind_direction: float
+    vertical_wind: float
+    shear: float
+    reference_height: float
+    sog: float
+    cog: float
+    heading: float
+    pitch: float
+    roll: float
+    heave: float
+    lidar_height: float
+    ranges: tuple
+    half_cone: float
+    misalignment: float
+    azimuths: tuple
+    vertical_beam: bool
+    correction: str
+
+    @property
+    def shape(self):
+        """Shape S of a batch of scenes (``()`` for one scene)."""
+        return np.broadcast(*[getattr(self, name) for name in SCENE_FIELDS]).shape
+
+    def field(self, name, trailing=0):
+        """A numeric field shaped ``S + (1,) * trailing``, to broadcast against data of
+        shape (..., *S, *trailing)."""
+        value = np.asarray(getattr(self, name))
+        return value if value.ndim == 0 else np.reshape(value, self.shape + (1,) * trailing)
+
+    @property
+    def n_beams(self):
+        return len(self.azimuths) + int(self.vertical_beam)
+
+    def nominal_unit_vectors(self):
+        """Configured beam vectors in the ship frame, shape (n_beams, 3)."""
+        return beam_unit_vectors(self.half_cone, np.asarray(self.azimuths),
+                                 self.misalignment, self.vertical_beam)
+
+    def gate_heights(self):
+        """Nominal measurement heights above sea level [m], shape (*S, n_gates)."""
+        return self.field("lidar_height", 1) + np.asarray(self.ranges, dtype=float)
+
+
+def sample_count(errors):
+    """Number of trials n of a call of the measurement model: the leading axis of its
+    error arrays (1 when every error is a scalar)."""
+    sizes = {np.shape(value)[0] for value in errors.values() if np.ndim(value) > 0}
+    return max(sizes) if sizes else 1

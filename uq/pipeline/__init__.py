@@ -1,0 +1,1 @@
+"""Scenario file -> sweep -> Dataset: validation, planning, the runner."""

@@ -1,0 +1,301 @@
+"""The scenario reference (``docs/scenario.md``), generated from the validator itself.
+
+The validator of :mod:`uq.pipeline.scenario` is run on :data:`EXEMPLAR`, a scenario that
+sets every optional key, with a checker that records each check it makes: the dotted
+key, its type, its range or allowed values, and its value (the default, where the
+exemplar leaves the default in place). Units and meanings come from :data:`MEANINGS`;
+``tests/pipeline/test_reference.py`` fails when a checked key has no meaning, a meaning
+names no checked key, or ``docs/scenario.md`` differs from what this module renders.
+
+Regenerate with ``python -m uq.pipeline.reference > docs/scenario.md``.
+"""
+import copy
+import math
+
+from uq.pipeline import scenario as scenario_module
+from uq.pipeline.distributions import ERROR_DISTRIBUTIONS
+from uq.pipeline.scenario import DEFAULTS, Checker
+
+#: A scenario that sets every optional key (values are examples, not defaults).
+EXEMPLAR_OPTIONAL = {
+    "ins": {"heading": {"dist": "normal", "u": 0.1}, "pitch": {"dist": "normal", "u": 0.05},
+            "roll": {"dist": "normal", "u": 0.05}, "sog": {"dist": "normal", "u": 0.1},
+            "cog": {"dist": "normal", "u": 0.1}, "heave": {"dist": "normal", "u": 0.02}},
+    "lidar": {"errors": {"half_cone": {"dist": "normal", "u": 0.1},
+                         "misalignment": {"dist": "normal", "u": 0.3},
+                         "radial_velocity": {"dist": "normal", "u": 0.05},
+                         "height": {"dist": "normal", "u": 0.2}}},
+    "sampling": {"chunk_size": 65536, "seed": 1},
+    "fit": {"priors": {"shear": {"dist": "uniform", "low": -0.5, "high": 1.0},
+                       "reference_speed": {"dist": "normal", "mean": 9.0, "u": 2.0}},
+            "columns": {"height": "height", "speed": "speed", "speed_u": "speed_u",
+                        "height_u": "height_u"}},
+}
+#: Keys checked only in the alternative form of a section (digits instead of n).
+EXEMPLAR_ALTERNATIVE = {"sampling": {"digits": 2, "stop_when_gum_valid": True}}
+
+#: Dotted key (``*`` for any name) -> (unit, meaning). Keys of error distributions
+#: (``ins.heading`` ...) are described once, in the table of distributions.
+MEANINGS = {
+    "name": ("", "name of the scenario; names the output file results/<name>.nc"),
+    "description": ("", "free text, kept in the results"),
+    "wind.speed": ("m s-1", "horizontal wind speed at wind.reference_height"),
+    "wind.direction": ("deg", "meteorological direction the wind comes from, clockwise "
+                       "from north"),
+    "wind.vertical": ("m s-1", "vertical wind, positive upwards"),
+    "wind.shear": ("1", "power-law shear exponent alpha: U(z) = U_ref (z / z_ref)^alpha"),
+    "wind.reference_height": ("m", "height above sea level of wind.speed"),
+    "ship.sog": ("m s-1", "speed over ground"),
+    "ship.cog": ("deg", "course over ground, clockwise from north"),
+    "ship.heading": ("deg", "heading of the bow, clockwise from north"),
+    "ship.pitch": ("deg", "pitch, positive bow up"),
+    "ship.roll": ("deg", "roll, positive starboard down"),
+    "ship.heave": ("m s-1", "heave velocity, positive up"),
+    "ins.correlation": ("", "scan: one INS reading per scan, shared by all beams; beam: an "
+                        "independent reading per beam (point-wise correction)"),
+    "ins.*": ("as the quantity", "error of the INS reading of heading, pitch, roll [deg], "
+              "sog [m s-1], cog [deg] or heave [m s-1] (a distribution)"),
+    "lidar.height": ("m", "height of the lidar above sea level"),
+    "lidar.ranges": ("m", "range-gate heights above a level lidar"),
+    "lidar.half_cone": ("deg", "half-cone angle of the slanted beams, from vertical"),
+    "lidar.azimuths": ("deg", "beam azimuths, clockwise from the reference beam"),
+    "lidar.vertical_beam": ("", "a vertical beam besides the slanted ones"),
+    "lidar.misalignment": ("deg", "angle from the bow to the reference beam, clockwise"),
+    "lidar.errors.*": ("as the quantity", "true minus configured half_cone [deg], "
+                       "misalignment [deg], radial_velocity noise per beam and gate "
+                       "[m s-1], height [m] (a distribution)"),
+    "correction": ("", "motion correction: none, yaw (heading and ship velocity), tilt2d "
+                   "(Rubio & Gottschall 2022 Eq. 13 as written), full (rotation of all "
+                   "three components and the ship velocity)"),
+    "sampling.method": ("", "mc, lhs, sobol, or none (GUM and the paper's model only)"),
+    "sampling.n": ("1", "Monte Carlo trials per scene (give n or digits)"),
+    "sampling.digits": ("1", "adaptive sampling to this many significant digits "
+                        "(JCGM 101 7.9)"),
+    "sampling.seed": ("1", "seed of the random numbers; none draws a new one (recorded in "
+                      "the results)"),
+    "sampling.control_variate": ("", "use the GUM linearisation as a control variate"),
+    "sampling.interval": ("", "coverage interval: probabilistically symmetric or shortest"),
+    "sampling.stopping": ("", "stopping rule of adaptive sampling"),
+    "sampling.chunk_size": ("1", "trials evaluated together (memory; never changes a "
+                            "number)"),
+    "sampling.stop_when_gum_valid": ("", "stop a scene once clause 8 validates its GUM "
+                                     "(with digits)"),
+    "outputs": ("", "quantities to report"),
+    "fit.profile": ("", "wind-profile model of uq fit"),
+    "fit.reference_height": ("m", "z_ref of the power law"),
+    "fit.scatter": ("", "fit an extra scatter ln_sigma"),
+    "fit.priors.<parameter>.dist": ("", "prior of a profile parameter (shear, "
+                                    "reference_speed, roughness_length, friction_velocity, "
+                                    "ln_sigma)"),
+    "fit.priors.<parameter>.low": ("as the parameter", "lower bound (uniform, log_uniform)"),
+    "fit.priors.<parameter>.high": ("as the parameter", "upper bound (uniform, "
+                                    "log_uniform)"),
+    "fit.priors.<parameter>.mean": ("as the parameter", "mean (normal)"),
+    "fit.priors.<parameter>.u": ("as the parameter", "standard deviation (normal)"),
+    "fit.walkers": ("1", "emcee walkers per ensemble"),
+    "fit.ensembles": ("1", "independent ensembles (for R-hat)"),
+    "fit.max_steps": ("1", "steps per ensemble before a fit is declared not converged"),
+    "fit.seed": ("1", "seed of the chains"),
+    "fit.columns.*": ("", "CSV column of height, speed, speed_u or height_u"),
+}
+DISTRIBUTION_MEANINGS = {
+    "normal": "N(mean, u^2)",
+    "uniform": "U(mean - half_width, mean + half_width); u = half_width / sqrt(3)",
+    "triangular": "symmetric triangle on mean +- half_width; u = half_width / sqrt(6)",
+    "arcsine": "arcsine on mean +- amplitude (a sinusoid at a random phase); "
+               "u = amplitude / sqrt(2)",
+    "student_t": "scaled t with dof > 2 and standard deviation u",
+    "constant": "a known offset: value + mean",
+}
+
+
+class RecordingChecker(Checker):
+    """A :class:`~uq.pipeline.scenario.Checker` that records every check it makes."""
+
+    def __init__(self, source):
+        super().__init__(source)
+        self.records, self._depth, self.overlay = {}, 0, {}
+
+    def _record(self, kind, key, value, **limits):
+        if self._depth:
+            return
+        if "[" in key:                        # an element of a list: the list's row
+            key, kind, value = key.split("[")[0], f"list of {kind}s", None
+        if _is_set(self.overlay, key):         # an example value, not a default
+            value = None
+        self.records.setdefault(key, (kind, value, limits))
+
+    def _nested(self, kind, method, value, key, *args, **kwargs):
+        self._record(kind, key, value, **dict(zip(("low", "high"), args)), **kwargs)
+        self._depth += 1
+        try:
+            return method(value, key, *args, **kwargs)
+        finally:
+            self._depth -= 1
+
+    def number(self, value, key, *args, **kwargs):
+        return self._nested("number", super().number, value, key, *args, **kwargs)
+
+    def integer(self, value, key, *args, **kwargs):
+        return self._nested("integer", super().integer, value, key, *args, **kwargs)
+
+    def angle(self, value, key):
+        return self._nested("angle", super().angle, value, key)
+
+    def number_list(self, value, key, **limits):
+        return self._nested("list of numbers", super().number_list, value, key, **limits)
+
+    def boolean(self, value, key):
+        return self._nested("boolean", super().boolean, value, key)
+
+    def choice(self, value, key, allowed):
+        self._record("choice", key, value, allowed=tuple(allowed))
+        return super().choice(value, key, allowed)
+
+    def text(self, value, key):
+        return self._nested("text", super().text, value, key)
+
+    def name(self, value):
+        self._record("name", "name", value)
+        return super().name(value)
+
+
+def recorded_checks():
+    """Dotted key -> (kind, value, limits) of every check the validator makes; the value
+    is the default wherever the exemplar leaves the key unset."""
+    checker = RecordingChecker("<reference>")
+    for overlay in (EXEMPLAR_OPTIONAL, EXEMPLAR_ALTERNATIVE):
+        checker.overlay = overlay
+        raw = _merge(copy.deepcopy(DEFAULTS), overlay)
+        raw["outputs"] = list(scenario_module.OUTPUTS)
+        scenario_module._validate(raw, checker.source, checker)
+    return checker.records
+
+
+def _merge(base, overlay):
+    """`base` with `overlay` merged in, mapping by mapping."""
+    for key, value in overlay.items():
+        if isinstance(value, dict) and isinstance(base.get(key), dict):
+            _merge(base[key], value)
+        else:
+            base[key] = value
+    return base
+
+
+def meaning(key):
+    """(unit, meaning) of a dotted key, or None."""
+    if key in MEANINGS:
+        return MEANINGS[key]
+    parts = key.split(".")
+    for i in range(len(parts) - 1, 0, -1):
+        for pattern in (".".join(parts[:i] + ["*"] + parts[i + 1:]), ".".join(parts[:i] + ["*"])):
+            if pattern in MEANINGS:
+                return MEANINGS[pattern]
+    return None
+
+
+def documented_keys(records):
+    """The rows of the reference: error distributions collapsed to their key."""
+    errors = {key.rpartition(".")[0] for key in records if key.endswith(".dist")
+              and not key.startswith("fit.")}
+    rows = {}
+    for key, (kind, value, limits) in records.items():
+        parent = key.rpartition(".")[0]
+        if parent in errors:
+            rows.setdefault(parent, ("distribution", None, {}))
+            continue
+        if key.startswith("fit.priors."):     # one row per prior key, any parameter
+            key, value = "fit.priors.<parameter>." + key.rpartition(".")[2], None
+        if key == "outputs":
+            kind = "list of choices"
+        if kind.startswith("list of"):        # the default of the whole list
+            value = _lookup(DEFAULTS, key) if _is_set(DEFAULTS, key) else None
+        rows.setdefault(key, (kind, value, limits))
+    return rows
+
+
+def _is_set(overlay, key):
+    try:
+        _lookup(overlay, key)
+        return True
+    except (KeyError, TypeError):
+        return False
+
+
+def _allowed(kind, limits):
+    if kind in ("choice", "list of choices"):
+        return ", ".join(str(a) for a in limits["allowed"])
+    if kind in ("angle", "list of angles"):
+        return "[-360, 360], wrapped into [0, 360)"
+    if kind == "distribution":
+        return "a distribution (below)"
+    if kind == "name":
+        return "letters, digits, '_', '.', '-'"
+    low, high = limits.get("low"), limits.get("high")
+    if low is None and high is None:
+        return "any finite" if kind != "text" and kind != "boolean" else \
+            ("true, false" if kind == "boolean" else "text")
+    left = "(" if limits.get("low_open") or low is None else "["
+    right = ")" if limits.get("high_open") or high is None else "]"
+    return f"{left}{_number(low, '-inf')}, {_number(high, 'inf')}{right}"
+
+
+def _number(value, infinite):
+    return infinite if value is None else (f"{value:g}" if isinstance(value, float) and
+                                           not math.isinf(value) else str(value))
+
+
+def _default(key, kind, value):
+    if kind == "distribution":
+        return "none (no error)"
+    if key == "sampling.seed":
+        return "none (a new seed, recorded)"
+    if value is None or isinstance(value, dict):
+        return "-"
+    if isinstance(value, list):
+        value = ", ".join(map(str, value))
+    return f"`{value}`" if value != "" else "empty"
+
+
+def _lookup(mapping, key):
+    node = mapping
+    for part in key.split("."):
+        node = node[part]
+    return node
+
+
+def render():
+    """The Markdown text of ``docs/scenario.md``."""
+    rows = documented_keys(recorded_checks())
+    lines = ["# Scenario reference", "",
+             "Generated from the validator (`python -m uq.pipeline.reference > "
+             "docs/scenario.md`); `tests/pipeline/test_reference.py` fails when the two "
+             "drift apart. Every key is optional; unknown keys are an error. Angles are in "
+             "degrees, clockwise; wind direction is where the wind comes from.", "",
+             "| key | type | unit | default | allowed | meaning |",
+             "|---|---|---|---|---|---|"]
+    for key in sorted(rows, key=_order):
+        kind, value, limits = rows[key]
+        unit, text = meaning(key) or ("?", "?")
+        lines.append(f"| `{key}` | {kind} | {unit or '-'} | {_default(key, kind, value)} | "
+                     f"{_allowed(kind, limits)} | {text} |")
+    lines += ["", "## Distributions of errors", "",
+              "Every error is a mapping with `dist`, its parameters and an optional `mean` "
+              "(a bias, default 0), in the unit of the quantity it belongs to.", "",
+              "| dist | parameters | distribution |", "|---|---|---|"]
+    lines += [f"| `{name}` | {', '.join(parameters)} | {DISTRIBUTION_MEANINGS[name]} |"
+              for name, parameters in ERROR_DISTRIBUTIONS.items()]
+    lines += ["", "## Sweeps", "",
+              "`sweep` maps dotted keys to a list of values, to `{start, stop, step}` (stop "
+              "excluded) or to `{same_as: another.swept.key}`; the scenes are the outer "
+              "product. Only single-valued keys can be swept.", ""]
+    return "\n".join(lines)
+
+
+def _order(key):
+    sections = list(DEFAULTS)
+    return (sections.index(key.split(".")[0]) if key.split(".")[0] in sections else 99, key)
+
+
+if __name__ == "__main__":
+    print(render(), end="")

@@ -1,0 +1,291 @@
+"""The orchestrator: scenario -> chunks of scenes of the sweep -> propagation -> Dataset.
+
+The sweep's outer product is cut into chunks (:mod:`uq.pipeline.sweep`): scenes that differ only
+in scene values are evaluated together as arrays; the measurement model runs through
+:func:`uq.propagate`; the true values, the error-free reconstruction and the Rubio &
+Gottschall (2022) model are added; the chunks are stacked back onto the grid. Every
+scene uses the same seed, and so the same underlying draws (common random numbers).
+Chunks can run on a dask cluster and be kept on disk for ``--resume``; neither changes
+a number.
+"""
+import time
+
+import numpy as np
+import xarray as xr
+
+from uq._version import __version__
+from uq.pipeline.distributions import error_distribution
+from uq.engine.inputs import Input
+from uq.physics.measurement import ANGULAR_NAVIGATION, OUTPUTS, Scene, measurement_model, true_values
+from uq.pipeline.metadata import COORDINATES, QUANTITIES, variable_attributes
+from uq.engine.propagate import propagate
+from uq.physics.rubio2022 import rubio2022_scene_uncertainty
+from uq.engine.sampling import new_seed
+from uq.pipeline.scenario import INS_KEYS, LIDAR_ERROR_KEYS, load_scenario
+from uq.engine.statistics import unwrap
+from uq.engine.stopping import STOPPED_BY
+from uq.pipeline.sweep import batch_scene, group_assignments, sweep_plan, vector_fields
+
+
+def run(scenario, progress=None, *, client=None, checkpoint=None):
+    """Run a scenario and return its results.
+
+    Parameters
+    ----------
+    scenario : Scenario, dict, str or pathlib.Path
+        Anything :func:`uq.load_scenario` accepts.
+    progress : callable, optional
+        Called as ``progress(done, total)`` after each chunk of scenes.
+    client : dask.distributed.Client, optional
+        Compute the chunks on this dask cluster; the result is identical to a local run.
+    checkpoint : uq.pipeline.checkpoint.Checkpoint, optional
+        Keeps finished chunks on disk and reuses those it already has (``--resume``).
+
+    Returns
+    -------
+    xarray.Dataset
+        The variables listed in the README ("Results files").
+    """
+    started = time.perf_counter()
+    scenario = load_scenario(scenario)
+    seed = scenario.sampling["seed"]
+    if seed is None:
+        seed = checkpoint.seed if checkpoint and checkpoint.seed is not None else new_seed()
+    plan = sweep_plan(scenario)
+    if checkpoint:
+        checkpoint.start(scenario, seed, len(plan.chunks))
+    results = _compute(scenario, plan, seed, progress, client, checkpoint)
+    dataset = _assemble(scenario, plan, results)
+    dataset.attrs.update(_global_attributes(scenario, seed, dataset, started))
+    return dataset
+
+
+def _compute(scenario, plan, seed, progress, client, checkpoint):
+    """Results of every chunk, by index: from the checkpoint, else computed."""
+    results = checkpoint.load() if checkpoint else {}
+    todo = [chunk for chunk in plan.chunks if chunk.index not in results]
+    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed)) for chunk in todo) \
+        if client is None else _distributed(client, scenario, plan, todo, seed)
+    if progress and results:
+        progress(len(results), len(plan.chunks))
+    for index, dataset in finished:
+        results[index] = dataset
+        if checkpoint:
+            checkpoint.save(index, dataset)
+        if progress:
+            progress(len(results), len(plan.chunks))
+    return results
+
+
+def _distributed(client, scenario, plan, chunks, seed):
+    """Chunks on a dask cluster, yielded as they finish."""
+    from dask.distributed import as_completed
+    futures = {client.submit(run_chunk, scenario, plan, chunk, seed, pure=False): chunk.index
+               for chunk in chunks}
+    for future in as_completed(futures):
+        yield futures[future], future.result()
+
+
+def run_chunk(scenario, plan, chunk, seed):
+    """Results of one chunk of scenes: a Dataset with a ``scene`` dimension."""
+    if plan.group_keys:
+        scenario = scenario.with_values(group_assignments(scenario, plan, chunk.group))
+    base = scene_from_settings(scenario.settings)
+    fields = vector_fields(scenario, plan, chunk) or {"wind_speed": np.array([base.wind_speed])}
+    return run_scene(scenario, batch_scene(base, fields), seed)
+
+
+def scene_from_settings(settings):
+    """The nominal :class:`Scene` (SI, radians) of validated settings (degrees)."""
+    w, s, lid = settings["wind"], settings["ship"], settings["lidar"]
+    rad = np.deg2rad
+    return Scene(
+        wind_speed=w["speed"], wind_direction=rad(w["direction"]), vertical_wind=w["vertical"],
+        shear=w["shear"], reference_height=w["reference_height"],
+        sog=s["sog"], cog=rad(s["cog"]), heading=rad(s["heading"]), pitch=rad(s["pitch"]),
+        roll=rad(s["roll"]), heave=s["heave"],
+        lidar_height=lid["height"], ranges=tuple(lid["ranges"]), half_cone=rad(lid["half_cone"]),
+        misalignment=rad(lid["misalignment"]), azimuths=tuple(rad(lid["azimuths"])),
+        vertical_beam=lid["vertical_beam"], correction=settings["correction"])
+
+
+def error_inputs(settings, n_beams, n_gates):
+    """Engine inputs (name -> distribution, float or Input) of the declared errors."""
+    inputs = {}
+    beam_mode = settings["ins"]["correlation"] == "beam"
+    for key in INS_KEYS:
+        if key in settings["ins"]:
+            dist = error_distribution(settings["ins"][key])
+            inputs[f"ins_{key}"] = Input(dist, (n_beams,)) if beam_mode and not \
+                isinstance(dist, float) else dist
+    for key, spec in settings["lidar"]["errors"].items():
+        dist = error_distribution(spec)
+        shaped = key == "radial_velocity" and not isinstance(dist, float)
+        inputs[f"lidar_{key}"] = Input(dist, (n_beams, n_gates)) if shaped else dist
+    return inputs
+
+
+def input_label(name):
+    """Dotted scenario key of an engine input name (``ins_sog`` -> ``ins.sog``)."""
+    section, key = name.split("_", 1)
+    return f"ins.{key}" if section == "ins" else f"lidar.errors.{key}"
+
+
+def run_scene(scenario, scene, seed):
+    """Results of a batch of scenes (dimension ``scene``) that share `scenario`'s structure."""
+    settings = scenario.settings
+    outputs = scenario.outputs
+    n_gates = len(scene.ranges)
+    sampling = settings["sampling"]
+
+    def model(**errors):
+        return measurement_model(scene, outputs, **errors)
+
+    engine = propagate(model, error_inputs(settings, scene.n_beams, n_gates),
+                       n=sampling.get("n"), digits=sampling.get("digits"),
+                       method=sampling["method"], seed=seed, circular=("wind_direction",),
+                       output_dims={q: _dims(q) for q in OUTPUTS},
+                       interval=sampling["interval"], chunk_size=sampling.get("chunk_size"),
+                       control_variate=sampling["control_variate"],
+                       stopping=sampling["stopping"],
+                       stop_when_gum_valid=sampling["stop_when_gum_valid"],
+                       covariance=profile_covariances(outputs, n_gates))
+    return _scene_dataset(scene, settings, outputs, engine)
+
+
+def profile_covariances(outputs, n_gates):
+    """Outputs whose gate-to-gate covariance is kept: wind speed and gate height, when
+    ``gate_height`` is requested (the inputs of ``uq fit``) and there are several gates."""
+    if "gate_height" not in outputs or n_gates < 2:
+        return ()
+    return tuple(q for q in ("wind_speed", "gate_height") if q in outputs)
+
+
+def _dims(quantity):
+    return ("scene", "beam", "range") if quantity == "radial_velocity" else ("scene", "range")
+
+
+def _scene_dataset(scene, settings, outputs, engine):
+    truth = true_values(scene)
+    nominal = measurement_model(scene, outputs)
+    paper = _paper_uncertainty(scene, settings, truth["wind_speed"])
+    data = {}
+    for q in outputs:
+        dims = _dims(q)
+        data[f"{q}_true"] = (dims, truth[q])
+        data[f"{q}_nominal"] = (dims, np.real(nominal[q][0]))
+        data[f"{q}_paper_u"] = (dims, paper[q])
+        if f"{q}_mc_mean" in engine:
+            bias = engine[f"{q}_mc_mean"].values - truth[q]
+            if q == "wind_direction":
+                bias = unwrap(bias, 0.0)
+            data[f"{q}_mc_bias"] = (dims, bias)
+    data["mc_n_samples"] = ("scene", np.full(scene.shape, engine.attrs["n_samples"]))
+    data["mc_stopped_by"] = ("scene", np.full(scene.shape, STOPPED_BY.index(
+        engine.attrs["stopped_by"]), dtype=np.int8))
+    coords = {"input": [input_label(name) for name in engine["input"].values],
+              "range": list(scene.ranges)}
+    if "range_other" in engine.dims:
+        coords["range_other"] = list(scene.ranges)
+    if "beam" in engine.dims:
+        coords["beam"] = list(np.rad2deg(scene.azimuths)) + [np.nan] * int(scene.vertical_beam)
+    return engine.assign(data).assign_coords(coords)      # one merge each (xarray's cost)
+
+
+def _paper_uncertainty(scene, settings, gate_speeds):
+    """Rubio & Gottschall (2022) u per output; NaN outside their model."""
+    ins = settings["ins"]
+    u = {key: _standard_uncertainty(ins.get(key)) for key in INS_KEYS}
+    u = {key: np.deg2rad(value) if key in ANGULAR_NAVIGATION else value
+         for key, value in u.items()}
+    per_gate = [rubio2022_scene_uncertainty(scene, gate_speeds[..., i], u["heading"],
+                                            u["pitch"], u["roll"], u["sog"], u["cog"])
+                for i in range(gate_speeds.shape[-1])]
+    return {q: np.stack([g[q] for g in per_gate], axis=-1) if q in per_gate[0]
+            else np.full(gate_speeds.shape, np.nan) for q in OUTPUTS}
+
+
+def _standard_uncertainty(spec):
+    if spec is None:
+        return 0.0
+    dist = error_distribution(spec)
+    return 0.0 if isinstance(dist, float) else float(dist.std())
+
+
+def _assemble(scenario, plan, results):
+    """Chunks (flat scenes, group-major) -> the grid, sweep dimensions in file order."""
+    first = results[plan.chunks[0].index]
+    names = {key: key.replace(".", "_") for key, _ in scenario.sweep}
+    grid_dims = tuple(names[k] for k in plan.group_keys + plan.vector_keys)
+    grid_shape = plan.group_shape + plan.vector_shape
+    data = {}
+    for var, template in first.data_vars.items():
+        axis = template.dims.index("scene")
+        values = np.concatenate([results[c.index][var].values for c in plan.chunks], axis=axis)
+        shape = values.shape[:axis] + grid_shape + values.shape[axis + 1:]
+        data[var] = (template.dims[:axis] + grid_dims + template.dims[axis + 1:],
+                     values.reshape(shape))
+    coords = {names[key]: list(values) for key, values in scenario.sweep}
+    coords.update({c: first[c] for c in first.coords})
+    coords.update({follower.replace(".", "_"): (names[leader], list(dict(scenario.sweep)[leader]))
+                   for follower, leader in scenario.links})
+    dataset = xr.Dataset(data, coords=coords)
+    dataset = dataset.transpose(*[names[key] for key, _ in scenario.sweep], ...)
+    if dataset.sizes.get("range", 0) == 1:
+        dataset = dataset.squeeze("range")
+    return _annotate(dataset, scenario)
+
+
+def _annotate(ds, scenario):
+    # attributes set on the Variables in place (ds[name] would build a DataArray each)
+    for name in ds.data_vars:
+        quantity = next((q for q in QUANTITIES if name.startswith(q + "_")), None)
+        if quantity:
+            ds.variables[name].attrs.update(
+                variable_attributes(quantity, name[len(quantity) + 1:]))
+    ds.variables["mc_n_samples"].attrs.update(units="1", long_name="Monte Carlo trials used")
+    ds.variables["mc_stopped_by"].attrs.update(  # a CF flag variable (CF 1.10, 3.5)
+        units="1", long_name="what stopped Monte Carlo sampling",
+        flag_values=np.arange(len(STOPPED_BY), dtype=np.int8),
+        flag_meanings=" ".join(name.replace(" ", "_") for name in STOPPED_BY))
+    for name, attrs in COORDINATES.items():
+        if name in ds.coords:
+            ds.variables[name].attrs.update(attrs)
+    for key, _ in scenario.sweep:
+        ds.variables[key.replace(".", "_")].attrs["long_name"] = f"swept scenario key {key}"
+    for follower, leader in scenario.links:
+        ds.variables[follower.replace(".", "_")].attrs["long_name"] = \
+            f"scenario key {follower}, linked to the swept key {leader}"
+    return ds
+
+
+def skipped_work(settings, outputs):
+    """What the model did not compute for this scenario, in words (the ``skipped``
+    attribute): each line names a shortcut the measurement model took."""
+    lidar, ins = settings["lidar"], settings["ins"]
+    lines = [f"input not sampled (no error declared): {key}" for key in
+             [f"ins.{k}" for k in INS_KEYS if k not in ins]
+             + [f"lidar.errors.{k}" for k in LIDAR_ERROR_KEYS
+                if k not in lidar["errors"]]]
+    if not ({"half_cone", "misalignment"} & set(lidar["errors"])):
+        lines.append("true beams and true radial velocities computed once per scene, not "
+                     "per trial (no geometry errors)")
+    if settings["correction"] in ("none", "yaw"):
+        lines.append(f"correction '{settings['correction']}': no pitch/roll rotation")
+    lines += [f"output not requested, not computed: {q}" for q in OUTPUTS if q not in outputs]
+    return "; ".join(lines) or "nothing"
+
+
+def _global_attributes(scenario, seed, dataset, started):
+    return {"title": f"uq results: {scenario.name}",
+            "skipped": skipped_work(scenario.settings, scenario.outputs),
+            "Conventions": "CF-1.10",
+            "scenario": scenario.text,
+            "uq_version": __version__,
+            "sampling_method": scenario.sampling["method"],
+            "n_samples": int(np.max(dataset["mc_n_samples"].values)),
+            "scenes": int(dataset["mc_n_samples"].size),
+            "seed": seed,
+            "correction": scenario.settings["correction"],
+            "ins_correlation": scenario.settings["ins"]["correlation"],
+            "runtime_s": time.perf_counter() - started}
