@@ -143,3 +143,44 @@ FUSED_BLOCK_TRIALS = 2**12
 #: (:mod:`uq.engine.orderstats`): its sort costs ~20 us; the brackets it gives hold ~1 % of
 #: the values around each wanted rank. [1] Floyd and Rivest (1975), sample selection.
 ORDER_SAMPLE = 1024
+
+# --- bounds on what an input may cost (issue 14) ---------------------------------------
+
+#: Largest configuration (scenario, golden, fit) file read [bytes]: the shipped ones are
+#: 1-3 KiB; a larger file (or an endless stream such as /dev/zero) is refused unread.
+MAX_CONFIG_BYTES = 1 << 20
+
+#: Deepest nesting of a configuration file [levels]: a scenario has at most 5 (sweep ->
+#: key -> mapping -> ...); PyYAML composes recursively, so depth bounds its stack.
+MAX_CONFIG_DEPTH = 64
+
+#: Most values a configuration file may expand to once YAML aliases are resolved [1]: the
+#: shipped files hold a few hundred; an alias bomb ("billion laughs") holds 10^9.
+MAX_CONFIG_NODES = 100_000
+
+#: Largest magnitude of a number in a scenario [unit of its key]: the squares of every
+#: quantity stay finite through the Monte Carlo moments (sums of 10^10 squares of 1e100 are
+#: 1e210 < DBL_MAX = 1.8e308); no physical input comes near it.
+MAX_MAGNITUDE = 1e100
+
+#: Largest seed [1]: numpy's SeedSequence takes any integer, but the seed is recorded in
+#: the results as a netCDF 64-bit unsigned attribute.
+MAX_SEED = 2**64 - 1
+
+#: Most scenes of a sweep (outer product) [1], and most values of one swept key; planned
+#: before anything is allocated. 10^7 scenes of the GUM grid take ~2 min and ~8 GB of
+#: results; larger grids are split by the user. Configurable: ``UQ_MAX_SCENES``.
+MAX_SCENES = 10_000_000
+
+#: Most combinations of swept structural keys (an error's size, the correction, the
+#: gates: each a model of its own, validated and run separately, ~10 ms of fixed cost) [1].
+MAX_GROUPS = 10_000
+
+#: Most range gates and most beams of a lidar [1]: a conical scan has 50-100 lines of sight,
+#: profilers 10-30 gates; each costs trials x beams x gates in the model.
+MAX_GATES = 1000
+MAX_BEAMS = 1000
+
+#: Largest sampling.chunk_size [trials]: a chunk holds trials x inputs draws and the model's
+#: temporaries; 2^24 trials of a 23-input scene are ~3 GB of draws.
+MAX_CHUNK_SIZE = 2**22

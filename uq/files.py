@@ -98,6 +98,25 @@ def _has_signature(path):
     return signature in head or signature in tail
 
 
+def missing_folders(folder):
+    """The folders of `folder`'s path that do not exist yet, deepest first (those a
+    write would create, and :func:`remove_if_empty` may remove again)."""
+    folder, missing = Path(folder).absolute(), []
+    while not folder.exists() and folder != folder.parent:
+        missing.append(folder)
+        folder = folder.parent
+    return missing
+
+
+def remove_if_empty(folders):
+    """Remove each folder (deepest first) that exists and is empty."""
+    for folder in folders:
+        try:
+            folder.rmdir()
+        except OSError:
+            return
+
+
 def check_target(path, source="-o"):
     """Refuse a target the tool may not write: a folder, or a file it did not write."""
     path = Path(path)
@@ -115,13 +134,22 @@ def atomic_file(path, source="-o"):
     and rename it onto `path`, on failure remove it. Refuses targets uq did not write."""
     path = check_target(path, source)
     _make_folder(path.parent, source)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part",
-                                         dir=path.parent)
+    try:
+        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part",
+                                             dir=path.parent)
+    except OSError as error:
+        raise OutputError(source, str(path), f"cannot write in {path.parent} "
+                          f"({error.strerror}); allowed: a writable folder") from None
     os.close(handle)
     try:
         yield Path(temporary)
         os.chmod(temporary, file_mode())
         os.replace(temporary, path)
+    except OSError as error:                 # a full disk, a quota, a read-only mount
+        Path(temporary).unlink(missing_ok=True)
+        raise OutputError(source, str(path), f"cannot write it ({error.strerror or error}); "
+                          "nothing was written; allowed: a folder with space and write "
+                          "permission") from None
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
@@ -193,6 +221,20 @@ def new_partial_folder(folder, source="-o"):
     return partial
 
 
+def check_folder_target(folder, source="-o"):
+    """Refuse a folder target that :func:`replace_folder` would refuse: a file, a link,
+    or a non-empty folder uq did not write."""
+    folder = Path(folder)
+    if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+        raise OutputError(source, str(folder), "exists and is not a folder uq wrote; "
+                          "allowed: a new folder name")
+    if folder.is_dir() and any(folder.iterdir()) and not written_by_uq(folder):
+        raise OutputError(source, str(folder), "exists and was not written by uq; allowed: "
+                          "a new folder name, an empty folder, or a folder uq wrote (uq "
+                          "replaces only its own outputs)")
+    return folder
+
+
 def replace_folder(partial, folder, kind, source="-o"):
     """Put the complete folder `partial` in place of `folder`.
 
@@ -205,12 +247,11 @@ def replace_folder(partial, folder, kind, source="-o"):
     write_marker(partial, kind)
     aside = None
     if folder.exists() or folder.is_symlink():
-        if folder.is_symlink() or not folder.is_dir() or \
-                (any(folder.iterdir()) and not written_by_uq(folder)):
+        try:
+            check_folder_target(folder, source)
+        except OutputError:
             shutil.rmtree(partial, ignore_errors=True)
-            raise OutputError(source, str(folder), "exists and was not written by uq; "
-                              "allowed: a new folder name, an empty folder, or a folder uq "
-                              "wrote (uq replaces only its own outputs)")
+            raise
         aside = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", suffix=".old",
                                       dir=folder.parent))
         os.replace(folder, aside / folder.name)

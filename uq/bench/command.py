@@ -5,7 +5,7 @@ from pathlib import Path
 
 from uq.bench import methods as bench
 from uq.errors import ScenarioError
-from uq.files import save_figure, write_netcdf
+from uq.files import check_target, save_figure, write_netcdf
 
 
 def run_bench(output, quick=False):
@@ -14,6 +14,8 @@ def run_bench(output, quick=False):
     output = Path(output)
     if output.suffix != ".nc":
         raise ScenarioError("-o", str(output), "the output file must end in .nc")
+    check_target(output)                           # before minutes of measuring
+    check_target(output.with_suffix(".png"))
     sizes = [2**k for k in ((10, 13, 16, 18) if quick else (10, 12, 14, 16, 18, 19))]
     repeats = 3 if quick else 8
     dataset = bench.measure(sizes, repeats,

@@ -18,8 +18,13 @@ def add_parser(commands):
 
 def open_results(path):
     """(path, Dataset) of a results file of ``uq run``; bad input names the file."""
+    from uq.errors import DataFileError
     from uq.pipeline.results import open_results as read
-    return Path(path), read(Path(path))
+    dataset = read(Path(path))
+    if "wind_speed_true" not in dataset:
+        raise DataFileError(str(path), "outputs", "no wind_speed in these results; allowed: "
+                            "results of a scenario whose outputs include wind_speed")
+    return Path(path), dataset
 
 
 def command(args):
@@ -30,6 +35,11 @@ def command(args):
         raise ScenarioError(str(path), "sweep", "no figure for these sweep dimensions "
                             f"({', '.join(dataset['mc_n_samples'].dims) or 'none'}); allowed: "
                             "the sweeps of the rubio2022_* scenarios or any 1-D sweep")
-    for written in make_figures(dataset, directory, formats=tuple(args.format or ["png"])):
+    formats = tuple(args.format or ["png"])
+    from uq.files import check_target
+    for name, _ in figure_plan(dataset):       # every target before any figure is drawn
+        for extension in formats:
+            check_target(directory / f"{name}.{extension}")
+    for written in make_figures(dataset, directory, formats=formats):
         print(f"wrote {written}")
     return EXIT_OK

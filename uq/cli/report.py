@@ -24,6 +24,8 @@ def command(args):
     output = Path(args.output) if args.output else path.with_name(f"{path.stem}_report.html")
     if output.suffix not in (".html", ".htm"):
         raise ScenarioError("-o", str(output), "the report file must end in .html")
+    from uq.files import check_target
+    check_target(output)
     for target in args.target or []:
         if not target > 0:
             raise ScenarioError("--target", str(target), "allowed: a positive number [m s-1]")

@@ -29,7 +29,7 @@ def add_parser(commands):
 
 
 def command(args):
-    from uq.files import write_netcdf
+    from uq.files import check_target, missing_folders, remove_if_empty, write_netcdf
     from uq.outputs.summary import summary_table
     from uq.pipeline.checkpoint import Checkpoint, checkpoint_directory
     from uq.pipeline.progress import ProgressBar
@@ -40,21 +40,37 @@ def command(args):
     output = Path(args.output) if args.output else Path("results") / f"{scenario.name}.nc"
     if output.suffix != ".nc":
         raise ScenarioError("-o", str(output), "the output file must end in .nc")
+    check_target(output)                     # before any work: refused targets cost nothing
+    check_scale_out(args)
     progress = None if args.quiet else ProgressBar()
-    checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume)
+    new_folders = missing_folders(output.parent)
+    checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume).acquire()
     try:
         with dask_client(args) as client:
             dataset = run(scenario, progress=progress, client=client, checkpoint=checkpoint)
+        write_netcdf(dataset, output)
+        checkpoint.clear()                   # still locked: no other run can be in it
     except KeyboardInterrupt:
         print(f"\nuq: interrupted; finished chunks are kept in {checkpoint.directory}; "
               "run the same command with --resume to continue", file=sys.stderr)
         return EXIT_INTERRUPTED
-    write_netcdf(dataset, output)
-    checkpoint.clear()
+    except Exception:
+        if checkpoint.is_empty():            # nothing to resume: leave nothing behind
+            checkpoint.clear()
+            remove_if_empty(new_folders)
+        raise
+    finally:
+        checkpoint.release()
     if not args.quiet:
         print(summary_table(dataset))
         print(f"wrote {output}")
     return EXIT_OK
+
+
+def check_scale_out(args):
+    """Refuse bad --workers before anything is created."""
+    if args.workers is not None and args.workers < 1:
+        raise ScenarioError("--workers", str(args.workers), "allowed: an integer >= 1")
 
 
 @contextlib.contextmanager
@@ -63,8 +79,6 @@ def dask_client(args):
     if args.workers is None and args.scheduler is None:
         yield None
         return
-    if args.workers is not None and args.workers < 1:
-        raise ScenarioError("--workers", str(args.workers), "allowed: an integer >= 1")
     try:
         from dask.distributed import Client, LocalCluster
     except ImportError:

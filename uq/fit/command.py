@@ -10,10 +10,10 @@ import numpy as np
 import yaml
 
 from uq.fit.bayesfit import NotConverged
-from uq.errors import ScenarioError
+from uq.errors import DataFileError, ScenarioError
 from uq.fit.fitting import (combine_fits, fit_profile, profile_from_results, profile_from_table,
                       true_parameters)
-from uq.files import save_figure, write_netcdf
+from uq.files import check_target, save_figure, write_netcdf
 from uq.pipeline.results import open_results
 from uq.pipeline.scenario import assign_dotted, load_fit_settings
 
@@ -29,8 +29,9 @@ def run_fit(input_path, config_path=None, output=None, overrides=None):
     output = Path(output) if output else path.with_name(f"{path.stem}_fit.nc")
     if output.suffix != ".nc":
         raise ScenarioError("-o", str(output), "the output file must end in .nc")
+    check_target(output)                           # before the fit (minutes)
     results = open_results(path) if path.suffix == ".nc" else None
-    scenario = None if results is None else yaml.safe_load(results.attrs["scenario"]) or {}
+    scenario = None if results is None else _scenario_of(results, path)
     config = fit_settings(config_path, scenario, overrides or {})
     try:
         dataset = _fit_input(path, results, scenario, config)
@@ -46,6 +47,18 @@ def run_fit(input_path, config_path=None, output=None, overrides=None):
     print(fit_table(dataset))
     print(f"wrote {output}, {figures[0].name}, {figures[1].name}")
     return EXIT_OK
+
+
+def _scenario_of(results, path):
+    """The scenario mapping recorded in a results file."""
+    try:
+        scenario = yaml.safe_load(results.attrs["scenario"]) or {}
+    except yaml.YAMLError:
+        scenario = None
+    if not isinstance(scenario, dict):
+        raise DataFileError(str(path), "scenario", "the recorded scenario attribute is not "
+                            "a YAML mapping; allowed: results written by uq run")
+    return scenario
 
 
 def fit_settings(config_path, scenario, overrides):
@@ -77,9 +90,12 @@ def _fit_input(path, results, scenario, config):
     if results is None:
         import pandas
         try:
-            table = pandas.read_csv(path)
-        except (OSError, ValueError) as error:
-            raise ScenarioError(str(path), "", f"cannot read it as CSV ({error})") from None
+            table = pandas.read_csv(path, encoding="utf-8")
+        except (OSError, ValueError, pandas.errors.ParserError,
+                pandas.errors.EmptyDataError) as error:
+            reason = str(error).splitlines()[0][:120] if str(error) else type(error).__name__
+            raise DataFileError(str(path), "", f"cannot read it as CSV ({reason}); allowed: "
+                                "a UTF-8 CSV table with a header row") from None
         data, dropped = profile_from_table(table, config.columns, source=str(path))
         dataset = combine_fits({"data": fit_profile(data, config)})
         dataset.attrs["rows_dropped_not_finite"] = dropped

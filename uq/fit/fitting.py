@@ -25,6 +25,7 @@ References
    TU Delft, Sec. 5.2.2 and App. A.11.
 """
 import numpy as np
+import pandas as pd
 import xarray as xr
 
 from uq.errors import DataFileError
@@ -37,6 +38,10 @@ GRID_POINTS = 60
 #: Posterior draws used for the bands (thinned, all ensembles).
 BAND_DRAWS = 4000
 SUMMARY_KEYS = ("low95", "low68", "median", "high68", "high95")
+
+
+#: Fewest profile points a fit needs [1]: two parameters and a residual.
+MIN_FIT_POINTS = 3
 
 
 def profile_from_results(dataset, kind="propagated", source="results"):
@@ -73,13 +78,28 @@ def profile_from_table(table, columns, source="table"):
         raise DataFileError(source, "fit.columns", f"no column {', '.join(missing)}; allowed: "
                             f"the file's columns ({', '.join(map(str, table))})")
     names = {k: columns[k] for k in ("height", "speed", "speed_u", "height_u") if k in columns}
-    values = {k: np.asarray(table[c], float) for k, c in names.items() if c in table}
+    values = {k: _numbers(table[c], c, source) for k, c in names.items() if c in table}
     finite = np.all([np.isfinite(v) for v in values.values()], axis=0)
     values = {k: v[finite] for k, v in values.items()}
     if np.any(values["height"] <= 0):
         raise DataFileError(source, columns["height"], "heights must be > 0 m")
+    if len(values["height"]) < MIN_FIT_POINTS:
+        raise DataFileError(source, "", f"{len(values['height'])} row(s) with a height and a "
+                            f"speed; allowed: at least {MIN_FIT_POINTS} to fit a profile "
+                            "with a residual")
     return profile_data(values["height"], values["speed"], values.get("speed_u"),
                         values.get("height_u")), int(np.sum(~finite))
+
+
+def _numbers(column, name, source):
+    """A table column as floats (empty cells NaN); text in it is bad input."""
+    values = pd.to_numeric(column, errors="coerce").to_numpy(dtype=float)
+    text = column[np.isnan(values) & column.notna().to_numpy()]
+    if len(text):
+        raise DataFileError(source, str(name), f"{str(text.iloc[0])[:40]!r} (row "
+                            f"{text.index[0] + 1}) is not a number; allowed: numbers without "
+                            "units (m, m s-1)")
+    return values
 
 
 def fit_profile(data, config, seed=None):

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import matplotlib
 
-from uq.files import (check_target, new_partial_folder, replace_folder, save_figure,
+from uq.files import (check_folder_target, new_partial_folder, replace_folder, save_figure,
                       write_netcdf, write_text)
 from .analysis import analyse
 from .config import load_golden_config
@@ -42,8 +42,7 @@ def run_golden(config_path, output=None, stream=None, errors=None):
     stream, errors = stream or sys.stdout, errors or sys.stderr
     config = load_golden_config(config_path)
     folder = Path(output) if output else Path("results") / config.name
-    if folder.exists() and not folder.is_dir():
-        check_target(folder)                  # a file at the target: refused
+    check_folder_target(folder)               # before any work
     partial = new_partial_folder(folder)
     try:
         if config.synthetic is not None:

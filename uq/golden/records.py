@@ -34,11 +34,10 @@ def read_table(instrument):
     if not path.exists():
         raise DataFileError(source, f"instruments.{instrument.name}.file",
                             "no such file; allowed: a CSV or netCDF file of 10-min records")
-    if path.suffix == ".nc":
-        with xr.open_dataset(path) as ds:
-            table = ds.to_dataframe().reset_index()
-    else:
-        table = pd.read_csv(path)
+    if path.is_dir():
+        raise DataFileError(source, f"instruments.{instrument.name}.file", "is a folder; "
+                            "allowed: a CSV or netCDF file of 10-min records")
+    table = _read(path, source, instrument.name)
     key = f"instruments.{instrument.name}.time"
     if instrument.time not in table.columns:
         raise DataFileError(source, key, f"no column {instrument.time!r}; allowed: "
@@ -53,6 +52,21 @@ def read_table(instrument):
     table.index = pd.DatetimeIndex(time, name="time")
     _check_times(table.index, source, key)
     return table
+
+
+def _read(path, source, name):
+    """The file as a pandas table; DataFileError if it is not CSV (or netCDF) text."""
+    try:
+        if path.suffix == ".nc":
+            with xr.open_dataset(path) as ds:
+                return ds.to_dataframe().reset_index()
+        return pd.read_csv(path, encoding="utf-8")
+    except (OSError, ValueError, UnicodeDecodeError, pd.errors.ParserError,
+            pd.errors.EmptyDataError) as error:
+        reason = str(error).splitlines()[0][:120] if str(error) else type(error).__name__
+        raise DataFileError(source, f"instruments.{name}.file", f"cannot read it as "
+                            f"{'netCDF' if path.suffix == '.nc' else 'CSV'} ({reason}); "
+                            "allowed: a UTF-8 CSV or a netCDF file of 10-min records") from None
 
 
 def load_records(instrument):
@@ -160,7 +174,8 @@ def _checked_direction(direction, source, key):
 
 
 def _listing(columns):
-    names = [str(c) for c in columns]
+    """Column names for a one-line message (control characters and newlines shown)."""
+    names = [repr(str(c))[1:-1][:40] for c in columns]
     return ", ".join(names[:12]) + (", ..." if len(names) > 12 else "")
 
 

@@ -1,22 +1,38 @@
 """Checkpoints of a long sweep on disk, so an interrupted run can be resumed. No physics.
 
 Each finished chunk of scenes is written to ``<output>.partial/chunk-<index>.nc``
-(atomically: temporary file, then rename), beside a ``manifest.json`` that records what
-the chunks belong to: the scenario text, the seed, the number of chunks and the uq
-version. ``--resume`` reuses the chunks of a matching manifest and computes the rest;
-netCDF stores float64 exactly, so the resumed result is bit for bit the uninterrupted
-one. The directory is removed once the results file is written.
+(atomically: temporary file, then rename) with a SHA-256 checksum beside it
+(``chunk-<index>.nc.sha256``), and ``manifest.json`` records what the chunks belong to:
+the scenario text, the seed, the uq version and the chunk plan (every chunk's group and
+scenes), with a digest of all of that that each chunk also carries. ``--resume`` reuses
+the chunks whose checksum and digest match and recomputes the rest (a chunk that fails
+is named in a warning); netCDF stores float64 exactly, so the resumed result is bit for
+bit the uninterrupted one.
+
+A checkpoint has one owner: the run holds an exclusive lock (``flock`` on
+``<output>.partial/lock``, released by the operating system even after ``kill -9``); a
+second run on the same output is refused. The folder carries the marker of
+:mod:`uq.files`; a folder of that name that uq did not write is never used or removed.
+Once the results file is written, the folder is removed (only the files uq put there).
 """
+import contextlib
+import fcntl
+import hashlib
 import json
-import shutil
+import logging
+import os
+import re
 from pathlib import Path
 
 from uq._version import __version__
-from uq.errors import CheckpointError
-from uq.files import write_netcdf, write_text
-from uq.pipeline.results import read_results
+from uq.errors import CheckpointError, OutputError
+from uq.files import MARKER, write_marker, write_netcdf, write_text, written_by_uq
 
 MANIFEST = "manifest.json"
+LOCK = "lock"
+DIGEST_ATTRIBUTE = "checkpoint_digest"
+_CHUNK = re.compile(r"chunk-(\d{6})\.nc")
+log = logging.getLogger(__name__)
 
 
 def checkpoint_directory(output):
@@ -26,7 +42,7 @@ def checkpoint_directory(output):
 
 
 class Checkpoint:
-    """Finished chunks of one run.
+    """Finished chunks of one run (see the module docstring).
 
     Parameters
     ----------
@@ -38,37 +54,169 @@ class Checkpoint:
     def __init__(self, directory, resume=False):
         self.directory = Path(directory)
         self.resume = resume
+        self.digest = None
+        self._lock = None
         self.seed = self._previous().get("seed") if resume else None
 
+    # --- ownership ---------------------------------------------------------------
+    def acquire(self):
+        """Create (or adopt) the folder and take its lock; CheckpointError if another
+        run holds it or uq did not write it."""
+        self._claim_folder()
+        handle = os.open(self.directory / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            owner = os.read(handle, 64).decode(errors="replace").strip() or "?"
+            os.close(handle)
+            raise CheckpointError(str(self.directory), "", f"in use by another run (process "
+                                  f"{owner}); allowed: one run per output at a time (wait "
+                                  "for it, or write elsewhere with -o)") from None
+        os.ftruncate(handle, 0)
+        os.write(handle, str(os.getpid()).encode())
+        self._lock = handle
+        if self.resume:
+            self.seed = self._previous().get("seed")
+        return self
+
+    @contextlib.contextmanager
+    def held(self):
+        """Hold the lock for a block (taken here unless the caller already holds it)."""
+        taken = self._lock is None
+        if taken:
+            self.acquire()
+        try:
+            yield self
+        finally:
+            if taken:
+                self.release()
+
+    def __del__(self):
+        self.release()
+
+    def release(self):
+        """Let go of the lock (the folder stays for --resume)."""
+        if self._lock is not None:
+            os.close(self._lock)
+            self._lock = None
+
+    def _claim_folder(self):
+        folder = self.directory
+        try:
+            folder.mkdir(parents=True)
+            write_marker(folder, "checkpoint")
+            return
+        except FileExistsError:
+            pass
+        except OSError as error:
+            raise OutputError(str(folder), "", f"cannot create the checkpoint folder "
+                              f"({error.strerror}); allowed: a writable place") from None
+        contents = {p.name for p in folder.iterdir()} if folder.is_dir() else None
+        if contents is None or not (written_by_uq(folder) or contents <= {LOCK}):
+            raise CheckpointError(str(folder), "", "exists and was not written by uq; "
+                                  "allowed: remove or rename it yourself, or write the "
+                                  "results elsewhere with -o")
+        if MARKER not in contents:
+            write_marker(folder, "checkpoint")
+
+    # --- the run -----------------------------------------------------------------
     def _previous(self):
         try:
             return json.loads((self.directory / MANIFEST).read_text())
         except (OSError, ValueError):
             return {}
 
-    def start(self, scenario, seed, n_chunks):
-        """Check (resume) or write (fresh) the manifest of this run."""
-        manifest = {"scenario": scenario.text, "seed": int(seed), "chunks": n_chunks,
-                    "uq_version": __version__}
-        if self.resume and self.directory.exists():
-            previous = self._previous()
-            if previous != manifest:
-                raise CheckpointError(str(self.directory), MANIFEST, "the checkpoint belongs to a "
-                                    "different scenario, seed or uq version; allowed: resume "
-                                    "the same run, or run without --resume to start afresh")
+    def start(self, scenario, seed, chunks):
+        """Check (resume) or write (fresh) the manifest of this run; `chunks` is the
+        sweep plan's chunks (index, group, start, stop)."""
+        plan = [[c.index, list(c.group), c.start, c.stop] for c in chunks]
+        manifest = {"scenario": scenario.text, "seed": int(seed), "uq_version": __version__,
+                    "chunks": len(plan), "plan": plan}
+        text = json.dumps(manifest, sort_keys=True)
+        self.digest = hashlib.sha256(text.encode()).hexdigest()
+        manifest["digest"] = self.digest
+        if self.resume and (self.directory / MANIFEST).exists():
+            if self._previous() != manifest:
+                raise CheckpointError(str(self.directory), MANIFEST, "the checkpoint belongs "
+                                      "to a different scenario, seed, chunk plan or uq "
+                                      "version; allowed: resume the same run, or run without "
+                                      "--resume to start afresh")
             return
-        self.clear()
-        self.directory.mkdir(parents=True)
+        self._remove_chunks()
         write_text(self.directory / MANIFEST, json.dumps(manifest, indent=1))
 
     def load(self):
-        """Chunk index -> Dataset of every chunk on disk."""
-        return {int(path.stem.split("-")[1]): read_results(path)
-                for path in sorted(self.directory.glob("chunk-*.nc"))}
+        """Chunk index -> Dataset of every intact chunk of this run on disk; a chunk that
+        fails its checksum or belongs to another run is removed and recomputed."""
+        from uq.pipeline.results import read_results
+        chunks = {}
+        for path in sorted(self.directory.glob("chunk-*.nc")):
+            match = _CHUNK.fullmatch(path.name)
+            problem = "bad name" if not match else self._verify(path)
+            dataset = None
+            if not problem:
+                try:
+                    dataset = read_results(path)
+                except (OSError, ValueError, RuntimeError):
+                    problem = "unreadable"
+            if dataset is not None and dataset.attrs.get(DIGEST_ATTRIBUTE) != self.digest:
+                problem, dataset = "written by another run", None
+            if problem:
+                log.warning("checkpoint chunk %s: %s; it is recomputed", path, problem)
+                self._remove(path)
+                self._remove(path.with_name(path.name + ".sha256"))
+                continue
+            chunks[int(match.group(1))] = dataset
+        return chunks
+
+    def _verify(self, path):
+        """'' if the chunk's bytes match its recorded SHA-256, else what is wrong."""
+        try:
+            recorded = path.with_name(path.name + ".sha256").read_text().strip()
+        except OSError:
+            return "no checksum"
+        return "" if _sha256(path) == recorded else "checksum mismatch"
 
     def save(self, index, dataset):
-        write_netcdf(dataset, self.directory / f"chunk-{index:06d}.nc")
+        dataset = dataset.copy(deep=False)
+        dataset.attrs[DIGEST_ATTRIBUTE] = self.digest
+        path = self.directory / f"chunk-{index:06d}.nc"
+        write_netcdf(dataset, path)
+        write_text(path.with_name(path.name + ".sha256"), _sha256(path) + "\n")
+
+    def is_empty(self):
+        """No chunk on disk (nothing a --resume could reuse)?"""
+        return not any(self.directory.glob("chunk-*.nc"))
 
     def clear(self):
-        shutil.rmtree(self.directory, ignore_errors=True)
+        """Remove the checkpoint (the files uq wrote there, then the folder if empty)."""
+        self._remove_chunks()
+        for name in (MANIFEST, MARKER, LOCK):
+            self._remove(self.directory / name)
+        self.release()
+        try:
+            self.directory.rmdir()
+        except OSError:
+            if self.directory.exists():
+                log.warning("checkpoint folder %s kept: it holds files uq did not write",
+                            self.directory)
 
+    def _remove_chunks(self):
+        for path in self.directory.glob("chunk-*.nc*"):
+            if _CHUNK.fullmatch(path.name.removesuffix(".sha256")):
+                self._remove(path)
+
+    @staticmethod
+    def _remove(path):
+        try:
+            path.unlink()
+        except FileNotFoundError:
+            pass
+
+
+def _sha256(path):
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()

@@ -8,6 +8,7 @@ scene uses the same seed, and so the same underlying draws (common random number
 Chunks can run on a dask cluster and be kept on disk for ``--resume``; neither changes
 a number.
 """
+import contextlib
 import time
 
 import numpy as np
@@ -48,13 +49,14 @@ def run(scenario, progress=None, *, client=None, checkpoint=None):
     """
     started = time.perf_counter()
     scenario = load_scenario(scenario)
-    seed = scenario.sampling["seed"]
-    if seed is None:
-        seed = checkpoint.seed if checkpoint and checkpoint.seed is not None else new_seed()
     plan = sweep_plan(scenario)
-    if checkpoint:
-        checkpoint.start(scenario, seed, len(plan.chunks))
-    results = _compute(scenario, plan, seed, progress, client, checkpoint)
+    with (checkpoint.held() if checkpoint else contextlib.nullcontext()):
+        seed = scenario.sampling["seed"]
+        if seed is None:             # a resumed run keeps the seed its chunks were drawn with
+            seed = checkpoint.seed if checkpoint and checkpoint.seed is not None else new_seed()
+        if checkpoint:
+            checkpoint.start(scenario, seed, plan.chunks)
+        results = _compute(scenario, plan, seed, progress, client, checkpoint)
     dataset = _assemble(scenario, plan, results)
     dataset.attrs.update(_global_attributes(scenario, seed, dataset, started))
     return dataset

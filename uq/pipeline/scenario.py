@@ -12,14 +12,18 @@ wrapped into [0, 360).
 """
 import copy
 import math
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import yaml
 
-from uq.constants import FULL_CIRCLE_DEG
+from uq.constants import (COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, MAX_BEAMS, MAX_CHUNK_SIZE,
+                          MAX_GATES, MAX_GROUPS, MAX_MAGNITUDE, MAX_SCENES, MAX_SEED)
 from uq.physics.correction import CORRECTION_MODELS
+from uq.physics.beams import beam_unit_vectors
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS, validate_error
 from uq.errors import ScenarioError
 from uq.pipeline.fitconfig import validate_fit
@@ -28,6 +32,7 @@ from uq.engine.sampling import PROPAGATION_METHODS
 from uq.engine.statistics import INTERVALS
 from uq.engine.stopping import STOPPING_RULES
 from uq.pipeline.sweep import VECTOR_KEYS
+from uq.pipeline.yamlfile import read_yaml  # noqa: F401  (read_yaml is the scenario reader)
 
 INS_CORRELATIONS = ("scan", "beam")
 INS_KEYS = ("heading", "pitch", "roll", "sog", "cog", "heave")
@@ -35,6 +40,14 @@ LIDAR_ERROR_KEYS = ("half_cone", "misalignment", "radial_velocity", "height")
 #: Largest tilt the model accepts [deg]; beyond it the lidar looks sideways.
 MAX_TILT_DEG = 89.0
 MAX_SAMPLES = 10**10
+#: Smallest singular value of the beam matrix, relative to the largest, for the beams to
+#: determine the 3-D wind [1]: a singular geometry gives 0 to rounding (~1e-17); 1e-10
+#: keeps every geometry whose reconstruction is exact to double precision in a noise-free
+#: scan (three azimuths within 1 deg on a 5 deg cone: ~1e-6).
+BEAM_RANK_TOLERANCE = 1e-10
+#: Fewest Monte Carlo trials that give a coverage interval [1]: JCGM 101:2008, 7.2.2, at
+#: least 1/(1 - p) (20 for p = 0.95; 10^4 and more recommended). Fewer give no endpoints.
+MIN_SAMPLES = round(1 / (1 - COVERAGE_PROBABILITY))
 
 DEFAULTS = {
     "name": "scenario",
@@ -155,19 +168,6 @@ def load_scenario(path_or_mapping, overrides=None):
     return _build(raw, source)
 
 
-def read_yaml(path):
-    try:
-        text = path.read_text()
-    except OSError as error:
-        raise ScenarioError(str(path), "", f"cannot read the file ({error.strerror})") from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark else ""
-        raise ScenarioError(str(path), "", f"not valid YAML{where}") from None
-
-
 def assign_dotted(raw, dotted, value, source):
     """Set raw[a][b]... = value for 'a.b...', creating mappings on the way.
 
@@ -202,6 +202,9 @@ def load_fit_settings(raw_fit, source):
 
 def _validate(raw, source, check=None):
     check = check or Checker(source)
+    if "golden" in raw:
+        check.fail("golden", "this is a golden-lidar configuration, not a scenario; "
+                   "allowed: uq golden FILE")
     check.keys(raw, "", DEFAULTS)
     settings = {
         "name": check.name(raw.get("name", DEFAULTS["name"])),
@@ -261,6 +264,8 @@ def _ins(check, value):
 
 def _lidar(check, value):
     lid = _section(check, value, "lidar")
+    check.length(lid["ranges"], "lidar.ranges", MAX_GATES)
+    check.length(lid["azimuths"], "lidar.azimuths", MAX_BEAMS)
     out = {"height": check.number(lid["height"], "lidar.height", low=0.0),
            "ranges": check.number_list(lid["ranges"], "lidar.ranges", low=0.0, low_open=True),
            "half_cone": check.number(lid["half_cone"], "lidar.half_cone", low=0.0, high=90.0,
@@ -275,12 +280,27 @@ def _lidar(check, value):
         raise ScenarioError(check.source, "lidar.azimuths", "need at least 3 beams (and 2 "
                             "slanted ones) to reconstruct the 3-D wind; allowed: >= 3 "
                             "azimuths, or 2 non-opposite ones with vertical_beam: true")
+    _check_beams_determine_wind(check, out)
     errors = lid["errors"] if lid["errors"] is not None else {}
     check.mapping(errors, "lidar.errors")
     check.keys(errors, "lidar.errors", LIDAR_ERROR_KEYS)
     out["errors"] = {key: validate_error(errors[key], f"lidar.errors.{key}", check)
                      for key in LIDAR_ERROR_KEYS if key in errors}
     return out
+
+
+def _check_beams_determine_wind(check, lidar):
+    """The beams must span the three wind components (the least-squares matrix of the
+    DBS reconstruction has full rank): e.g. azimuths 0 and 180 with a vertical beam do
+    not (they see nothing of the cross wind)."""
+    vectors = beam_unit_vectors(math.radians(lidar["half_cone"]),
+                                np.radians(lidar["azimuths"]), 0.0, lidar["vertical_beam"])
+    singular = np.linalg.svd(vectors, compute_uv=False)
+    if singular[-1] < BEAM_RANK_TOLERANCE * singular[0]:
+        check.fail("lidar.azimuths", f"the beams ({', '.join(f'{a:g}' for a in lidar['azimuths'])}"
+                   f"{' and vertical' if lidar['vertical_beam'] else ''}) do not determine the "
+                   "3-D wind; allowed: beams spanning north, east and up (e.g. 3 azimuths not "
+                   "on one line, or 2 non-opposite ones with vertical_beam: true)")
 
 
 def _sampling(check, value):
@@ -299,11 +319,13 @@ def _sampling(check, value):
     if "digits" in value:
         out["digits"] = check.integer(value["digits"], "sampling.digits", low=1, high=6)
     else:
-        out["n"] = check.integer(value.get("n", DEFAULT_SAMPLES), "sampling.n", low=2,
-                                 high=MAX_SAMPLES)
-    out["seed"] = None if s["seed"] is None else check.integer(s["seed"], "sampling.seed", low=0)
+        out["n"] = check.integer(value.get("n", DEFAULT_SAMPLES), "sampling.n",
+                                 low=MIN_SAMPLES, high=MAX_SAMPLES)
+    out["seed"] = None if s["seed"] is None else check.integer(s["seed"], "sampling.seed", low=0,
+                                                               high=MAX_SEED)
     if "chunk_size" in value:
-        out["chunk_size"] = check.integer(value["chunk_size"], "sampling.chunk_size", low=1)
+        out["chunk_size"] = check.integer(value["chunk_size"], "sampling.chunk_size", low=1,
+                                          high=MAX_CHUNK_SIZE)
     out["stop_when_gum_valid"] = check.boolean(value.get("stop_when_gum_valid", False),
                                                "sampling.stop_when_gum_valid")
     if out["stop_when_gum_valid"] and "digits" not in out:
@@ -329,11 +351,19 @@ def _validate_sweep(value, settings, source):
                             "values or to {start, stop, step}")
     sweep, links = [], []
     for key, spec in value.items():
+        if not isinstance(key, str):
+            raise ScenarioError(source, f"sweep.{key}", "a swept key must be a dotted key "
+                                "(text), e.g. wind.direction")
         _sweep_key_exists(settings, key, source)
         if isinstance(spec, dict) and set(spec) == {"same_as"}:
+            if not isinstance(spec["same_as"], str):
+                raise ScenarioError(source, f"sweep.{key}.same_as", f"expected a swept key "
+                                    f"(text), got {_kind(spec['same_as'])}")
             links.append((key, spec["same_as"]))
             continue
-        sweep.append((key, tuple(_sweep_values(spec, f"sweep.{key}", source))))
+        sweep.append((key, _sweep_values(spec, f"sweep.{key}", source)))
+    _check_sweep_size(sweep, source)           # counts only: nothing allocated yet
+    sweep = [(key, tuple(values)) for key, values in sweep]
     swept = dict(sweep)
     for follower, leader in links:
         if leader not in swept:
@@ -345,11 +375,52 @@ def _validate_sweep(value, settings, source):
                                 f"({', '.join(VECTOR_KEYS)}) or pairs of other keys")
         swept[follower] = swept[leader]
     for key, values in swept.items():
-        for item in values:       # each value must make a valid scenario
-            raw = copy.deepcopy(settings)
+        for item in _values_to_validate(key, values, source):
+            raw = copy.deepcopy(settings)     # each value must make a valid scenario
             assign_dotted(raw, key, item, source)
             _validate(raw, source)
     return tuple(sweep), tuple(links)
+
+
+def _values_to_validate(key, values, source):
+    """The values of a swept key that must each be validated in a whole scenario. A
+    scene value (:data:`VECTOR_KEYS`) is a number checked against an interval, so its
+    smallest and largest values stand for all (after a type check of each): a sweep of
+    10^6 directions costs two validations, not 10^6."""
+    if key not in VECTOR_KEYS:
+        return values
+    for item in values:
+        if isinstance(item, bool) or not isinstance(item, (int, float)):
+            raise ScenarioError(source, f"sweep.{key}", f"expected numbers, got {_kind(item)}")
+    bad = [item for item in values if not math.isfinite(_float_magnitude(item))]
+    return bad[:1] or [min(values), max(values)]
+
+
+def _check_sweep_size(sweep, source):
+    """Refuse a sweep of more scenes (or structural groups) than the limits, before
+    anything is allocated (:data:`~uq.constants.MAX_SCENES`, ``UQ_MAX_SCENES``)."""
+    limit = max_scenes()
+    scenes = math.prod(len(values) for _, values in sweep)
+    if scenes > limit:
+        sizes = " x ".join(f"{len(values)} ({key})" for key, values in sweep)
+        raise ScenarioError(source, "sweep", f"{sizes} = {scenes:.3g} scenes; allowed: at "
+                            f"most {limit} (environment variable UQ_MAX_SCENES)")
+    groups = math.prod(len(values) for key, values in sweep if key not in VECTOR_KEYS)
+    if groups > MAX_GROUPS:
+        raise ScenarioError(source, "sweep", f"{groups} combinations of structural keys "
+                            "(each its own model); allowed: at most "
+                            f"{MAX_GROUPS} (sweep scene values such as wind.* and ship.* "
+                            "instead, which are evaluated as arrays)")
+
+
+def max_scenes():
+    """The most scenes a sweep may have: UQ_MAX_SCENES if set, else MAX_SCENES."""
+    text = os.environ.get("UQ_MAX_SCENES", "")
+    try:
+        return int(text) if text else MAX_SCENES
+    except ValueError:
+        raise ScenarioError("UQ_MAX_SCENES", "", f"{text!r} is not an integer; allowed: the "
+                            "most scenes a sweep may have") from None
 
 
 def _sweep_key_exists(settings, key, source):
@@ -372,13 +443,32 @@ def _sweep_values(spec, key, source):
     if isinstance(spec, dict) and set(spec) == {"start", "stop", "step"}:
         check = Checker(source)
         start, stop, step = (check.number(spec[k], f"{key}.{k}") for k in ("start", "stop", "step"))
-        if step == 0 or (stop - start) / step <= 0:
+        with np.errstate(all="ignore"):
+            span = (stop - start) / step if step else math.nan
+        if not span > 0:
             raise ScenarioError(source, key, "start, stop, step give no values; allowed: "
                                 "step != 0 pointing from start towards stop (stop excluded)")
-        count = math.ceil((stop - start) / step - 1e-9)
-        return [start + i * step for i in range(count)]
+        if not span <= max_scenes():
+            raise ScenarioError(source, key, f"start, stop, step give {span:.3g} values; "
+                                f"allowed: at most {max_scenes()} (environment variable "
+                                "UQ_MAX_SCENES)")
+        count = math.ceil(span - 1e-9)
+        return _Steps(start, step, count)
     raise ScenarioError(source, key, "must be a list of values, {start, stop, step} or "
                         "{same_as: another swept key}")
+
+
+class _Steps:
+    """The values start + i step, i < count, made only when iterated."""
+
+    def __init__(self, start, step, count):
+        self.start, self.step, self.count = start, step, count
+
+    def __len__(self):
+        return self.count
+
+    def __iter__(self):
+        return (self.start + i * self.step for i in range(self.count))
 
 
 class Checker:
@@ -406,8 +496,11 @@ class Checker:
         return value
 
     def number(self, value, key, low=None, high=None, low_open=False, high_open=False):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
             self.fail(key, f"expected a finite number, got {_kind(value)}")
+        if not _float_magnitude(value) <= MAX_MAGNITUDE:
+            self.fail(key, f"{_kind(value)} is not allowed; allowed: a finite number of "
+                      f"magnitude at most {MAX_MAGNITUDE:g}")
         below = low is not None and (value < low or (low_open and value == low))
         above = high is not None and (value > high or (high_open and value == high))
         if below or above:
@@ -424,6 +517,11 @@ class Checker:
         """An angle on the circle [deg], given in [-360, 360], wrapped into [0, 360)."""
         value = self.number(value, key, -FULL_CIRCLE_DEG, FULL_CIRCLE_DEG)
         return value % FULL_CIRCLE_DEG
+
+    def length(self, value, key, most):
+        """Refuse a list longer than `most` before its elements are checked."""
+        if isinstance(value, list) and len(value) > most:
+            self.fail(key, f"{len(value)} values; allowed: at most {most}")
 
     def number_list(self, value, key, **limits):
         items = self.list(value, key)
@@ -458,7 +556,17 @@ class Checker:
 
 
 def _kind(value):
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**30:
+        return f"an integer of {len(str(abs(value)))} digits"
     return "nothing" if value is None else f"{type(value).__name__} {value!r}"[:60]
+
+
+def _float_magnitude(value):
+    """|value| as a float (inf for an integer too large for a float; NaN stays NaN)."""
+    try:
+        return abs(float(value))
+    except OverflowError:
+        return math.inf
 
 
 def _range(low, high, low_open, high_open):

@@ -1,0 +1,201 @@
+"""Checkpoints are verified before they are trusted, have one owner, and survive faults:
+a flipped bit, a truncated chunk, a chunk of another run, a full disk, kill -9."""
+import errno
+import logging
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import xarray as xr
+import yaml
+
+import uq.pipeline.sweep
+from uq.cli import main
+from uq.errors import CheckpointError
+from uq.pipeline.checkpoint import Checkpoint
+from uq.pipeline.runner import run
+from uq.pipeline.scenario import load_scenario
+
+ROOT = Path(__file__).resolve().parents[2]
+SWEEP = {"name": "tiny", "ins": {"heading": {"dist": "normal", "u": 0.3}},
+         "lidar": {"errors": {"radial_velocity": {"dist": "normal", "u": 0.1}}},
+         "sampling": {"n": 3000, "seed": 7},
+         "sweep": {"wind.direction": [0.0, 90.0, 180.0, 270.0], "ins.heading.u": [0.2, 0.5]}}
+
+
+@pytest.fixture
+def one_scene_per_chunk(monkeypatch):
+    monkeypatch.setattr(uq.pipeline.sweep, "SWEEP_CHUNK_ELEMENTS", 1)
+    monkeypatch.setattr(uq.pipeline.sweep, "SWEEP_CHUNK_ELEMENTS_COMPILED", 1)
+    scenario = load_scenario(SWEEP)
+    assert len(uq.pipeline.sweep.sweep_plan(scenario).chunks) == 8
+    return scenario
+
+
+def same(a, b):
+    xr.testing.assert_identical(a.drop_attrs(), b.drop_attrs())
+
+
+def interrupted(scenario, directory, after=3):
+    def stop(done, total):
+        if done == after:
+            raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt):
+        run(scenario, progress=stop, checkpoint=Checkpoint(directory))
+    return sorted(directory.glob("chunk-*.nc"))
+
+
+@pytest.mark.parametrize("damage", ["flip one bit", "truncate", "drop the checksum"])
+def test_a_damaged_chunk_is_recomputed_with_a_warning(tmp_path, one_scene_per_chunk, damage,
+                                                      caplog):
+    directory = tmp_path / "out.nc.partial"
+    chunks = interrupted(one_scene_per_chunk, directory)
+    victim = chunks[1]
+    data = bytearray(victim.read_bytes())
+    if damage == "flip one bit":
+        data[len(data) // 2] ^= 0x10
+        victim.write_bytes(bytes(data))
+    elif damage == "truncate":
+        victim.write_bytes(bytes(data[:len(data) // 3]))
+    else:
+        victim.with_name(victim.name + ".sha256").unlink()
+    seen = []
+    with caplog.at_level(logging.WARNING, logger="uq.pipeline.checkpoint"):
+        resumed = run(one_scene_per_chunk, progress=lambda d, t: seen.append(d),
+                      checkpoint=Checkpoint(directory, resume=True))
+    assert victim.name in caplog.text and "recomputed" in caplog.text
+    assert seen[0] == 2                              # two intact chunks reused
+    same(resumed, run(one_scene_per_chunk))
+
+
+def test_a_chunk_of_another_run_is_not_mixed_in(tmp_path, one_scene_per_chunk, caplog):
+    """A chunk written by a run of another seed, dropped into this checkpoint (the race of
+    two runs on one output), is recomputed: resumed results equal a clean run."""
+    mine, theirs = tmp_path / "a.nc.partial", tmp_path / "b.nc.partial"
+    interrupted(one_scene_per_chunk, mine)
+    other = one_scene_per_chunk.with_values({"sampling.seed": 8})
+    foreign = interrupted(other, theirs, after=5)[4]
+    for suffix in ("", ".sha256"):
+        (mine / (foreign.name + suffix)).write_bytes((theirs / (foreign.name + suffix)).read_bytes())
+    with caplog.at_level(logging.WARNING, logger="uq.pipeline.checkpoint"):
+        resumed = run(one_scene_per_chunk, checkpoint=Checkpoint(mine, resume=True))
+    assert "another run" in caplog.text
+    same(resumed, run(one_scene_per_chunk))
+
+
+def test_a_checkpoint_has_one_owner(tmp_path):
+    directory = tmp_path / "out.nc.partial"
+    first = Checkpoint(directory).acquire()
+    with pytest.raises(CheckpointError, match=f"in use by another run \\(process {os.getpid()}"):
+        Checkpoint(directory).acquire()
+    first.release()
+    Checkpoint(directory).acquire().release()
+
+
+def test_a_second_command_on_the_same_output_is_refused(tmp_path):
+    """Two `uq run` on one output: the second is refused at once (exit 2), the first
+    finishes with the uninterrupted result."""
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump({**SWEEP, "sampling": {"n": 200_000, "seed": 7}}))
+    first = subprocess.Popen([sys.executable, "-m", "uq.cli", "run", str(path), "--quiet",
+                              "-o", "out.nc"], cwd=tmp_path, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not (tmp_path / "out.nc.partial" / "manifest.json").exists():
+        assert time.monotonic() < deadline and first.poll() is None
+        time.sleep(0.05)
+    second = subprocess.run([sys.executable, "-m", "uq.cli", "run", str(path), "--quiet",
+                             "-o", "out.nc"], cwd=tmp_path, capture_output=True, text=True)
+    assert first.wait(timeout=300) == 0, first.stderr.read()
+    assert second.returncode == 2 and "in use by another run" in second.stderr
+    assert len(second.stderr.strip().splitlines()) == 1
+
+
+def test_kill_9_then_resume_is_bit_identical(tmp_path):
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump({**SWEEP, "sampling": {"n": 60_000, "seed": None}}))
+    env = dict(os.environ)
+    child = subprocess.Popen([sys.executable, "-c", KILLABLE, str(path)], cwd=tmp_path,
+                             env=env)
+    partial = tmp_path / "out.nc.partial"
+    deadline = time.monotonic() + 120
+    while len(list(partial.glob("chunk-*.nc.sha256"))) < 2:
+        assert time.monotonic() < deadline and child.poll() is None
+        time.sleep(0.02)
+    child.send_signal(signal.SIGKILL)
+    child.wait()
+    assert not (tmp_path / "out.nc").exists()
+    resumed = subprocess.run([sys.executable, "-c", KILLABLE, str(path), "--resume"],
+                             cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert resumed.returncode == 0, resumed.stderr
+    with xr.open_dataset(tmp_path / "out.nc") as ds:
+        out = ds.load()
+    clean = subprocess.run([sys.executable, "-c", KILLABLE, str(path), "-o", "clean.nc",
+                            "--set", f"sampling.seed={out.attrs['seed']}"],
+                           cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert clean.returncode == 0, clean.stderr
+    with xr.open_dataset(tmp_path / "clean.nc") as ds:
+        same(out, ds.load())
+    assert not partial.exists()
+
+
+#: `uq run` with one scene per chunk (so the sweep has several chunks to kill between).
+KILLABLE = """
+import sys
+import uq.pipeline.sweep
+uq.pipeline.sweep.SWEEP_CHUNK_ELEMENTS = uq.pipeline.sweep.SWEEP_CHUNK_ELEMENTS_COMPILED = 1
+from uq.cli import main
+args = sys.argv[1:]
+extra = [] if "-o" in args else ["-o", "out.nc"]
+sys.exit(main(["run", args[0], "--quiet"] + extra + args[1:]))
+"""
+
+
+def test_a_full_disk_is_survived(tmp_path, one_scene_per_chunk, monkeypatch, capsys):
+    """The disk fills while the fourth chunk is written: exit 2 with one line, no results
+    file and no temporary file left; after space is freed, --resume completes to the
+    uninterrupted result."""
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump(SWEEP, sort_keys=False))
+    monkeypatch.chdir(tmp_path)
+    original = xr.Dataset.to_netcdf
+    writes = []
+
+    def fill_up(self, target, *args, **kwargs):
+        writes.append(target)
+        if len(writes) == 4:
+            Path(target).write_bytes(b"\0" * 100)       # half a file, then the disk is full
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return original(self, target, *args, **kwargs)
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", fill_up)
+    assert main(["run", str(path), "--quiet", "-o", "out.nc"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "No space left on device" in err[0] and "chunk-000003" in err[0]
+    assert not (tmp_path / "out.nc").exists()
+    assert not [p for p in tmp_path.rglob("*.part")]
+    assert len(list((tmp_path / "out.nc.partial").glob("chunk-*.nc"))) == 3
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", original)
+    assert main(["run", str(path), "--quiet", "-o", "out.nc", "--resume"]) == 0
+    with xr.open_dataset(tmp_path / "out.nc") as ds:
+        same(ds.load(), run(one_scene_per_chunk))
+
+
+def test_a_foreign_folder_is_never_removed(tmp_path):
+    directory = tmp_path / "out.nc.partial"
+    directory.mkdir()
+    (directory / "thesis.tex").write_text("years of work")
+    with pytest.raises(CheckpointError, match="not written by uq"):
+        Checkpoint(directory).acquire()
+    assert (directory / "thesis.tex").read_text() == "years of work"
+
+
+def test_clearing_keeps_files_uq_did_not_write(tmp_path, caplog):
+    directory = tmp_path / "out.nc.partial"
+    checkpoint = Checkpoint(directory).acquire()
+    (directory / "notes.txt").write_text("mine")
+    with caplog.at_level(logging.WARNING, logger="uq.pipeline.checkpoint"):
+        checkpoint.clear()
+    assert (directory / "notes.txt").read_text() == "mine" and "kept" in caplog.text
