@@ -1,5 +1,8 @@
 """``uq run SCENARIO [-o OUT.nc] [--set k=v] [--resume] [--workers N]``."""
 import contextlib
+import logging
+import os
+import signal
 import sys
 from pathlib import Path
 
@@ -75,19 +78,40 @@ def check_scale_out(args):
 
 @contextlib.contextmanager
 def dask_client(args):
-    """A dask.distributed Client for --workers / --scheduler, else None."""
+    """A dask.distributed Client for --workers / --scheduler, else None. It is not made
+    dask's default scheduler: the runner submits chunks to it explicitly, and files are
+    written in this process (xarray would otherwise take cluster-wide locks to write)."""
     if args.workers is None and args.scheduler is None:
         yield None
         return
+    # dask's own log lines (task cancelled at Ctrl-C, ...) are not the user's business;
+    # workers read this from the environment they inherit
+    os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "error")
     try:
         from dask.distributed import Client, LocalCluster
     except ImportError:
         raise ScenarioError("--workers/--scheduler", "dask", "dask.distributed is not "
                             "installed; allowed: pip install 'uq[dask]'") from None
     if args.scheduler:
-        with Client(args.scheduler) as client:
+        with Client(args.scheduler, set_as_default=False) as client:
             yield client
         return
-    with LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster, Client(cluster) as client:
+    logging.getLogger("distributed").setLevel(logging.ERROR)
+    with _ignoring_sigint():          # the workers inherit it: Ctrl-C reaches uq alone
+        cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                               dashboard_address=":0")
+    with cluster, Client(cluster, set_as_default=False) as client:
         yield client
+
+
+@contextlib.contextmanager
+def _ignoring_sigint():
+    """Ignore SIGINT while child processes start. A terminal sends Ctrl-C to the whole
+    process group; workers started with SIGINT ignored keep ignoring it (POSIX keeps an
+    ignored signal across exec, and Python does not override it), so only this process
+    sees the interrupt, stops the cluster and exits 130 with one message."""
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)

@@ -23,7 +23,7 @@ References
 import numpy as np
 from scipy.special import ndtri
 
-from uq.constants import COMPLEX_STEP, COVERAGE_PROBABILITY
+from uq.constants import COMPLEX_STEP, COVERAGE_PROBABILITY, FULL_CIRCLE_DEG
 from uq.engine.statistics import unwrap
 
 
@@ -150,9 +150,23 @@ def gum_interval_valid(estimate, u, low, high, digits, circular=False,
 
     k = Phi^-1((1 + p) / 2) (the GUM's Gaussian coverage factor). Both endpoint
     differences must not exceed the numerical tolerance of u at `digits` digits.
-    Circular outputs compare angles modulo 360 deg. NaN anywhere gives False.
+    Circular outputs compare angles modulo 360 deg, which means something only while the
+    GUM interval is shorter than the circle: a GUM interval of 2 k u >= 360 deg (u >= 92 deg
+    at 95 %; e.g. the direction of a wind of 1e-9 m/s) cannot be validated and is False,
+    whatever its wrapped endpoints. NaN anywhere gives False.
     """
     d_low, d_high = endpoint_differences(estimate, u, low, high, circular, probability)
     delta = numerical_tolerance(u, digits)
     with np.errstate(invalid="ignore"):
-        return (np.abs(d_low) <= delta) & (np.abs(d_high) <= delta)
+        valid = (np.abs(d_low) <= delta) & (np.abs(d_high) <= delta)
+        if circular:
+            valid &= interval_within_circle(u, probability)
+    return valid
+
+
+def interval_within_circle(u, probability=COVERAGE_PROBABILITY):
+    """Is the GUM interval y +- k u of a circular output shorter than the circle
+    (2 k u < 360 deg)? Only then can it be compared with Monte Carlo modulo 360 deg."""
+    k = ndtri((1 + probability) / 2)
+    with np.errstate(invalid="ignore"):
+        return 2 * k * np.asarray(u) < FULL_CIRCLE_DEG

@@ -9,6 +9,8 @@ References
    Monte Carlo method: 7.7 (coverage intervals), 7.9 (adaptive procedure), 8
    (validation of the GUM framework).
 """
+import logging
+
 import numpy as np
 import xarray as xr
 
@@ -25,6 +27,9 @@ from uq.engine.statistics import (INTERVALS, CoMoments, Moments, StreamingStatis
                          tail_capacity)
 
 _BATCH_KEYS = ("mean", "u", "low", "high")
+
+
+log = logging.getLogger(__name__)
 
 
 def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
@@ -352,6 +357,8 @@ class _Runner:
     def _gum_decided(self, targets, digits, stopping, check):
         """Every output's GUM interval validated beyond the Monte Carlo noise."""
         for q, (value, u, circular) in targets.items():
+            if circular and not np.all(gum.interval_within_circle(u)):
+                return False                        # cannot be validated (clause 8)
             result = self.result(q)
             differences = gum.endpoint_differences(value, u, result["low"], result["high"],
                                                    circular)
@@ -401,6 +408,7 @@ def _mc_variables(runner, gum_results, circular, digits):
         value, u_gum = gum_results[f"{q}_gum_value"].values, gum_results[f"{q}_gum_u"].values
         result = runner.result(q)
         error = runner.numerical_error(q)
+        _warn_overflow(q, result)
         data.update({
             f"{q}_mc_mean": (dims, result["mean"]),
             f"{q}_mc_u": (dims, result["u"]),
@@ -418,6 +426,18 @@ def _mc_variables(runner, gum_results, circular, digits):
         if q in circular:
             data[f"{q}_mc_circular_std"] = (dims, result["circular_std"])
     return data
+
+
+def _warn_overflow(quantity, result):
+    """Say so when finite outputs gave a non-finite u: their squares overflowed (|y| of
+    ~1e154 and more). The scenario layer bounds inputs far below (MAX_MAGNITUDE)."""
+    with np.errstate(invalid="ignore"):
+        overflowed = ~np.isfinite(result["u"]) & np.isfinite(result["mean"]) & \
+            (np.asarray(result["n_valid"]) > 1)
+    if np.any(overflowed):
+        log.warning("%s: the Monte Carlo moments overflowed in %d element(s) (outputs of "
+                    "magnitude ~1e154 or more); u there is not an estimate",
+                    quantity, int(np.sum(overflowed)))
 
 
 def _other(dims):

@@ -84,7 +84,7 @@ def _distributed(client, scenario, plan, chunks, seed):
     from dask.distributed import as_completed
     futures = {client.submit(run_chunk, scenario, plan, chunk, seed, pure=False): chunk.index
                for chunk in chunks}
-    for future in as_completed(futures):
+    for future in as_completed(futures, loop=client.loop):
         yield futures[future], future.result()
 
 
