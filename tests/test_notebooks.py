@@ -24,3 +24,14 @@ def test_notebook_runs_headless(notebook, tmp_path):
                          text=True, env={**os.environ, "MPLBACKEND": "Agg"}, timeout=600)
     assert run.returncode == 0, run.stderr[-2000:]
     assert "Warning" not in run.stderr, run.stderr[-2000:]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [script.name]   # writes no file
+
+
+def test_the_notebooks_write_nothing_into_the_checkout():
+    """Running a notebook leaves the checkout clean: no savefig or to_netcdf into a
+    relative path (the notebook runs with the notebooks/ folder as its directory)."""
+    for notebook in NOTEBOOKS:
+        for cell in json.loads(notebook.read_text())["cells"]:
+            code = [line for line in cell["source"] if not line.lstrip().startswith("#")]
+            assert not any(("savefig(" in line or "to_netcdf(" in line or "write_" in line)
+                           for line in code), notebook.name

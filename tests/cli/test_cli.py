@@ -194,3 +194,26 @@ def test_interrupted_run_keeps_its_checkpoint_and_resumes(tmp_path, capsys, monk
                               monkeypatch)
     assert status == 0 and (tmp_path / "results" / "tiny.nc").exists()
     assert not (tmp_path / "results" / "tiny.nc.partial").exists()
+
+
+def test_bare_uq_prints_the_usage_and_the_commands(tmp_path):
+    result = uq(cwd=tmp_path)
+    assert result.returncode == 2
+    for command in ("run", "check", "plot", "report", "bench", "fit", "golden"):
+        assert f"\n    {command} " in result.stderr
+    assert "usage: uq" in result.stderr and "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("command", ["run", "check", "plot", "report", "bench", "fit",
+                                     "golden"])
+def test_every_command_has_quiet_and_verbose(command, tmp_path):
+    text = uq(command, "--help", cwd=tmp_path).stdout
+    assert "-q, --quiet" in text and "-v, --verbose" in text
+
+
+def test_quiet_prints_nothing_and_results_go_to_stdout(tmp_path):
+    path = write(tmp_path, GOOD, "good.yaml")
+    quiet = uq("run", str(path), "-q", "-o", "q.nc", cwd=tmp_path)
+    assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == ""
+    loud = uq("run", str(path), "-o", "l.nc", cwd=tmp_path)
+    assert "wrote l.nc" in loud.stdout and "wrote" not in loud.stderr

@@ -13,7 +13,7 @@ import sys
 from uq._version import __version__
 from uq.cli import bench, check, fit, golden, plot, report, run
 from uq.cli.common import (EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK,  # noqa: F401
-                           Parser, parse_overrides)
+                           Parser, add_common_options, configure_logging, parse_overrides)
 from uq.errors import InputError
 
 SUBCOMMANDS = (run, check, plot, report, bench, fit, golden)
@@ -21,17 +21,25 @@ SUBCOMMANDS = (run, check, plot, report, bench, fit, golden)
 
 def build_parser():
     parser = Parser(prog="uq", description="Uncertainty of ship-based and floating "
-                    "Doppler wind lidar: Monte Carlo beside the GUM.")
+                    "Doppler wind lidar: Monte Carlo beside the GUM.",
+                    epilog="Run 'uq COMMAND --help' for a command's options. "
+                    "Exit status: 0 success, 1 failure, 2 bad input, 130 interrupted.")
     parser.add_argument("--version", action="version", version=f"uq {__version__}")
-    commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    commands = parser.add_subparsers(dest="command", parser_class=Parser,
+                                     metavar="COMMAND", title="commands")
     for module in SUBCOMMANDS:
-        module.add_parser(commands)
+        add_common_options(module.add_parser(commands))
     return parser
 
 
 def main(argv=None):
     try:
-        args = build_parser().parse_args(argv)
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        if args.command is None:                 # bare `uq`: the usage and the commands
+            parser.print_help(sys.stderr)
+            return EXIT_BAD_INPUT
+        configure_logging(args)
         return args.handler(args)
     except InputError as error:
         print(f"uq: error: {error}", file=sys.stderr)

@@ -8,6 +8,7 @@ def add_parser(commands):
     bench.add_argument("-o", "--output", default="results/bench.nc", help="results file")
     bench.add_argument("--quick", action="store_true", help="fewer sizes and repeats (~1 min)")
     bench.set_defaults(handler=command)
+    return bench
 
 
 def command(args):

@@ -1,5 +1,5 @@
 """``uq check SCENARIO``: validate a scenario or a golden-lidar configuration."""
-from uq.cli.common import EXIT_OK, parse_overrides
+from uq.cli.common import EXIT_OK, parse_overrides, say
 
 
 def add_parser(commands):
@@ -9,6 +9,7 @@ def add_parser(commands):
                        "scenario")
     check.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     check.set_defaults(handler=command)
+    return check
 
 
 def command(args):
@@ -21,12 +22,12 @@ def command(args):
         config = load_golden_config(path)
         what = "synthetic campaign" if config.synthetic else \
             f"{len(config.comparisons)} comparison(s)"
-        print(f"{args.scenario}: ok (golden-lidar configuration {config.name}: {what})")
+        say(args, f"{args.scenario}: ok (golden-lidar configuration {config.name}: {what})")
         return EXIT_OK
     scenario = load_scenario(path, parse_overrides(args.set))
     scenes = 1
     for _, values in scenario.sweep:
         scenes *= len(values)
-    print(f"{args.scenario}: ok ({scenario.name}: {scenes} scene(s), outputs "
-          f"{', '.join(scenario.outputs)})")
+    say(args, f"{args.scenario}: ok ({scenario.name}: {scenes} scene(s), outputs "
+         f"{', '.join(scenario.outputs)})")
     return EXIT_OK

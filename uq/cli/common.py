@@ -1,6 +1,8 @@
 """What every subcommand shares: exit codes, the parser that reports usage errors as bad
 input, and ``--set`` overrides. Imports nothing heavy (``uq --help`` stays fast)."""
 import argparse
+import logging
+import sys
 
 from uq.errors import ScenarioError
 
@@ -39,3 +41,64 @@ def _number_or_value(value):
         except ValueError:
             return value
     return value
+
+
+class _StderrHandler(logging.StreamHandler):
+    """A handler that writes to whatever sys.stderr is at the time of each message."""
+
+    def __init__(self):
+        super().__init__()
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value):
+        pass
+
+
+class _Formatter(logging.Formatter):
+    """``uq: warning: ...`` (``uq golden: warning: ...`` from a wing)."""
+
+    def format(self, record):
+        parts = record.name.split(".")
+        prefix = f"uq {parts[1]}" if len(parts) > 1 and parts[1] in WINGS else "uq"
+        return f"{prefix}: {record.levelname.lower()}: {record.getMessage()}"
+
+
+WINGS = ("golden", "fit", "bench")
+
+
+def add_common_options(parser):
+    """-q/--quiet and -v/--verbose, on every subcommand."""
+    parser.add_argument("-q", "--quiet", action="store_true",
+                        help="print only errors (no summary, progress or warnings)")
+    parser.add_argument("-v", "--verbose", action="count", default=0,
+                        help="more diagnostics on stderr (-vv: debugging)")
+
+
+def configure_logging(args):
+    """Diagnostics through logging on stderr; results stay on stdout. Third-party
+    warnings are logged at debug level (shown with -vv), not leaked."""
+    quiet, verbose = getattr(args, "quiet", False), getattr(args, "verbose", 0)
+    level = logging.ERROR if quiet else (logging.WARNING, logging.INFO, logging.DEBUG)[
+        min(verbose, 2)]
+    logger = logging.getLogger("uq")
+    if not any(isinstance(h, _StderrHandler) for h in logger.handlers):
+        handler = _StderrHandler()
+        handler.setFormatter(_Formatter())
+        logger.addHandler(handler)
+    logger.setLevel(level)
+    logging.captureWarnings(True)
+    warnings_logger = logging.getLogger("py.warnings")
+    warnings_logger.setLevel(logging.DEBUG if verbose >= 2 else logging.CRITICAL)
+    for name in ("distributed", "matplotlib", "root"):
+        logging.getLogger(name if name != "root" else None).setLevel(
+            logging.DEBUG if verbose >= 2 else logging.ERROR)
+
+
+def say(args, text):
+    """Print a result line on stdout unless --quiet."""
+    if not getattr(args, "quiet", False):
+        print(text)

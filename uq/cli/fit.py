@@ -14,8 +14,10 @@ def add_parser(commands):
     fit.add_argument("--set", action="append", default=[], metavar="fit.KEY=VALUE",
                      help="override a fit setting (dotted key, YAML value); repeatable")
     fit.set_defaults(handler=command)
+    return fit
 
 
 def command(args):
     from uq.fit.command import run_fit
-    return run_fit(args.input, args.config, args.output, parse_overrides(args.set))
+    return run_fit(args.input, args.config, args.output, parse_overrides(args.set),
+                   quiet=args.quiet)

@@ -10,10 +10,14 @@ def add_parser(commands):
                         "section), e.g. scenarios/golden_campaign.yaml")
     golden.add_argument("-o", "--output", help="output folder (default results/<name>/)")
     golden.set_defaults(handler=command)
+    return golden
 
 
 def command(args):
     from uq.golden.command import run_golden
     from uq.pipeline.shipped import scenario_path
-    run_golden(scenario_path(args.config), args.output)
+    import io
+    import sys
+    run_golden(scenario_path(args.config), args.output,
+               stream=io.StringIO() if args.quiet else sys.stdout)
     return EXIT_OK

@@ -1,7 +1,7 @@
 """``uq plot RESULTS.nc [-o FOLDER] [--format png|pdf|svg]``."""
 from pathlib import Path
 
-from uq.cli.common import EXIT_OK
+from uq.cli.common import EXIT_OK, say
 from uq.errors import ScenarioError
 
 
@@ -14,6 +14,7 @@ def add_parser(commands):
     plot.add_argument("--format", action="append", choices=("png", "pdf", "svg"),
                       help="figure format; repeatable (default png)")
     plot.set_defaults(handler=command)
+    return plot
 
 
 def open_results(path):
@@ -41,5 +42,5 @@ def command(args):
         for extension in formats:
             check_target(directory / f"{name}.{extension}")
     for written in make_figures(dataset, directory, formats=formats):
-        print(f"wrote {written}")
+        say(args, f"wrote {written}")
     return EXIT_OK

@@ -1,7 +1,7 @@
 """``uq report RESULTS.nc [-o REPORT.html] [--target U]``."""
 from pathlib import Path
 
-from uq.cli.common import EXIT_OK
+from uq.cli.common import EXIT_OK, say
 from uq.cli.plot import open_results
 from uq.errors import ScenarioError
 
@@ -16,6 +16,7 @@ def add_parser(commands):
                         help="target u(wind speed) [m s-1] for the largest velocity ratio; "
                         "repeatable (default 0.05, 0.06 and 0.07)")
     report.set_defaults(handler=command)
+    return report
 
 
 def command(args):
@@ -31,5 +32,5 @@ def command(args):
             raise ScenarioError("--target", str(target), "allowed: a positive number [m s-1]")
     write_report(dataset, output, source=path,
                  **({"targets": tuple(args.target)} if args.target else {}))
-    print(f"wrote {output}")
+    say(args, f"wrote {output}")
     return EXIT_OK

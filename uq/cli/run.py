@@ -6,7 +6,7 @@ import signal
 import sys
 from pathlib import Path
 
-from uq.cli.common import EXIT_INTERRUPTED, EXIT_OK, parse_overrides
+from uq.cli.common import EXIT_INTERRUPTED, EXIT_OK, parse_overrides, say
 from uq.errors import ScenarioError
 
 
@@ -17,7 +17,6 @@ def add_parser(commands):
     run.add_argument("-o", "--output", help="output file (default results/<name>.nc)")
     run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                      help="override a scenario value (dotted key, YAML value); repeatable")
-    run.add_argument("--quiet", action="store_true", help="no summary table or progress")
     run.add_argument("--resume", action="store_true",
                      help="continue an interrupted run: reuse the finished chunks kept in "
                      "OUT.nc.partial/ and compute only the missing scenes")
@@ -29,6 +28,7 @@ def add_parser(commands):
                        help="run the sweep on the dask scheduler at ADDRESS "
                        "(e.g. tcp://host:8786)")
     run.set_defaults(handler=command)
+    return run
 
 
 def command(args):
@@ -64,9 +64,8 @@ def command(args):
         raise
     finally:
         checkpoint.release()
-    if not args.quiet:
-        print(summary_table(dataset))
-        print(f"wrote {output}")
+    say(args, summary_table(dataset))
+    say(args, f"wrote {output}")
     return EXIT_OK
 
 
@@ -91,7 +90,7 @@ def dask_client(args):
         from dask.distributed import Client, LocalCluster
     except ImportError:
         raise ScenarioError("--workers/--scheduler", "dask", "dask.distributed is not "
-                            "installed; allowed: pip install 'uq[dask]'") from None
+                            "installed; allowed: pip install 'floating-lidar-uq[dask]' (or pip install -e '.[dask]' in a checkout)") from None
     if args.scheduler:
         with Client(args.scheduler, set_as_default=False) as client:
             yield client

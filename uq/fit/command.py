@@ -3,7 +3,7 @@
 I/O and orchestration only; the fit is :mod:`uq.fit.fitting`, the figures
 :mod:`uq.fit.plots`.
 """
-import sys
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -18,10 +18,12 @@ from uq.pipeline.results import open_results
 from uq.pipeline.scenario import assign_dotted, load_fit_settings
 
 EXIT_OK, EXIT_FAILURE = 0, 1
+log = logging.getLogger(__name__)
 
 
-def run_fit(input_path, config_path=None, output=None, overrides=None):
-    """Fit `input_path` (.nc results or .csv table); returns the exit status."""
+def run_fit(input_path, config_path=None, output=None, overrides=None, quiet=False):
+    """Fit `input_path` (.nc results or .csv table); returns the exit status. The table
+    of results goes to stdout (not with `quiet`), diagnostics to the log."""
     path = Path(input_path)
     if path.suffix not in (".nc", ".csv"):
         raise ScenarioError(str(path), "", "allowed: results of uq run (.nc) or a CSV table "
@@ -36,7 +38,7 @@ def run_fit(input_path, config_path=None, output=None, overrides=None):
     try:
         dataset = _fit_input(path, results, scenario, config)
     except NotConverged as error:
-        print(f"uq: fit failed: {error}", file=sys.stderr)
+        log.error("fit failed: %s", error)
         return EXIT_FAILURE
     write_netcdf(dataset, output)
     from uq.fit.plots import plot_corner, plot_profile_fit
@@ -44,8 +46,9 @@ def run_fit(input_path, config_path=None, output=None, overrides=None):
                output.with_name(f"{output.stem}_corner.png")]
     save_figure(plot_profile_fit(dataset), figures[0], dpi=120)
     save_figure(plot_corner(dataset), figures[1], dpi=100, bbox_inches="tight")
-    print(fit_table(dataset))
-    print(f"wrote {output}, {figures[0].name}, {figures[1].name}")
+    if not quiet:
+        print(fit_table(dataset))
+        print(f"wrote {output}, {figures[0].name}, {figures[1].name}")
     return EXIT_OK
 
 
@@ -100,7 +103,7 @@ def _fit_input(path, results, scenario, config):
         dataset = combine_fits({"data": fit_profile(data, config)})
         dataset.attrs["rows_dropped_not_finite"] = dropped
         if dropped:
-            print(f"uq: {dropped} row(s) with a missing value not fitted", file=sys.stderr)
+            log.warning("%d row(s) with a missing value not fitted", dropped)
     else:
         fits = {kind: fit_profile(profile_from_results(results, kind, str(path)), config)
                 for kind in ("propagated", "naive")}

@@ -9,6 +9,7 @@ configuration takes). Everything is written into a fresh temporary folder beside
 renamed into place at the end (:func:`uq.files.replace_folder`), so a failure leaves no
 half-written folder, and a folder uq did not write is never replaced.
 """
+import logging
 import shutil
 import sys
 from pathlib import Path
@@ -22,6 +23,7 @@ from .config import load_golden_config
 from .findings import thin_bins
 from .report import render_html, render_markdown, report_blocks
 
+log = logging.getLogger(__name__)
 PER_BIN = ("n_records", "sufficient", "reference_mean", "unit_mean", "unit_std",
            "deviation_mean", "deviation_std", "reference_calibration",
            "reference_classification", "statistical", "mean_deviation", "deviation",
@@ -36,10 +38,10 @@ KPI = ("speed_slope", "speed_r_squared", "speed_n_records", "speed_slope_verdict
        "availability_verdict", "coverage_verdict", "class_number")
 
 
-def run_golden(config_path, output=None, stream=None, errors=None):
+def run_golden(config_path, output=None, stream=None):
     """Analyse the campaign of `config_path` and write the folder; returns its path.
-    The summary goes to `stream` (default stdout), warnings to `errors` (stderr)."""
-    stream, errors = stream or sys.stdout, errors or sys.stderr
+    The summary goes to `stream` (default stdout), warnings to the log (stderr)."""
+    stream = stream or sys.stdout
     config = load_golden_config(config_path)
     folder = Path(output) if output else Path("results") / config.name
     check_folder_target(folder)               # before any work
@@ -55,8 +57,8 @@ def run_golden(config_path, output=None, stream=None, errors=None):
         raise
     replace_folder(partial, folder, kind="golden")
     for key, height, bins in thin_bins(ds):
-        print(f"uq golden: warning: {key} at {height:g} m: required bins with too few "
-              f"records: {', '.join(f'{b:g} m/s ({n})' for b, n in bins)}", file=errors)
+        log.warning("%s at %g m: required bins with too few records: %s", key, height,
+                    ", ".join(f"{b:g} m/s ({n})" for b, n in bins))
     print(_summary(ds), file=stream)
     print(f"wrote {folder}/ (report.html, report.md, {config.name}.nc, tables/, figures/)",
           file=stream)
