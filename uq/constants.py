@@ -184,3 +184,15 @@ MAX_BEAMS = 1000
 #: Largest sampling.chunk_size [trials]: a chunk holds trials x inputs draws and the model's
 #: temporaries; 2^24 trials of a 23-input scene are ~3 GB of draws.
 MAX_CHUNK_SIZE = 2**22
+
+# --- time-resolved motion (issue 17) ---------------------------------------------------
+
+#: Error bound of the dwell average per unit amplitude of the fastest motion component
+#: [1] (:func:`uq.physics.timing.dwell_node_count`): 1e-9 of a 10 deg roll is 2e-10 rad,
+#: ~2e-9 m/s of radial velocity at 10 m/s: far below any other error of the model.
+DWELL_QUADRATURE_TOLERANCE = 1e-9
+
+#: Most Gauss-Legendre nodes per dwell [1]: 32 nodes average a sinusoid over a dwell of up
+#: to ~10 of its radians to 1e-9 (a 1 s dwell of a 0.6 s motion period); a conical scan's
+#: dwell of 20 ms needs 2-4.
+MAX_DWELL_NODES = 32

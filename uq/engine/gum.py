@@ -113,7 +113,8 @@ def output_covariance(jacobian, input_set):
 def variance_budget(jacobian, input_set):
     """Each input's share c_k^2 u_k^2 summed over its elements; (n_inputs, *output_shape)."""
     u = input_set.standard_uncertainties()
-    share = (_columns(jacobian) * u[:, None]) ** 2
+    with np.errstate(over="ignore", invalid="ignore"):       # inf shares stay inf
+        share = (_columns(jacobian) * u[:, None]) ** 2
     columns = np.array(input_set.column_names())
     rows = [share[columns == name].sum(axis=0) for name in input_set.names]
     return np.array(rows).reshape((len(input_set.names),) + jacobian.shape[1:])

@@ -1,8 +1,11 @@
 """Input quantities of a propagation: distributions, shapes, correlation, draws.
 
 An input is a scipy.stats frozen distribution (one scalar), a float (a known constant,
-not sampled), or :class:`Input` (a distribution with a shape: that many independent,
-identically distributed scalars, e.g. one noise value per beam and range gate).
+not sampled), or :class:`Input` (a distribution with a shape: that many identically
+distributed scalars, e.g. one noise value per beam and range gate; independent, or with a
+correlation matrix between its elements, e.g. a Gauss-Markov process in time). A joint
+distribution such as :class:`UniformCircle` (a point uniform on a circle: the unit phase
+vector of a harmonic) draws its last axis together.
 
 Correlation between scalar inputs is imposed with a Gaussian copula: correlated standard
 normal scores ``z = L e`` (L the Cholesky factor of the correlation matrix) are mapped
@@ -24,12 +27,46 @@ class Input:
 
     Parameters
     ----------
-    distribution : scipy.stats frozen distribution or float
+    distribution : scipy.stats frozen distribution, joint distribution or float
     shape : tuple of int
+    correlation : ndarray, optional
+        Correlation matrix between the ``prod(shape)`` elements (C order), imposed with
+        the Gaussian copula like the correlation between inputs.
     """
 
     distribution: object
     shape: tuple = ()
+    correlation: object = None
+
+
+class UniformCircle:
+    """A point uniform on a circle of radius r: ``r (cos phi, sin phi)``, phi uniform on
+    [0, 2 pi). Its two coordinates are drawn together (the last axis of an
+    :class:`Input`'s shape must be 2). Each coordinate is arcsine-distributed with mean 0
+    and standard deviation r / sqrt(2); the two are uncorrelated (the GUM's view of it).
+
+    From two independent normal scores (z1, z2) the point is ``r z / |z|``: the angle of
+    a standard bivariate normal is uniform (its density is rotation invariant).
+    """
+
+    joint_size = 2
+
+    def __init__(self, radius=1.0):
+        self.radius = float(radius)
+
+    def mean(self):
+        return 0.0
+
+    def std(self):
+        return self.radius / np.sqrt(2.0)
+
+    def transform(self, scores):
+        """Points from normal scores, shape (..., 2) -> (..., 2)."""
+        norm = np.sqrt(np.sum(scores * scores, axis=-1, keepdims=True))
+        return self.radius * scores / norm
+
+    def __repr__(self):
+        return f"UniformCircle(radius={self.radius:g})"
 
 
 @dataclass(frozen=True)
@@ -98,9 +135,14 @@ class InputSet:
             start = self.offsets[name]
             size = int(np.prod(self.shapes[name]))
             columns = slice(start, start + size)
-            value = affine[:, columns] if _is_normal(self.distributions[name]) \
-                else _inverse_cdf(self.distributions[name], correlated[:, columns])
-            arrays[name] = value.reshape((len(scores),) + tuple(self.shapes[name]))
+            distribution = self.distributions[name]
+            shape = (len(scores),) + tuple(self.shapes[name])
+            if hasattr(distribution, "joint_size"):
+                arrays[name] = distribution.transform(correlated[:, columns].reshape(shape))
+                continue
+            value = affine[:, columns] if _is_normal(distribution) \
+                else _inverse_cdf(distribution, correlated[:, columns])
+            arrays[name] = value.reshape(shape)
         return arrays
 
     @functools.cached_property
@@ -124,28 +166,40 @@ def input_set(inputs, correlation=None):
     correlation : dict, optional
         ``{(name_a, name_b): rho}`` between scalar random inputs, -1 < rho < 1.
     """
-    shapes, distributions, constants = {}, {}, {}
+    shapes, distributions, constants, blocks = {}, {}, {}, {}
     for name, spec in inputs.items():
         distribution, shape = (spec.distribution, tuple(spec.shape)) if isinstance(spec, Input) \
             else (spec, ())
         if isinstance(distribution, (int, float, np.number)):
             constants[name] = float(distribution) if not shape else np.full(shape, float(distribution))
             continue
-        if not hasattr(distribution, "ppf"):
+        if not (hasattr(distribution, "ppf") or hasattr(distribution, "joint_size")):
             raise TypeError(f"input {name!r}: expected a scipy.stats frozen distribution or a "
                             f"float, got {type(distribution).__name__}")
+        if hasattr(distribution, "joint_size") and shape[-1:] != (distribution.joint_size,):
+            raise ValueError(f"input {name!r}: a joint distribution of "
+                             f"{distribution.joint_size} needs a shape ending in it")
         distributions[name], shapes[name] = distribution, shape
+        if isinstance(spec, Input) and spec.correlation is not None:
+            blocks[name] = np.asarray(spec.correlation, dtype=float)
     names = tuple(sorted(distributions))
     offsets, start = {}, 0
     for name in names:
         offsets[name] = start
         start += int(np.prod(shapes[name]))
-    cholesky = _cholesky(correlation or {}, names, shapes, offsets, start)
+    cholesky = _cholesky(correlation or {}, names, shapes, offsets, start, blocks)
     return InputSet(names, shapes, distributions, constants, offsets, start, cholesky)
 
 
-def _cholesky(correlation, names, shapes, offsets, dimension):
+def _cholesky(correlation, names, shapes, offsets, dimension, blocks=None):
     matrix = np.eye(dimension)
+    for name, block in (blocks or {}).items():
+        size = int(np.prod(shapes[name]))
+        if block.shape != (size, size) or not np.allclose(block, block.T) or \
+                not np.allclose(np.diag(block), 1.0):
+            raise ValueError(f"input {name!r}: its correlation must be a symmetric "
+                             f"{size} x {size} matrix with a unit diagonal")
+        matrix[offsets[name]:offsets[name] + size, offsets[name]:offsets[name] + size] = block
     for pair, rho in correlation.items():
         a, b = pair
         for name in (a, b):

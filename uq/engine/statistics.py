@@ -118,7 +118,8 @@ class Moments:
         delta = mean - self.mean
         weight = np.divide(count, total, out=np.zeros(self.shape), where=total > 0)
         self.mean = self.mean + delta * weight
-        self.m2 = self.m2 + m2 + delta**2 * self.count * weight
+        with np.errstate(over="ignore", invalid="ignore"):   # reported by propagate
+            self.m2 = self.m2 + m2 + delta**2 * self.count * weight
         self.count = total
 
     def variance(self):

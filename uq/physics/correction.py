@@ -19,6 +19,10 @@ Correction models (``model``):
 ``full``
     The full rotation applied to all three lidar-frame components, plus the ship
     velocity including heave: ``u = R A^+ v + (sog cos cog, sog sin cog, heave)``.
+``pointwise``
+    Each beam corrected with the INS attitude and velocity (lever arm included) read at
+    its own time stamp, then least squares (:func:`pointwise_wind`); needs the
+    time-resolved model (:mod:`uq.physics.timeresolved`).
 
 The vertical wind of ``none``, ``yaw`` and ``tilt2d`` is the lidar-frame vertical
 component (no heave or tilt correction); that of ``full`` is the corrected one.
@@ -50,7 +54,9 @@ import numpy as np
 
 from uq.physics.rotation import apply_matrix, attitude_matrix, rotation_about_vertical
 
-CORRECTION_MODELS = ("none", "yaw", "tilt2d", "full")
+CORRECTION_MODELS = ("none", "yaw", "tilt2d", "full", "pointwise")
+#: The models of a static scan (``pointwise`` needs the time-resolved model).
+STATIC_CORRECTION_MODELS = CORRECTION_MODELS[:4]
 
 
 def correction_rotation(model, heading, pitch, roll, nominal_heading):
@@ -146,6 +152,46 @@ def _horizontal_rotation(rotation, lidar_wind, ship_velocity):
         + ship_velocity[..., :2, None]
     vertical = np.broadcast_to(lidar_wind[..., 2:3, :], earth.shape[:-2] + (1, earth.shape[-1]))
     return np.concatenate([earth, vertical], axis=-2)
+
+
+def scan_wind(radial_velocity, model, operator, rotation, ship_velocity):
+    """Wind from one reading per scan given as a rotation (the model's, from
+    :func:`correction_rotation`, shape (..., 3, 3)) and the ship velocity the model
+    removes (:func:`removed_velocity`, shape (..., 3)); shape (..., 3, n_gates)."""
+    return _scan_correction(radial_velocity, model, operator, rotation, ship_velocity)
+
+
+def removed_velocity(model, velocity):
+    """The part of an INS velocity (..., 3) [m s-1] a correction model removes: none of
+    it (``none``), the horizontal (``yaw``, ``tilt2d``), all of it (``full``,
+    ``pointwise``); as :func:`correction_ship_velocity` does from sog, cog and heave."""
+    velocity = np.asarray(velocity)
+    if model == "none":
+        return 0 * velocity
+    if model in ("full", "pointwise"):
+        return velocity
+    return velocity * np.array([1.0, 1.0, 0.0])
+
+
+def pointwise_wind(radial_velocity, lidar_unit_vectors, rotation, ship_velocity):
+    """Least squares on point-wise corrected beams, each with its own reading (Matavar
+    2024, Sec. 3.2 [2]).
+
+    Parameters
+    ----------
+    radial_velocity : ndarray, shape (..., b, g) [m s-1]
+    lidar_unit_vectors : ndarray, shape (b, 3)
+        Configured beams in the lidar frame.
+    rotation : ndarray, shape (..., b, 3, 3)
+        Each beam's lidar-to-earth rotation as read.
+    ship_velocity : ndarray, shape (..., b, 3)
+        Each beam's lidar velocity as read [m s-1].
+
+    Returns
+    -------
+    ndarray, shape (..., 3, g)
+    """
+    return _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship_velocity)
 
 
 def _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship_velocity):

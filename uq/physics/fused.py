@@ -56,7 +56,8 @@ def applicable(scene, outputs, errors, scene_draws=False):
     :data:`FUSED_OUTPUTS`, real errors, one INS reading per scan (``scan``) and radial
     noise of shape (n, beams, gates) if any.
     """
-    if scene_draws or not set(outputs) <= set(FUSED_OUTPUTS) or \
+    if scene_draws or scene.time_resolved is not None or \
+            not set(outputs) <= set(FUSED_OUTPUTS) or \
             math.prod(scene.shape) > FUSED_MAX_SCENES:
         return False
     if any(np.iscomplexobj(value) for value in errors.values()):

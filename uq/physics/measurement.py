@@ -143,6 +143,9 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
         shape (n, *S, n_gates); ``radial_velocity`` [m s-1] (n, *S, n_beams, n_gates), the
         motion-corrected radial velocity along the beam the correction believes in.
     """
+    if scene.time_resolved is not None:       # motion within the scan: its own model
+        from uq.physics import timeresolved
+        return timeresolved.measurement_model(scene, outputs, scene_draws, **errors)
     if compiled and not scene_draws and set(outputs) <= set(COMPILED_OUTPUTS):
         from uq.physics import fused  # (numba: imported only where it may apply)
         if fused.applicable(scene, outputs, errors, scene_draws):

@@ -200,3 +200,103 @@ def apply_matrix(matrix, vectors):
     if vectors.shape[-1] == 1:
         return np.einsum("...ij,...jg->...ig", matrix, vectors)
     return np.matmul(matrix, vectors)
+
+
+def attitude_matrix_rate(heading, pitch, roll, heading_rate, pitch_rate, roll_rate):
+    """Time derivative of :func:`attitude_matrix` [rad s-1 -> (..., 3, 3) per s].
+
+    ``dR/dt = dR/dheading heading' + dR/dpitch pitch' + dR/droll roll'``, written out
+    from the same product; the velocity of a point fixed at ``x_ship`` in the ship frame
+    is ``(dR/dt) @ x_ship`` in the earth frame (the lever-arm velocity omega x r, without
+    forming omega in these left-handed triads). Complex-step safe.
+    """
+    ch, sh = np.cos(heading), np.sin(heading)
+    cp, sp = np.cos(pitch), np.sin(pitch)
+    cr, sr = np.cos(roll), np.sin(roll)
+    dh, dp, dr = heading_rate, pitch_rate, roll_rate
+    # d/dheading: ch -> -sh, sh -> ch
+    row0 = [-sh * cp * dh - ch * sp * dp,
+            (-sh * sp * sr - ch * cr) * dh + ch * cp * sr * dp + (ch * sp * cr + sh * sr) * dr,
+            (sh * sp * cr - ch * sr) * dh - ch * cp * cr * dp + (ch * sp * sr - sh * cr) * dr]
+    row1 = [ch * cp * dh - sh * sp * dp,
+            (ch * sp * sr - sh * cr) * dh + sh * cp * sr * dp + (sh * sp * cr - ch * sr) * dr,
+            (-ch * sp * cr - sh * sr) * dh - sh * cp * cr * dp + (sh * sp * sr + ch * cr) * dr]
+    row2 = [cp * dp, sp * sr * dp - cp * cr * dr, -sp * cr * dp - cp * sr * dr]
+    return _matrix([row0, row1, row2])
+
+
+def attitude_from_matrix_analytic(matrix):
+    """:func:`attitude_from_matrix` for complex-step arguments: (heading, pitch, roll)
+    [rad] with the first-order imaginary parts carried (no clipping; heading not
+    wrapped). Valid for |pitch| < 90 deg."""
+    from uq import complexstep
+    m = np.asarray(matrix)
+    pitch = np.arcsin(m[..., 2, 0])
+    heading = complexstep.arctan2(m[..., 1, 0], m[..., 0, 0])
+    roll = complexstep.arctan2(-m[..., 2, 1], m[..., 2, 2])
+    return heading, pitch, roll
+
+
+def interpolate_rotation(start, end, fraction):
+    """Rotation a `fraction` of the way from `start` to `end` on the rotation group
+    (spherical linear interpolation, slerp): ``start @ exp(fraction log(start^T end))``.
+
+    Parameters
+    ----------
+    start, end : ndarray, shape (..., 3, 3)
+    fraction : array_like, shape (...)
+        0 gives `start`, 1 gives `end`.
+
+    The rotation vector comes from the skew part of ``start^T end`` (angle below 90 deg
+    between INS samples, so arcsin is exact); the small-angle factors use their series,
+    so the interpolation is analytic (complex-step safe) down to equal rotations.
+    """
+    relative = np.swapaxes(start, -1, -2) @ end
+    skew = 0.5 * (relative - np.swapaxes(relative, -1, -2))
+    axis_sin = np.stack([skew[..., 2, 1], skew[..., 0, 2], skew[..., 1, 0]], axis=-1)
+    sin2 = np.sum(axis_sin * axis_sin, axis=-1)              # sin^2 theta
+    angle_over_sin = _angle_over_sin(sin2)                   # theta / sin theta
+    rotation_vector = axis_sin * angle_over_sin[..., None] * np.asarray(fraction)[..., None]
+    return start @ rotation_from_vector(rotation_vector)
+
+
+def rotation_from_vector(vector):
+    """Rodrigues: the rotation by |v| about v (v in the frame's own coordinates; the sense
+    is that of the skew matrix ``[v]_x``, consistent with :func:`interpolate_rotation`)."""
+    v = np.asarray(vector)
+    angle2 = np.sum(v * v, axis=-1)
+    a, b = _sin_over_angle(angle2), _one_minus_cos_over_angle2(angle2)
+    zero = np.zeros_like(v[..., 0])
+    k = _matrix([[zero, -v[..., 2], v[..., 1]], [v[..., 2], zero, -v[..., 0]],
+                 [-v[..., 1], v[..., 0], zero]])
+    eye = np.eye(3, dtype=k.dtype)
+    return eye + a[..., None, None] * k + b[..., None, None] * (k @ k)
+
+
+#: Squared angle [rad^2] below which the small-angle factors use their series: the first
+#: omitted terms are ~x^6/5040 = 2e-22 relative at x^2 = 1e-6, far below an ulp; the
+#: closed forms above it have no cancellation (1 - cos x is written 2 sin^2(x/2)).
+_SERIES_LIMIT = 1e-6
+
+
+def _series_or(closed, series, x2):
+    x2 = np.asarray(x2)
+    small = np.real(x2) < _SERIES_LIMIT
+    safe = np.where(small, _SERIES_LIMIT, x2)
+    return np.where(small, series(x2), closed(safe))
+
+
+def _angle_over_sin(sin2):
+    """theta / sin theta from sin^2 theta (theta < 90 deg)."""
+    return _series_or(lambda s2: np.arcsin(np.sqrt(s2)) / np.sqrt(s2),
+                      lambda s2: 1 + s2 / 6 + 3 * s2**2 / 40, sin2)
+
+
+def _sin_over_angle(x2):
+    return _series_or(lambda a2: np.sin(np.sqrt(a2)) / np.sqrt(a2),
+                      lambda a2: 1 - a2 / 6 + a2**2 / 120, x2)
+
+
+def _one_minus_cos_over_angle2(x2):
+    """(1 - cos x) / x^2 = (sin(x/2) / (x/2))^2 / 2, without cancellation."""
+    return 0.5 * _sin_over_angle(np.asarray(x2) / 4) ** 2

@@ -11,6 +11,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from uq.physics.beams import beam_unit_vectors
+from uq.physics.ins import InsSampling
+from uq.physics.motion import Motion
+from uq.physics.timing import ScanTiming
 
 SCENE_FIELDS = ("wind_speed", "wind_direction", "vertical_wind", "shear", "reference_height",
                 "sog", "cog", "heading", "pitch", "roll", "heave", "lidar_height",
@@ -52,6 +55,9 @@ class Scene:
     vertical_beam : bool
     correction : str
         One of :data:`uq.physics.correction.CORRECTION_MODELS`.
+    time_resolved : TimeResolved or None
+        Motion during the scan, scan timing and the INS as a sampled series; None is the
+        static model (every beam at the same instant and attitude).
     """
 
     wind_speed: float
@@ -72,6 +78,7 @@ class Scene:
     azimuths: tuple
     vertical_beam: bool
     correction: str
+    time_resolved: object = None
 
     @property
     def shape(self):
@@ -96,6 +103,23 @@ class Scene:
     def gate_heights(self):
         """Nominal measurement heights above sea level [m], shape (*S, n_gates)."""
         return self.field("lidar_height", 1) + np.asarray(self.ranges, dtype=float)
+
+
+@dataclass(frozen=True)
+class TimeResolved:
+    """What makes a scan time-resolved (see :mod:`uq.physics.timeresolved`).
+
+    Attributes
+    ----------
+    motion : uq.physics.motion.Motion
+        Harmonic components and the lever arm.
+    timing : uq.physics.timing.ScanTiming
+    ins : uq.physics.ins.InsSampling
+    """
+
+    motion: Motion = Motion()
+    timing: ScanTiming = ScanTiming()
+    ins: InsSampling = InsSampling()
 
 
 def sample_count(errors):

@@ -39,12 +39,13 @@ ERROR_DISTRIBUTIONS = {
 MIN_STUDENT_DOF = 2.0
 
 
-def validate_error(spec, key, check):
-    """Validated, normalised error specification (a dict with ``dist`` and ``mean``)."""
+def validate_error(spec, key, check, extra=()):
+    """Validated, normalised error specification (a dict with ``dist`` and ``mean``);
+    `extra` names further keys the caller validates (e.g. ``correlation_time``)."""
     check.mapping(spec, key)
     dist = check.choice(spec.get("dist"), f"{key}.dist", tuple(ERROR_DISTRIBUTIONS))
     parameters = ERROR_DISTRIBUTIONS[dist]
-    check.keys(spec, key, ("dist", "mean") + parameters)
+    check.keys(spec, key, ("dist", "mean") + parameters + tuple(extra))
     out = {"dist": dist, "mean": check.number(spec.get("mean", 0.0), f"{key}.mean")}
     for name in parameters:
         if name not in spec:

@@ -20,11 +20,17 @@ from uq.pipeline.scenario import DEFAULTS, Checker
 EXEMPLAR_OPTIONAL = {
     "ins": {"heading": {"dist": "normal", "u": 0.1}, "pitch": {"dist": "normal", "u": 0.05},
             "roll": {"dist": "normal", "u": 0.05}, "sog": {"dist": "normal", "u": 0.1},
-            "cog": {"dist": "normal", "u": 0.1}, "heave": {"dist": "normal", "u": 0.02}},
+            "cog": {"dist": "normal", "u": 0.1}, "heave": {"dist": "normal", "u": 0.02},
+            "rate": 10.0, "interpolation": "linear",
+            "clock_offset": {"dist": "normal", "u": 0.02}},
     "lidar": {"errors": {"half_cone": {"dist": "normal", "u": 0.1},
                          "misalignment": {"dist": "normal", "u": 0.3},
                          "radial_velocity": {"dist": "normal", "u": 0.05},
-                         "height": {"dist": "normal", "u": 0.2}}},
+                         "height": {"dist": "normal", "u": 0.2}},
+              "lever_arm": [0.0, 0.0, 2.0],
+              "scan": {}},
+    "motion": {dof: {"amplitude": 1.0, "period": 5.0, "phase": 0.0}
+               for dof in ("roll", "pitch", "yaw", "surge", "sway", "heave")},
     "sampling": {"chunk_size": 65536, "seed": 1},
     "fit": {"priors": {"shear": {"dist": "uniform", "low": -0.5, "high": 1.0},
                        "reference_speed": {"dist": "normal", "mean": 9.0, "u": 2.0}},
@@ -32,7 +38,8 @@ EXEMPLAR_OPTIONAL = {
                         "height_u": "height_u"}},
 }
 #: Keys checked only in the alternative form of a section (digits instead of n).
-EXEMPLAR_ALTERNATIVE = {"sampling": {"digits": 2, "stop_when_gum_valid": True}}
+EXEMPLAR_ALTERNATIVE = {"sampling": {"digits": 2, "stop_when_gum_valid": True},
+                        "ins": {"sog": {"dist": "normal", "u": 0.1, "correlation_time": 2.0}}}
 
 #: Dotted key (``*`` for any name) -> (unit, meaning). Keys of error distributions
 #: (``ins.heading`` ...) are described once, in the table of distributions.
@@ -80,7 +87,27 @@ MEANINGS = {
                             "number)"),
     "sampling.stop_when_gum_valid": ("", "stop a scene once clause 8 validates its GUM "
                                      "(with digits)"),
-    "outputs": ("", "quantities to report"),
+    "outputs": ("", "quantities to report (wind_speed_motion_ti: the motion-induced "
+                "turbulence-intensity increment, u of Vh from motion over Vh; needs motion)"),
+    "motion.<dof>.amplitude": ("deg or m", "amplitude of a harmonic motion of a degree of "
+                               "freedom, added to the static attitude: roll, pitch, yaw in "
+                               "deg (at most 45); surge, sway, heave in m"),
+    "motion.<dof>.period": ("s", "period of the harmonic"),
+    "motion.<dof>.phase": ("deg", "phase at the start of the scan (0: at the static "
+                           "attitude, moving positive), or random: uniform over the cycle, "
+                           "per trial (default)"),
+    "lidar.lever_arm": ("m", "(bow, starboard, up) from the INS to the lidar"),
+    "lidar.scan.beam_duration": ("s", "dwell per line of sight; beams in the order of "
+                                 "azimuths, then the vertical beam"),
+    "lidar.scan.timestamp": ("", "a beam's time stamp: start, mid or end of its dwell"),
+    "lidar.scan.dwell_average": ("", "radial velocity averaged over the dwell "
+                                 "(Gauss-Legendre quadrature)"),
+    "ins.rate": ("Hz", "INS sampling rate (absent: a continuous INS)"),
+    "ins.interpolation": ("", "reading between INS samples: nearest, or linear (the "
+                          "default; attitude on the rotation group); needs ins.rate"),
+    "ins.clock_offset": ("s", "INS clock minus lidar clock (a distribution)"),
+    "ins.*.correlation_time": ("s", "Gauss-Markov correlation time of an INS error "
+                               "between the beams (0: independent, .inf: one per scan)"),
     "fit.profile": ("", "wind-profile model of uq fit"),
     "fit.reference_height": ("m", "z_ref of the power law"),
     "fit.scatter": ("", "fit an extra scatter ln_sigma"),
@@ -201,11 +228,13 @@ def documented_keys(records):
     rows = {}
     for key, (kind, value, limits) in records.items():
         parent = key.rpartition(".")[0]
-        if parent in errors:
+        if parent in errors and not key.endswith(".correlation_time"):
             rows.setdefault(parent, ("distribution", None, {}))
             continue
         if key.startswith("fit.priors."):     # one row per prior key, any parameter
             key, value = "fit.priors.<parameter>." + key.rpartition(".")[2], None
+        if key.startswith("motion."):         # one row per harmonic key, any dof
+            key = "motion.<dof>." + key.rpartition(".")[2]
         if key == "outputs":
             kind = "list of choices"
         if kind.startswith("list of"):        # the default of the whole list

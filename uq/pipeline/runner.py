@@ -16,7 +16,9 @@ import xarray as xr
 
 from uq._version import __version__
 from uq.pipeline.distributions import error_distribution
-from uq.engine.inputs import Input
+from uq.engine.inputs import Input, UniformCircle
+from uq.physics.ins import gauss_markov_correlation
+from uq.pipeline import motionsection
 from uq.physics.measurement import ANGULAR_NAVIGATION, OUTPUTS, Scene, measurement_model, true_values
 from uq.pipeline.metadata import COORDINATES, QUANTITIES, variable_attributes
 from uq.engine.propagate import propagate
@@ -108,27 +110,70 @@ def scene_from_settings(settings):
         roll=rad(s["roll"]), heave=s["heave"],
         lidar_height=lid["height"], ranges=tuple(lid["ranges"]), half_cone=rad(lid["half_cone"]),
         misalignment=rad(lid["misalignment"]), azimuths=tuple(rad(lid["azimuths"])),
-        vertical_beam=lid["vertical_beam"], correction=settings["correction"])
+        vertical_beam=lid["vertical_beam"], correction=settings["correction"],
+        time_resolved=motionsection.time_resolved(settings))
 
 
 def error_inputs(settings, n_beams, n_gates):
-    """Engine inputs (name -> distribution, float or Input) of the declared errors."""
+    """Engine inputs (name -> distribution, float or Input) of the declared errors.
+
+    INS errors: one per scan (``scan``), one per beam (``beam``), or with a
+    ``correlation_time`` tau a Gauss-Markov process over the beams' time stamps
+    (correlation ``exp(-|t_k - t_l| / tau)``; tau = inf is one per scan). Time-resolved
+    scans add the unit phases of the random-phase motion components
+    (:class:`uq.engine.inputs.UniformCircle`), the clock offset and, for a sampled INS,
+    the offset of its samples (uniform over one period).
+    """
     inputs = {}
     beam_mode = settings["ins"]["correlation"] == "beam"
     for key in INS_KEYS:
         if key in settings["ins"]:
-            dist = error_distribution(settings["ins"][key])
-            inputs[f"ins_{key}"] = Input(dist, (n_beams,)) if beam_mode and not \
-                isinstance(dist, float) else dist
+            inputs[f"ins_{key}"] = _ins_input(settings, key, n_beams, beam_mode)
     for key, spec in settings["lidar"]["errors"].items():
         dist = error_distribution(spec)
         shaped = key == "radial_velocity" and not isinstance(dist, float)
         inputs[f"lidar_{key}"] = Input(dist, (n_beams, n_gates)) if shaped else dist
+    inputs.update(_motion_inputs(settings))
     return inputs
+
+
+def _ins_input(settings, key, n_beams, beam_mode):
+    spec = settings["ins"][key]
+    dist = error_distribution({k: v for k, v in spec.items() if k != "correlation_time"})
+    if isinstance(dist, float):
+        return dist
+    tau = spec.get("correlation_time")
+    if tau is None:
+        return Input(dist, (n_beams,)) if beam_mode else dist
+    if tau == np.inf:
+        return dist                                   # the limit: one error per scan
+    stamps = motionsection.beam_stamps(settings, n_beams)
+    return Input(dist, (n_beams,), correlation=gauss_markov_correlation(stamps, tau))
+
+
+def _motion_inputs(settings):
+    inputs = {}
+    random = motionsection.random_phase_count(settings)
+    if random:
+        inputs["motion_phases"] = Input(UniformCircle(1.0), (random, 2))
+    ins = settings["ins"]
+    if "clock_offset" in ins:
+        inputs["ins_clock_offset"] = error_distribution(ins["clock_offset"])
+    if "rate" in ins and motionsection.is_time_resolved(settings):
+        period = 1.0 / ins["rate"]
+        inputs["ins_sample_offset"] = error_distribution(
+            {"dist": "uniform", "half_width": period / 2, "mean": period / 2})
+    return inputs
+
+
+#: Budget labels of the inputs that are not scenario keys of their own.
+INPUT_LABELS = {"motion_phases": "motion (phases)", "ins_sample_offset": "ins.rate (sampling)"}
 
 
 def input_label(name):
     """Dotted scenario key of an engine input name (``ins_sog`` -> ``ins.sog``)."""
+    if name in INPUT_LABELS:
+        return INPUT_LABELS[name]
     section, key = name.split("_", 1)
     return f"ins.{key}" if section == "ins" else f"lidar.errors.{key}"
 
@@ -136,14 +181,61 @@ def input_label(name):
 def run_scene(scenario, scene, seed):
     """Results of a batch of scenes (dimension ``scene``) that share `scenario`'s structure."""
     settings = scenario.settings
-    outputs = scenario.outputs
+    outputs = model_outputs(scenario.outputs)
     n_gates = len(scene.ranges)
+    inputs = error_inputs(settings, scene.n_beams, n_gates)
+    engine = _propagate(scene, settings, outputs, inputs, seed)
+    dataset = _scene_dataset(scene, settings, outputs, engine)
+    if "wind_speed_motion_ti" in scenario.outputs:
+        dataset = dataset.assign(_motion_ti(scene, settings, inputs, seed, dataset))
+    return dataset
+
+
+def model_outputs(outputs):
+    """The per-trial outputs the model evaluates (derived ones need wind_speed)."""
+    model = [q for q in outputs if q in OUTPUTS]
+    if "wind_speed_motion_ti" in outputs and "wind_speed" not in model:
+        model.insert(0, "wind_speed")
+    return tuple(model)
+
+
+#: Inputs that are the motion itself (random phases and when the INS samples it).
+MOTION_INPUTS = ("motion_phases", "ins_sample_offset")
+
+
+def _motion_ti(scene, settings, inputs, seed, dataset):
+    """``wind_speed_motion_ti``: u of the scan's Vh from the motion alone (every other
+    error at its mean), over the true Vh; Monte Carlo with the run's seed and sampling,
+    and ``wind_speed_motion_ti_gum`` from the motion inputs' share of the GUM budget."""
+    motion_only = {name: spec if name in MOTION_INPUTS else _mean_of(spec)
+                   for name, spec in inputs.items()}
+    engine = _propagate(scene, settings, ("wind_speed",), motion_only, seed)
+    truth = dataset["wind_speed_true"].values
+    dims = dataset["wind_speed_true"].dims
+    budget = dataset["wind_speed_budget"]
+    labels = [input_label(name) for name in MOTION_INPUTS]
+    motion_variance = budget.sel(input=[i for i in budget["input"].values if i in labels]
+                                 ).sum("input").values
+    return {"wind_speed_motion_ti": (dims, engine["wind_speed_mc_u"].values / truth),
+            "wind_speed_motion_ti_gum": (dims, np.sqrt(motion_variance) / truth)}
+
+
+def _mean_of(spec):
+    """An input held at its mean (a float; the model broadcasts it)."""
+    distribution = spec.distribution if isinstance(spec, Input) else spec
+    if isinstance(distribution, float):
+        return distribution
+    return float(distribution.mean())
+
+
+def _propagate(scene, settings, outputs, inputs, seed):
     sampling = settings["sampling"]
+    n_gates = len(scene.ranges)
 
     def model(**errors):
         return measurement_model(scene, outputs, **errors)
 
-    engine = propagate(model, error_inputs(settings, scene.n_beams, n_gates),
+    return propagate(model, inputs,
                        n=sampling.get("n"), digits=sampling.get("digits"),
                        method=sampling["method"], seed=seed, circular=("wind_direction",),
                        output_dims={q: _dims(q) for q in OUTPUTS},
@@ -152,7 +244,6 @@ def run_scene(scenario, scene, seed):
                        stopping=sampling["stopping"],
                        stop_when_gum_valid=sampling["stop_when_gum_valid"],
                        covariance=profile_covariances(outputs, n_gates))
-    return _scene_dataset(scene, settings, outputs, engine)
 
 
 def profile_covariances(outputs, n_gates):
@@ -238,11 +329,24 @@ def _assemble(scenario, plan, results):
     return _annotate(dataset, scenario)
 
 
+#: Attributes of the derived outputs.
+DERIVED_ATTRIBUTES = {
+    "wind_speed_motion_ti": {"units": "1", "long_name": "motion-induced turbulence-intensity "
+                             "increment: Monte Carlo u of the horizontal wind speed from the "
+                             "platform motion alone, over the true speed"},
+    "wind_speed_motion_ti_gum": {"units": "1", "long_name": "motion-induced turbulence-"
+                                 "intensity increment from the motion inputs' share of the "
+                                 "GUM variance, over the true speed"},
+}
+
+
 def _annotate(ds, scenario):
     # attributes set on the Variables in place (ds[name] would build a DataArray each)
     for name in ds.data_vars:
         quantity = next((q for q in QUANTITIES if name.startswith(q + "_")), None)
-        if quantity:
+        if name in DERIVED_ATTRIBUTES:
+            ds.variables[name].attrs.update(DERIVED_ATTRIBUTES[name])
+        elif quantity:
             ds.variables[name].attrs.update(
                 variable_attributes(quantity, name[len(quantity) + 1:]))
     ds.variables["mc_n_samples"].attrs.update(units="1", long_name="Monte Carlo trials used")

@@ -27,6 +27,8 @@ from uq.physics.beams import beam_unit_vectors
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS, validate_error
 from uq.errors import ScenarioError
 from uq.pipeline.fitconfig import validate_fit
+from uq.pipeline.motionsection import (is_time_resolved, validate_ins_timing, validate_lever_arm,
+                                       validate_motion, validate_scan)
 from uq.physics.measurement import OUTPUTS
 from uq.engine.sampling import PROPAGATION_METHODS
 from uq.engine.statistics import INTERVALS
@@ -65,7 +67,14 @@ DEFAULTS = {
     "sweep": {},
     "outputs": ["wind_speed", "wind_direction", "vertical_wind"],
     "fit": {},
+    "motion": {},
 }
+#: Optional keys of a section that enter the settings only when given (so a scenario
+#: without them is today's, to the text of its ``scenario`` attribute).
+OPTIONAL_LIDAR_KEYS = ("lever_arm", "scan")
+OPTIONAL_INS_KEYS = ("rate", "interpolation", "clock_offset")
+#: Outputs derived from the results rather than evaluated per trial.
+DERIVED_OUTPUTS = ("wind_speed_motion_ti",)
 DEFAULT_SAMPLES = 100_000
 
 
@@ -220,13 +229,16 @@ def _validate(raw, source, check=None):
     }
     if raw.get("fit") is not None:                   # optional: settings of uq fit
         settings["fit"] = validate_fit(check, raw["fit"]).to_dict()
+    if raw.get("motion") is not None:                # optional: motion within the scan
+        settings["motion"] = validate_motion(check, raw["motion"])
+    _check_time_resolved(check, settings)
     return settings
 
 
-def _section(check, value, key):
+def _section(check, value, key, optional=()):
     value = {} if value is None else value
     check.mapping(value, key)
-    check.keys(value, key, DEFAULTS[key])
+    check.keys(value, key, tuple(DEFAULTS[key]) + tuple(optional))
     return {**copy.deepcopy(DEFAULTS[key]), **value}
 
 
@@ -253,17 +265,32 @@ def _ship(check, value):
 def _ins(check, value):
     value = {} if value is None else value
     check.mapping(value, "ins")
-    check.keys(value, "ins", ("correlation",) + INS_KEYS)
+    check.keys(value, "ins", ("correlation",) + INS_KEYS + OPTIONAL_INS_KEYS)
     out = {"correlation": check.choice(value.get("correlation", "scan"), "ins.correlation",
                                        INS_CORRELATIONS)}
     for key in INS_KEYS:
         if key in value:
-            out[key] = validate_error(value[key], f"ins.{key}", check)
+            out[key] = _ins_error(check, value[key], f"ins.{key}")
+    validate_ins_timing(check, value, out)
+    if "clock_offset" in value:
+        out["clock_offset"] = validate_error(value["clock_offset"], "ins.clock_offset", check)
+    return out
+
+
+def _ins_error(check, spec, key):
+    """An INS error, with an optional ``correlation_time`` [s] (>= 0, .inf allowed)."""
+    out = validate_error(spec, key, check, extra=("correlation_time",))
+    if "correlation_time" in spec:
+        value = spec["correlation_time"]
+        if isinstance(value, float) and value == math.inf:
+            out["correlation_time"] = math.inf
+        else:
+            out["correlation_time"] = check.number(value, f"{key}.correlation_time", low=0.0)
     return out
 
 
 def _lidar(check, value):
-    lid = _section(check, value, "lidar")
+    lid = _section(check, value, "lidar", OPTIONAL_LIDAR_KEYS)
     check.length(lid["ranges"], "lidar.ranges", MAX_GATES)
     check.length(lid["azimuths"], "lidar.azimuths", MAX_BEAMS)
     out = {"height": check.number(lid["height"], "lidar.height", low=0.0),
@@ -286,7 +313,29 @@ def _lidar(check, value):
     check.keys(errors, "lidar.errors", LIDAR_ERROR_KEYS)
     out["errors"] = {key: validate_error(errors[key], f"lidar.errors.{key}", check)
                      for key in LIDAR_ERROR_KEYS if key in errors}
+    if "lever_arm" in lid:
+        out["lever_arm"] = validate_lever_arm(check, lid["lever_arm"])
+    if "scan" in lid:
+        out["scan"] = validate_scan(check, lid["scan"])
     return out
+
+
+def _check_time_resolved(check, settings):
+    """Keys that only mean something together."""
+    ins = settings["ins"]
+    if "interpolation" in ins and "rate" not in ins:
+        check.fail("ins.interpolation", "needs ins.rate (a continuous INS is not "
+                   "interpolated); allowed: give ins.rate in Hz")
+    per_beam = ins["correlation"] == "beam" or any(
+        isinstance(spec, dict) and "correlation_time" in spec for spec in ins.values())
+    if per_beam and is_time_resolved(settings) and settings["correction"] != "pointwise":
+        check.fail("correction", f"{settings['correction']!r} reads the INS once per scan "
+                   "in a time-resolved scan, so its errors cannot differ between beams; "
+                   "allowed: pointwise (a reading per beam), or ins.correlation: scan "
+                   "without correlation_time")
+    if DERIVED_OUTPUTS[0] in settings["outputs"] and not settings.get("motion"):
+        check.fail("outputs", f"{DERIVED_OUTPUTS[0]} needs a motion section; allowed: the "
+                   "other outputs")
 
 
 def _check_beams_determine_wind(check, lidar):
@@ -337,7 +386,7 @@ def _sampling(check, value):
 def _outputs(check, value):
     items = check.list(value, "outputs")
     for item in items:
-        check.choice(item, "outputs", OUTPUTS)
+        check.choice(item, "outputs", OUTPUTS + DERIVED_OUTPUTS)
     check.unique(items, "outputs")
     if not items:
         raise ScenarioError(check.source, "outputs", f"empty; allowed: any of {', '.join(OUTPUTS)}")
