@@ -16,7 +16,8 @@ Inputs (:func:`profile_from_results`, :func:`profile_from_table`):
   optional standard uncertainties of speed and height.
 
 Each fit gives the posterior summary (median, 68 % and 95 % central credible
-intervals), the posterior predictive band, the least-squares (``curve_fit``) estimate
+intervals, each with its Monte Carlo standard error ``posterior_<key>_mcse``), the
+posterior predictive band, the least-squares (``curve_fit``) estimate
 with its delta-method intervals beside it, and the chains.
 
 References
@@ -111,9 +112,12 @@ def _fit_dataset(data, posterior, chains, least, grid):
     summary = posterior_summary(chains["samples"], names)
     bands = predictive_bands(posterior, chains["samples"], grid)
     k = len(posterior.names)
+    summaries = {f"posterior_{key}": ("parameter", [summary[n][key] for n in names])
+                 for key in SUMMARY_KEYS}
+    summaries.update({f"posterior_{key}_mcse": ("parameter", chains["quantile_mcse"][key])
+                      for key in SUMMARY_KEYS})
     ds = xr.Dataset(
-        {f"posterior_{key}": ("parameter", [summary[n][key] for n in names])
-         for key in SUMMARY_KEYS},
+        summaries,
         coords={"parameter": names, "point": np.arange(grid.size),
                 "gate": np.arange(data.heights.size)})
     ds["grid_height"] = ("point", grid)
@@ -183,9 +187,15 @@ def true_parameters(scenario_settings, config):
 
 
 def combine_fits(fits, truth=None):
-    """Fits by name -> one Dataset with dimension ``fit`` (chains padded with NaN)."""
+    """Fits by name -> one Dataset with dimension ``fit``.
+
+    The fits' chains may have different lengths (each ensemble runs until it has
+    converged): the shorter ones are padded with NaN at the end of ``step``, which
+    becomes an index coordinate (0, 1, ...) so that the fits align on it.
+    """
     steps = max(ds.sizes["step"] for ds in fits.values())
-    padded = [ds.reindex(step=np.arange(steps)) for ds in fits.values()]
+    padded = [ds.assign_coords(step=np.arange(ds.sizes["step"])).reindex(step=np.arange(steps))
+              for ds in fits.values()]
     combined = xr.concat(padded, dim="fit", combine_attrs="drop_conflicts")
     combined = combined.assign_coords(fit=list(fits))
     combined["burn"] = ("fit", [ds.attrs["burn"] for ds in fits.values()])
