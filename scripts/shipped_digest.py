@@ -10,7 +10,8 @@ configurations); the digest is a SHA-256 of every variable's and coordinate's by
 of the attributes that are not timings. Bit-identical results give identical digests.
 
 ``--values-only`` digests each variable's values alone (as float64 where numeric, so a
-boolean stored as a 0/1 flag byte has the digest of the boolean), without its attributes
+boolean stored as a 0/1 flag byte has the digest of the boolean; strings as Python
+strings, however they are stored), without its attributes
 and the global ones: a change of metadata (CF attributes, coordinates' encoding) then
 shows no difference, a change of any number does. Variables that are new in the later
 version are listed but do not count as differences.
@@ -52,6 +53,8 @@ def values_digest(dataset):
         values = np.ascontiguousarray(dataset.variables[name].values)
         if values.dtype.kind in "biuf":
             values = values.astype(np.float64)
+        elif values.dtype.kind in "US":         # strings stored as characters: as objects
+            values = values.astype(object)
         h = hashlib.sha256(f"{values.shape}".encode())
         h.update(values.tobytes() if values.dtype != object else repr(values.tolist()).encode())
         out[name] = h.hexdigest()[:16]

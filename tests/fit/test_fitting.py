@@ -216,3 +216,13 @@ def test_corner_plot_shows_the_bulk_and_leaks_no_warning(caplog):
         assert len(counts) >= 15 and counts.max() < 0.25 * counts.sum(), ax.get_title()
         extent = ax.title.get_window_extent()
         assert box.x0 <= extent.x0 and extent.x1 <= box.x1, ax.get_title()
+
+
+def test_fit_file_passes_the_cf_checker(results, fitted, cf_compliance):
+    """Issue 16: the file of `uq fit` has Conventions, a title and history, and a long
+    name for every variable (units where one unit fits; the parameters' units beside
+    them), and passes compliance-checker CF 1.10."""
+    cf_compliance(results.with_name("profile_fit.nc"))
+    assert fitted.attrs["Conventions"] == "CF-1.10" and "uq fit" in fitted.attrs["history"]
+    assert all("long_name" in fitted[name].attrs for name in fitted.variables)
+    assert list(fitted["parameter_units"].values) == ["m s-1", "1"]

@@ -110,3 +110,12 @@ def test_bad_config_exits_2_and_writes_nothing(tmp_path, capsys):
     assert err.startswith("uq: error: ") and "golden.synthetic.lidars" in err
     assert len(err.strip().splitlines()) == 1
     assert not (tmp_path / "out").exists() and not list(tmp_path.glob(".*partial"))
+
+
+def test_golden_file_passes_the_cf_checker(campaign, cf_compliance):
+    """Issue 16: the campaign's netCDF file passes compliance-checker CF 1.10; its flags
+    (bins with enough records, significant slopes) are CF flag variables."""
+    folder, ds = campaign
+    cf_compliance(folder / "golden_campaign.nc")
+    assert ds["sufficient"].dtype == bool and ds["sufficient"].attrs["flag_meanings"]
+    assert ds.attrs["title"] and "uq golden" in ds.attrs["history"]

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import xarray as xr
 
 import uq
 from uq.physics.rotation import attitude_matrix, rubio2022_angles_from_attitude, rubio2022_rotation
@@ -285,3 +286,35 @@ def test_beam_mode_case_ii_paper_is_not_the_physical_gum_under_tilt():
     level = beam_mode_scene("rubio2022_tilt", **{**values, "ship.pitch": 0.0, "ship.roll": 0.0})
     assert float(level.wind_speed_paper_u) == pytest.approx(float(level.wind_speed_gum_u),
                                                             rel=FIRST_ORDER)
+
+
+def test_results_files_pass_the_cf_checker(tmp_path, cf_compliance):
+    """Issue 16: a single scene with range gates, a vertical beam and covariances, and a
+    sweep of two keys with a linked key and a swept error size, written by `uq run`,
+    pass compliance-checker CF 1.10 (and the checks of the cf_compliance fixture); the
+    swept coordinates have units, booleans are flags, the interval's ends are linked to
+    the mean, the beams are numbered with their azimuth beside them."""
+    from uq.cli import main
+    scene, sweep = tmp_path / "scene.nc", tmp_path / "sweep.nc"
+    assert main(["run", str(ROOT / "scenarios" / "floating_lidar_full.yaml"), "-o", str(scene),
+                 "--quiet", "--set", "sampling.n=2000"]) == 0
+    assert main(["run", str(ROOT / "scenarios" / "rubio2022_case_i.yaml"), "-o", str(sweep),
+                 "--quiet", "--set", "sampling.n=2000", "--set", "outputs=[wind_speed]",
+                 "--set", "sweep={wind.direction: [0, 90], ship.cog: [0, 90], "
+                 "ship.heading: {same_as: ship.cog}, ins.sog.u: [0.05, 0.1]}"]) == 0
+    for path in (scene, sweep):
+        cf_compliance(path)
+    with xr.open_dataset(scene) as ds:
+        np.testing.assert_array_equal(ds["beam"], [0, 1, 2, 3, 4])
+        np.testing.assert_array_equal(ds["beam_azimuth"], [0.0, 90.0, 180.0, 270.0, np.nan])
+        np.testing.assert_array_equal(ds["beam_vertical"], [False] * 4 + [True])
+        assert ds["wind_speed_gum_valid"].dtype == bool
+        assert ds["wind_speed_gum_valid"].attrs["flag_meanings"] == "not_validated validated"
+        assert set(ds["wind_speed_mc_mean"].attrs["ancillary_variables"].split()) >= {
+            "wind_speed_mc_low", "wind_speed_mc_high", "wind_speed_mc_u"}
+        assert "uq run" in ds.attrs["history"]
+    with xr.open_dataset(sweep) as ds:
+        units = {name: ds[name].attrs.get("units") for name in
+                 ("wind_direction", "ship_cog", "ship_heading", "ins_sog_u")}
+        assert units == {"wind_direction": "degree", "ship_cog": "degree",
+                         "ship_heading": "degree", "ins_sog_u": "m s-1"}

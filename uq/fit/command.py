@@ -14,6 +14,7 @@ from uq.errors import ScenarioError
 from uq.fit.fitting import (combine_fits, fit_profile, profile_from_results, profile_from_table,
                       true_parameters)
 from uq.files import save_figure, write_netcdf
+from uq.pipeline.metadata import history
 from uq.pipeline.results import open_results
 from uq.pipeline.scenario import assign_dotted, load_fit_settings
 
@@ -89,7 +90,8 @@ def _fit_input(path, results, scenario, config):
         fits = {kind: fit_profile(profile_from_results(results, kind, str(path)), config)
                 for kind in ("propagated", "naive")}
         dataset = combine_fits(fits, true_parameters(scenario, config))
-    dataset.attrs.update(source=str(path), fit_settings=yaml.safe_dump(config.to_dict()))
+    dataset.attrs.update(source=str(path), fit_settings=yaml.safe_dump(config.to_dict()),
+                         history=history(f"uq fit {path}"))
     return dataset
 
 

@@ -151,7 +151,7 @@ def fig5_radial_against_direction(dataset):
                 for model in models:
                     ax.plot(level["wind_direction"], level[f"radial_velocity_{model}"].sel(
                         {tilt: angle, "beam": beam}), MODELS[model][1], color=colour)
-            ax.set_title(f"beam {BEAM_NAMES.get(float(beam), beam)}, {tilt.split('_')[1]} "
+            ax.set_title(f"beam {beam_name(dataset, beam)}, {tilt.split('_')[1]} "
                          f"({other.split('_')[1]} 0)", fontsize=9)
             ax.grid(alpha=0.3)
             if row == 1:
@@ -163,6 +163,17 @@ def fig5_radial_against_direction(dataset):
     styles = [Line2D([], [], color="k", ls=MODELS[m][1], label=MODELS[m][0]) for m in models]
     figure.legend(handles=styles, fontsize=7, loc="outside lower center", ncols=len(styles))
     return figure
+
+
+def beam_name(dataset, beam):
+    """N, E, S, W for the paper's beams (by azimuth), else the azimuth or "vertical"."""
+    if "beam_azimuth" not in dataset.coords:                 # results of uq < 0.2
+        azimuth = float(beam)
+    else:
+        azimuth = float(dataset["beam_azimuth"].sel(beam=beam))
+    if np.isnan(azimuth):
+        return "vertical"
+    return BEAM_NAMES.get(azimuth, f"{azimuth:g} deg")
 
 
 def fig6_tilt_maps(dataset):
