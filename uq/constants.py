@@ -143,3 +143,10 @@ FUSED_BLOCK_TRIALS = 2**12
 #: (:mod:`uq.engine.orderstats`): its sort costs ~20 us; the brackets it gives hold ~1 % of
 #: the values around each wanted rank. [1] Floyd and Rivest (1975), sample selection.
 ORDER_SAMPLE = 1024
+
+#: Size [the output's unit: m s-1 or deg] under which a figure or a report takes a
+#: deterministic number (an uncertainty, the correction's systematic error) for zero: far
+#: above the rounding of the model's double arithmetic (values of ~10 m s-1 carry errors
+#: of ~1e-15, ~1e-13 after a few dozen operations; a vanishing u comes out at ~1e-29) and
+#: far below anything a lidar resolves (~1e-2 m s-1) or a report prints (4 digits of u).
+NUMERICAL_ZERO = 1e-9
