@@ -119,7 +119,7 @@ def test_bayesian_credible_intervals_cover_at_95_percent():
         assert binomtest(int(count), trials, 0.95).pvalue > 0.001, hits
 
 
-def test_csv_input_with_scatter(tmp_path):
+def test_csv_input_with_scatter(tmp_path, capfd):
     """10-min-like records at 4 heights: speed = power law + N(0, 0.4) per record; the
     fitted scatter's 95 % interval holds 0.4 and the shear's holds the truth."""
     rng = np.random.default_rng(3)
@@ -132,6 +132,7 @@ def test_csv_input_with_scatter(tmp_path):
     config = tmp_path / "fit.yaml"
     config.write_text("fit: {columns: {height: z, speed: ws}, ensembles: 2}\n")
     assert main(["fit", str(path), "-c", str(config)]) == 0
+    assert "WARNING" not in capfd.readouterr().err          # nothing leaks (issue 16)
     ds = xr.open_dataset(tmp_path / "mast_fit.nc").load()
     assert ds.attrs["rows_dropped_not_finite"] == 1
     row = ds.sel(fit="data")

@@ -146,3 +146,11 @@ def test_shared_colour_scale_only_where_every_panel_shows_its_variation():
     # the paper's 6 % effect beside a model 40 % higher: one scale would flatten both
     assert not shared_scale([np.array([1.0, 1.06]), np.array([1.4, 1.48])])
     assert shared_scale([np.zeros(3), np.zeros(3)])
+
+
+def test_report_of_many_dimensions_says_how_to_get_figures(sweeps):
+    from uq.outputs.report import render_report
+    page = render_report(sweeps[4])
+    assert "--select" in page.split("<h2>Figures</h2>")[1] and "<img" not in page
+    page = render_report(sweeps[4], select={"ship_sog": 4, "wind_speed": 8})
+    assert page.count("<img") == 2

@@ -270,6 +270,8 @@ def _velocity_ratio_findings(dataset):
         lines = {ratio: velocity_ratio_line(dataset, f"wind_speed_{model}", ratio)
                  for ratio in VELOCITY_RATIOS}
         common = np.intersect1d(lines[0.5][0], lines[2.0][0])
+        if common.size == 0:            # no swept Vh whose sog reaches VR = 2: not testable
+            continue
         pick = lambda r: lines[r][1][np.isin(lines[r][0], common)]   # noqa: E731
         ordered = np.all(pick(0.5) <= pick(1.0)) and np.all(pick(1.0) <= pick(2.0))
         gain = float(np.mean(pick(2.0) / pick(0.5) - 1))
@@ -282,6 +284,8 @@ def _velocity_ratio_findings(dataset):
 
 def _tilt_findings(dataset):
     rows = []
+    if not (np.isin(0.0, dataset["ship_pitch"].values) and np.isin(0.0, dataset["ship_roll"].values)):
+        return rows                     # no level ship on the grid to compare with
     for quantity in ("wind_speed", "wind_direction"):
         for model in models(dataset, quantity):
             grid = mean_over(dataset, f"{quantity}_{model}", ("ship_pitch", "ship_roll"))

@@ -19,7 +19,8 @@ import numpy as np
 from uq.constants import NUMERICAL_ZERO
 from uq.files import SIGNATURE, write_text
 from uq.outputs import planning
-from uq.outputs.figures import caption, figure_plan, sweep_dimensions
+from uq.outputs.figures import (caption, figure_plan, no_figure_reason, select_scenes,
+                                sweep_dimensions)
 from uq.outputs.labels import KEY_WORDS
 
 QUANTITY_UNITS = {"wind_speed": "m/s", "wind_direction": "deg", "vertical_wind": "m/s"}
@@ -35,20 +36,22 @@ figure{margin:1em 0}figcaption{font-size:90%;color:#444;max-width:900px}
 summary{cursor:pointer;font-weight:bold}"""
 
 
-def write_report(dataset, path, source="", targets=planning.DEFAULT_TARGETS):
+def write_report(dataset, path, source="", targets=planning.DEFAULT_TARGETS, select=None):
     """Write the report of `dataset` to `path` (HTML); returns the path."""
-    page = render_report(dataset, source=source, targets=targets)
+    page = render_report(dataset, source=source, targets=targets, select=select)
     return write_text(path, page)
 
 
-def render_report(dataset, source="", targets=planning.DEFAULT_TARGETS):
-    """The report as one HTML string."""
+def render_report(dataset, source="", targets=planning.DEFAULT_TARGETS, select=None):
+    """The report as one HTML string. `select` (``{dim: value}``) picks the scenes the
+    figures show (:func:`uq.outputs.figures.select_scenes`); the tables cover them all."""
     name = dataset.attrs.get("title", "uq results")
     parts = [f"<!DOCTYPE html><!-- {SIGNATURE} --><html><head><meta charset='utf-8'>"
              f"<title>{_e(name)}</title>"
              f"<style>{STYLE}</style></head><body><h1>{_e(name)}</h1>",
              _run_table(dataset, source), _answers(dataset, targets), _findings(dataset),
-             _summary_tables(dataset), _figures(dataset), _scenario(dataset),
+             _summary_tables(dataset), _figures(select_scenes(dataset, select)),
+             _scenario(dataset),
              "</body></html>"]
     return "\n".join(parts)
 
@@ -250,6 +253,9 @@ def _number(value):
 
 def _figures(dataset):
     out = ["<h2>Figures</h2>"]
+    reason = no_figure_reason(dataset)
+    if reason:
+        out.append(f"<p>{_e(reason)}.</p>")
     for name, function in figure_plan(dataset):
         figure = function(dataset)
         buffer = io.BytesIO()
