@@ -154,3 +154,10 @@ def test_report_of_many_dimensions_says_how_to_get_figures(sweeps):
     assert "--select" in page.split("<h2>Figures</h2>")[1] and "<img" not in page
     page = render_report(sweeps[4], select={"ship_sog": 4, "wind_speed": 8})
     assert page.count("<img") == 2
+
+
+def test_flat_panels_do_not_force_a_scale_each():
+    """A panel flat to rounding has no variation to show: it does not count (two flat
+    models that differ share one scale, so their difference shows)."""
+    assert shared_scale([np.full(4, 0.0707), np.full(4, 0.1)])
+    assert not shared_scale([np.full(4, 0.0707), np.array([0.1, 0.1001])])

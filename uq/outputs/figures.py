@@ -318,7 +318,8 @@ CAPTIONS = {
     "the paper's model (dashed), the physical GUM (line) and Monte Carlo (points).",
     "uncertainty_against_sweep": "u of each model against the swept value.",
     "maps_": "u over the two swept keys, one column per model (one colour scale, or one "
-    "per panel where a common one would hide a panel's variation).",
+    "per panel where a common one would hide a panel's variation); white: outside the "
+    "model (the paper's model covers only its own cases).",
     "budget": "Each input's contribution to the GUM uncertainty, |c_i| u_i, in the "
     "output's units; the dashed line is the combined u (the bars add in quadrature). The "
     "longest bar is the input to improve first.",

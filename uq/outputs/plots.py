@@ -21,7 +21,7 @@ import numpy as np  # noqa: E402
 from matplotlib.ticker import NullFormatter  # noqa: E402
 from scipy.stats import norm  # noqa: E402
 
-from uq.constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG  # noqa: E402
+from uq.constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, NUMERICAL_ZERO  # noqa: E402
 from uq.outputs.labels import (QUANTITIES, SWEEP_QUANTITIES, coordinate_label,  # noqa: E402
                                model_style, quantity_label)
 from uq.outputs.planning import models as available_models  # noqa: E402
@@ -124,10 +124,13 @@ def middle_gate(dataset):
 
 
 def shared_scale(panels):
-    """Do the panels (arrays) share one colour scale (see SHARED_SCALE_FRACTION)?"""
+    """Do the panels (arrays) share one colour scale (see SHARED_SCALE_FRACTION)? Panels
+    that are flat (to NUMERICAL_ZERO) have no variation to show and do not count: if all
+    are, one scale shows how they differ."""
     ranges = [float(np.nanmax(p) - np.nanmin(p)) for p in panels]
     common = max(float(np.nanmax(p)) for p in panels) - min(float(np.nanmin(p)) for p in panels)
-    return common == 0 or min(ranges) >= SHARED_SCALE_FRACTION * common
+    varied = [r for r in ranges if r > NUMERICAL_ZERO]
+    return not varied or min(varied) >= SHARED_SCALE_FRACTION * common
 
 
 def plot_budget(dataset):
@@ -304,9 +307,12 @@ def plot_maps(dataset, quantity, x, y, facet=None):
     for i, (row, value) in enumerate(zip(panels, rows)):
         for j, (panel, model) in enumerate(zip(row, models)):
             ax = axes[i, j]
-            mesh = ax.pcolormesh(at[x].values, at[y].values, panel.transpose(y, x).values,
-                                 shading="nearest", cmap="viridis",
+            mesh = ax.pcolormesh(_positions(at[x]), _positions(at[y]),
+                                 panel.transpose(y, x).values, shading="nearest",
+                                 cmap="viridis",
                                  **({"vmin": limits[0], "vmax": limits[1]} if shared else {}))
+            _name_ticks(ax.xaxis, at[x])
+            _name_ticks(ax.yaxis, at[y])
             if not shared:
                 figure.colorbar(mesh, ax=ax, label=quantity_label(quantity))
             title = model_style(model)["label"]
@@ -323,3 +329,18 @@ def plot_maps(dataset, quantity, x, y, facet=None):
     figure.suptitle(f"u({QUANTITIES[quantity][0]}), {scale}"
                     + (f", {gate_text}" if gate_text else ""), fontsize=10)
     return figure
+
+
+def _positions(coordinate):
+    """Positions of a coordinate's values on an axis: the numbers, or 0, 1, ... for texts
+    and flags (named by :func:`_name_ticks`)."""
+    values = coordinate.values
+    return values if values.dtype.kind in "iuf" else np.arange(values.size)
+
+
+def _name_ticks(axis, coordinate):
+    """Ticks named by the values of a text or flag coordinate."""
+    values = coordinate.values
+    if values.dtype.kind not in "iuf":
+        axis.set_ticks(np.arange(values.size), [str(v).lower() if values.dtype == bool
+                                               else str(v) for v in values])
