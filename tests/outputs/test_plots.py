@@ -161,3 +161,13 @@ def test_flat_panels_do_not_force_a_scale_each():
     models that differ share one scale, so their difference shows)."""
     assert shared_scale([np.full(4, 0.0707), np.full(4, 0.1)])
     assert not shared_scale([np.full(4, 0.0707), np.array([0.1, 0.1001])])
+
+
+def test_monte_carlo_error_bars_fall_back_to_the_normal_standard_error(sweeps):
+    """2000 trials make no two batches of 2^14: the stored standard error of u is NaN and
+    the error bars use that of the standard deviation of N normal draws, u/sqrt(2(N-1))."""
+    from uq.outputs.plots import u_standard_error
+    ds = sweeps[1]
+    assert np.isnan(ds["wind_speed_mc_u_standard_error"]).all()
+    np.testing.assert_allclose(u_standard_error(ds, "wind_speed"),
+                               ds["wind_speed_mc_u"] / np.sqrt(2 * (2000 - 1)), rtol=1e-15)

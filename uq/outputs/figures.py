@@ -316,7 +316,10 @@ CAPTIONS = {
     "fig7_half_cone": "u against the half-cone angle, averaged over wind direction.",
     "uncertainty_against_direction": "u(Vh) and u(wind direction) against wind direction: "
     "the paper's model (dashed), the physical GUM (line) and Monte Carlo (points).",
-    "uncertainty_against_sweep": "u of each model against the swept value.",
+    "uncertainty_against_sweep": "u of each model against the swept value; Monte Carlo "
+    "with two standard errors of u (from independent batches, or u/sqrt(2(N-1)) for runs "
+    "of fewer than two batches), so that its difference from the GUM can be told from "
+    "sampling noise.",
     "maps_": "u over the two swept keys, one column per model (one colour scale, or one "
     "per panel where a common one would hide a panel's variation); white: outside the "
     "model (the paper's model covers only its own cases).",
@@ -324,7 +327,8 @@ CAPTIONS = {
     "output's units; the dashed line is the combined u (the bars add in quadrature). The "
     "longest bar is the input to improve first.",
     "uncertainty_against_gate": "u of each model against the range gate; Monte Carlo with "
-    "two standard errors of u.",
+    "two standard errors of u (from independent batches, or u/sqrt(2(N-1)) for runs of "
+    "fewer than two batches).",
     "histogram": "The Monte Carlo trials against the GUM's Gaussian, with both 95 % "
     "intervals (JCGM 101, clause 8): where the dashed and solid lines part by more than "
     "delta, the GUM interval is not validated.",

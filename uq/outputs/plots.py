@@ -182,15 +182,24 @@ def plot_against_gate(dataset):
         for model in available_models(dataset, quantity):
             values = dataset[f"{quantity}_{model}"].values
             ax.plot(values, gates, **model_style(model))
-            error = f"{quantity}_mc_u_standard_error"
-            if model == "mc_u" and error in dataset:
-                ax.errorbar(values, gates, xerr=2 * dataset[error].values, fmt="none",
-                            ecolor="k", elinewidth=0.8, zorder=4)
+            if model == "mc_u":
+                ax.errorbar(values, gates, xerr=2 * u_standard_error(dataset, quantity),
+                            fmt="none", ecolor="k", elinewidth=0.8, zorder=4)
         ax.set_xlabel(quantity_label(quantity))
         ax.grid(alpha=0.3)
     axes[0, 0].set_ylabel(coordinate_label(dataset, "range"))
     axes[0, 0].legend(fontsize=7)
     return figure
+
+
+def u_standard_error(dataset, quantity):
+    """Standard error of the Monte Carlo u: the run's own, from independent batches
+    (``q_mc_u_standard_error``), or, where it has fewer than two batches (NaN), that of
+    the standard deviation of N normal draws, u / sqrt(2 (N - 1))."""
+    u = dataset[f"{quantity}_mc_u"]
+    normal = u / np.sqrt(2 * (dataset["mc_n_samples"] - 1))
+    stored = dataset.get(f"{quantity}_mc_u_standard_error")
+    return (normal if stored is None else stored.fillna(normal)).values
 
 
 def plot_histogram(dataset, trials):
@@ -265,7 +274,8 @@ def _validation_text(at, quantity, d_low, d_high):
 
 def plot_against_sweep(dataset, dim=None):
     """Any 1-D sweep: u of each model against the swept value, one panel per output;
-    with range gates, a colour per shown gate (model by line style and marker)."""
+    with range gates, a colour per shown gate (model by line style and marker); Monte
+    Carlo with +-2 standard errors of u."""
     dim = dim or dataset["mc_n_samples"].dims[0]
     quantities = sweep_quantities(dataset)
     figure, axes = plt.subplots(1, len(quantities), figsize=(4.5 * len(quantities), 3.6),
@@ -277,10 +287,15 @@ def plot_against_sweep(dataset, dim=None):
             at = dataset.isel(range=gate) if "range" in dataset.dims else dataset
             for model in available_models(dataset, quantity):
                 style = model_style(model)
+                style.setdefault("marker", ".")          # a value alone still shows
                 if len(gates) > 1:
                     style.update(color=f"C{k}", label=f"{style['label']}, "
                                  f"{_gate_text(dataset, gate)}")
                 ax.plot(x, at[f"{quantity}_{model}"].values, **style)
+                if model == "mc_u":                     # +-2 standard errors of u
+                    ax.errorbar(x, at[f"{quantity}_mc_u"].values,
+                                yerr=2 * u_standard_error(at, quantity), fmt="none",
+                                ecolor=style["color"], elinewidth=0.7, zorder=4)
         ax.set_xlabel(coordinate_label(dataset, dim))
         ax.set_ylabel(quantity_label(quantity))
         ax.grid(alpha=0.3)
