@@ -301,8 +301,9 @@ def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=20
         start = _starting_ball(space, space.to_sampled(centre), ball, walkers)
         states.append(emcee.State(start, random_state=np.random.RandomState(
             np.random.MT19937(stream)).get_state()))
-        samplers.append(emcee.EnsembleSampler(walkers, centre.size, space.log_probability,
-                                              vectorize=True))
+        target = space.log_probability if space.logarithmic.any() else \
+            posterior.log_probability                   # nothing to transform: no wrapper
+        samplers.append(emcee.EnsembleSampler(walkers, centre.size, target, vectorize=True))
     chains, taus = _run_until_converged(samplers, states, steps, max_steps)
     tau = np.max(taus, axis=0)
     burn, thin = int(np.ceil(2 * tau.max())), max(1, int(tau.min() / 2))
@@ -319,7 +320,7 @@ def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=20
     return {"samples": samples, "chain": chains, "tau": tau,
             "burn": burn, "thin": thin, "rhat": rhat, "map": centre,
             "names": posterior.parameter_names,
-            "quantile_mcse": quantile_standard_errors(chains[:, burn:])}
+            "quantile_mcse": quantile_standard_errors(chains[:, burn::thin])}
 
 
 class SamplingSpace:
@@ -351,6 +352,8 @@ class SamplingSpace:
 
     def log_probability(self, points):
         """log density of walkers (W, k) in the sampled space, for emcee; shape (W,)."""
+        if not self.logarithmic.any():                  # the posterior itself: no copies
+            return self.posterior.log_probability(points)
         points = np.asarray(points, float)
         jacobian = np.sum(points[..., self.logarithmic], axis=-1)
         return self.posterior.log_probability(self.to_natural(points)) + jacobian
@@ -372,7 +375,9 @@ def quantile_standard_errors(chains, probabilities=SUMMARY_PROBABILITIES):
     Parameters
     ----------
     chains : numpy.ndarray
-        (ensembles, steps, walkers, k) after burn-in, not thinned.
+        (ensembles, steps, walkers, k): the draws the quantiles are taken from (after
+        burn-in; thinned by tau/2, the indicator's autocorrelation is short and cheap to
+        sum).
     probabilities : dict
         key -> p.
 
