@@ -2,10 +2,19 @@
 
     python scripts/shipped_digest.py > before.json      # on the old version
     python scripts/shipped_digest.py --compare before.json   # on the new one
+    python scripts/shipped_digest.py --values-only > before.json   # values, not metadata
+
 
 Each scenario runs as shipped (``uq run``'s code path, ``uq golden`` for golden
 configurations); the digest is a SHA-256 of every variable's and coordinate's bytes and
 of the attributes that are not timings. Bit-identical results give identical digests.
+
+``--values-only`` digests each variable's values alone (as float64 where numeric, so a
+boolean stored as a 0/1 flag byte has the digest of the boolean; strings as Python
+strings, however they are stored), without its attributes
+and the global ones: a change of metadata (CF attributes, coordinates' encoding) then
+shows no difference, a change of any number does. Variables that are new in the later
+version are listed but do not count as differences.
 """
 import argparse
 import contextlib
@@ -37,7 +46,22 @@ def digest(dataset):
     return out
 
 
-def shipped():
+def values_digest(dataset):
+    """Variable name -> SHA-256 of its shape and values alone (no dtype, no attributes)."""
+    out = {}
+    for name in sorted(dataset.variables):
+        values = np.ascontiguousarray(dataset.variables[name].values)
+        if values.dtype.kind in "biuf":
+            values = values.astype(np.float64)
+        elif values.dtype.kind in "US":         # strings stored as characters: as objects
+            values = values.astype(object)
+        h = hashlib.sha256(f"{values.shape}".encode())
+        h.update(values.tobytes() if values.dtype != object else repr(values.tolist()).encode())
+        out[name] = h.hexdigest()[:16]
+    return out
+
+
+def shipped(digest=digest):
     """Name -> digest of every shipped scenario's results."""
     import uq
     from uq.cli import main
@@ -62,15 +86,22 @@ def shipped():
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--compare", help="digest file of the earlier version")
+    parser.add_argument("--values-only", action="store_true",
+                        help="digest the values of the variables only, not their metadata")
     args = parser.parse_args()
-    now = shipped()
+    now = shipped(values_digest if args.values_only else digest)
     if not args.compare:
         json.dump(now, sys.stdout, indent=1)
         return 0
     before = json.loads(Path(args.compare).read_text())
     differ = [(s, v) for s in before for v in before[s]
               if now.get(s, {}).get(v) != before[s][v]]
-    differ += [(s, v) for s in now for v in now[s] if v not in before.get(s, {})]
+    new = [(s, v) for s in now for v in now[s] if v not in before.get(s, {})]
+    if args.values_only:
+        for s, v in new:
+            print(f"new: {s} {v}")
+    else:
+        differ += new
     for s, v in differ:
         print(f"differs: {s} {v}")
     print(f"{len(before)} scenarios, {sum(map(len, before.values()))} variables: "

@@ -25,3 +25,59 @@ def _nest(changes):
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+@pytest.fixture(scope="session")
+def cf_compliance():
+    """A function that checks one netCDF file the way the ecosystem's tools do (issue 16,
+    "files that the ecosystem's tools accept") and returns its checker report:
+
+    * the IOOS compliance-checker, CF 1.10, finds no error (no failed high-priority
+      check) and raises no exception of its own;
+    * no coordinate variable (a 1-D numeric variable named as its dimension) carries a
+      _FillValue or a missing value, and each is strictly monotonic (CF 2.5.1, 5; also
+      checked here, as the checker skips that check when any coordinate is a string);
+    * xarray opens it and ``xarray.decode_cf`` of the raw variables gives the same Dataset;
+    * ``ncdump -h`` reads it (where the netCDF utilities are installed).
+    """
+    import json
+    import shutil
+    import subprocess
+    import tempfile
+    from pathlib import Path
+
+    import netCDF4
+    import xarray as xr
+    from compliance_checker.runner import CheckSuite, ComplianceChecker
+
+    import warnings
+    with warnings.catch_warnings():         # the checker's own deprecation notices
+        warnings.simplefilter("ignore", DeprecationWarning)
+        CheckSuite().load_all_available_checkers()
+
+    def check(path):
+        with tempfile.TemporaryDirectory() as folder:
+            report_path = Path(folder) / "report.json"
+            _, raised = ComplianceChecker.run_checker(str(path), ["cf:1.10"], 0, "normal",
+                                                      output_filename=str(report_path),
+                                                      output_format="json")
+            report = json.loads(report_path.read_text())["cf:1.10"]
+        failed = [(item["name"], item["msgs"]) for item in report["high_priorities"]
+                  if item["value"][0] < item["value"][1]]
+        assert not raised, f"{path}: the checker raised (see its stderr)"
+        assert not failed, f"{path}: CF 1.10 errors {failed}"
+        with netCDF4.Dataset(path) as handle:
+            for name, variable in handle.variables.items():
+                if variable.dimensions != (name,) or variable.dtype.kind not in "iuf":
+                    continue
+                assert "_FillValue" not in variable.ncattrs(), f"{path}: {name} _FillValue"
+                values = np.ma.filled(variable[:].astype(float), np.nan)
+                assert np.isfinite(values).all(), f"{path}: {name} has missing values"
+                steps = np.diff(values)
+                assert np.all(steps > 0) or np.all(steps < 0), f"{path}: {name} not monotonic"
+        with xr.open_dataset(path) as decoded, xr.open_dataset(path, decode_cf=False) as raw:
+            assert xr.decode_cf(raw).identical(decoded), f"{path}: decode_cf round trip"
+        if shutil.which("ncdump"):
+            subprocess.run(["ncdump", "-h", str(path)], check=True, capture_output=True)
+        return report
+    return check

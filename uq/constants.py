@@ -196,3 +196,10 @@ DWELL_QUADRATURE_TOLERANCE = 1e-9
 #: to ~10 of its radians to 1e-9 (a 1 s dwell of a 0.6 s motion period); a conical scan's
 #: dwell of 20 ms needs 2-4.
 MAX_DWELL_NODES = 32
+
+#: Size [the output's unit: m s-1 or deg] under which a figure or a report takes a
+#: deterministic number (an uncertainty, the correction's systematic error) for zero: far
+#: above the rounding of the model's double arithmetic (values of ~10 m s-1 carry errors
+#: of ~1e-15, ~1e-13 after a few dozen operations; a vanishing u comes out at ~1e-29) and
+#: far below anything a lidar resolves (~1e-2 m s-1) or a report prints (4 digits of u).
+NUMERICAL_ZERO = 1e-9

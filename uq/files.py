@@ -26,7 +26,9 @@ import json
 import os
 import re
 import shutil
+import signal
 import tempfile
+import threading
 from pathlib import Path
 
 from uq._version import __version__
@@ -142,9 +144,10 @@ def atomic_file(path, source="-o"):
                           f"({error.strerror}); allowed: a writable folder") from None
     os.close(handle)
     try:
-        yield Path(temporary)
-        os.chmod(temporary, file_mode())
-        os.replace(temporary, path)
+        with deferred_interrupt():           # Ctrl-C waits until the file is whole
+            yield Path(temporary)
+            os.chmod(temporary, file_mode())
+            os.replace(temporary, path)
     except OSError as error:                 # a full disk, a quota, a read-only mount
         Path(temporary).unlink(missing_ok=True)
         raise OutputError(source, str(path), f"cannot write it ({error.strerror or error}); "
@@ -153,6 +156,28 @@ def atomic_file(path, source="-o"):
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
+
+
+@contextlib.contextmanager
+def deferred_interrupt():
+    """Hold Ctrl-C (SIGINT) back until the block is done, then raise KeyboardInterrupt.
+
+    A KeyboardInterrupt in the middle of a netCDF write can leave the writer's internal
+    (non-reentrant) lock held, and its clean-up then waits on it forever; a write takes
+    milliseconds, so the interrupt is taken at its end. Only in the main thread (the only
+    one that receives signals); elsewhere the block runs as it is.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    received = []
+    previous = signal.signal(signal.SIGINT, lambda number, frame: received.append(number))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if received:
+        raise KeyboardInterrupt
 
 
 def _make_folder(folder, source):

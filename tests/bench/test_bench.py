@@ -42,3 +42,24 @@ def test_measure_gives_errors_against_the_reference(monkeypatch):
     # plain mc at 4096 trials: relative error of u ~ 1/sqrt(2 n) = 1.1 %; 10 % is > 8 sigma
     assert np.all(result["relative_error"] < 0.1) and np.all(result["time_s"] > 0)
     assert float(result["reference_relative_error"].max()) < 1e-3
+
+
+def test_bench_file_passes_the_cf_checker(monkeypatch, tmp_path, cf_compliance):
+    """Issue 16: bench.nc (here from a tiny run: one scene, 2^10 and 2^11 trials, two
+    repeats) has valid attribute names (letters, digits, underscores: no '+cv' or
+    '1e-3'), the time to target as variables, and passes compliance-checker CF 1.10."""
+    import re
+
+    from uq.bench.command import run_bench
+    monkeypatch.setattr(bench, "REFERENCE_SAMPLES", 2**14)
+    monkeypatch.setattr(bench, "SCENES", {"rubio2022_case_i": bench.SCENES["rubio2022_case_i"]})
+    monkeypatch.setattr(bench, "scan_throughput", lambda: 0.1)
+    path = tmp_path / "bench.nc"
+    run_bench(path, quick=True, sizes=[2**10, 2**11], repeats=2)
+    cf_compliance(path)
+    with xr.open_dataset(path) as ds:
+        assert all(re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", name) for name in ds.attrs), \
+            list(ds.attrs)
+        assert "rubio2022_case_i_sobol_cv_time_to_1e_3_s" in ds.attrs
+        assert ds["time_to_target"].sizes == {"scene": 1, "method": 5}
+        assert ds["time_to_target_extrapolated"].dtype == bool

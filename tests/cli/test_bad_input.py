@@ -406,16 +406,32 @@ def results_file(d, **changes):
     return path
 
 
-@case("plot of results without wind_speed")
+@case("plot of results without any uncertainty")
 def _(d):
-    path = results_file(d, outputs=["vertical_wind"])
-    return [(["plot", str(path), "-o", str(d / "figures")], (str(path), "wind_speed"))]
+    path = results_file(d, outputs=["vertical_wind"], ins={})
+    return [(["plot", str(path), "-o", str(d / "figures")], (str(path), "outputs",
+                                                             "no output has an uncertainty"))]
 
 
-@case("report of results without wind_speed")
+@case("plot of a 4-D sweep without --select")
 def _(d):
-    path = results_file(d, outputs=["vertical_wind"])
-    return [(["report", str(path), "-o", str(d / "r.html")], (str(path), "wind_speed"))]
+    path = results_file(d, sweep={"wind.direction": [0, 90], "ship.sog": [1, 2],
+                                  "wind.speed": [4, 8], "ins.heading.u": [0.1, 0.2, 0.3, 0.4,
+                                                                          0.5]})
+    return [(["plot", str(path), "-o", str(d / "figures")], (str(path), "--select"))]
+
+
+@case("plot --select of an unknown dimension")
+def _(d):
+    path = results_file(d, sweep={"wind.direction": [0, 90]})
+    return [(["plot", str(path), "--select", "colour=red", "-o", str(d / "figures")],
+             ("--select", "colour"))]
+
+
+@case("report -o not html")
+def _(d):
+    path = results_file(d)
+    return [(["report", str(path), "-o", str(d / "r.pdf")], ("r.pdf", ".html"))]
 
 
 @case("plot of a text file")

@@ -1,5 +1,7 @@
 """uq fit: the shipped tilted, drifting floating-lidar scenario, coverage of naive and
 propagated fits over repeated scans, Bayesian coverage, CSV input and bad input."""
+import logging
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -12,6 +14,8 @@ from uq.cli import main
 from uq.engine.inputs import input_set
 from uq.physics.measurement import measurement_model
 from uq.pipeline.runner import error_inputs, scene_from_settings
+from uq.fit.fitting import combine_fits
+from uq.fit.plots import plot_corner
 from uq.fit.profilefit import least_squares_profile
 from uq.physics.profiles import power_law_profile
 
@@ -38,7 +42,7 @@ def test_fit_of_the_shipped_scenario_writes_everything(fitted, results):
     assert list(fitted["fit"].values) == ["propagated", "naive"]
     for name in ("posterior_median", "posterior_low95", "posterior_high68", "chain", "rhat",
                  "tau", "predictive_low95", "profile_high95", "least_squares_low95",
-                 "true_value"):
+                 "true_value", "posterior_low95_mcse", "posterior_high95_mcse"):
         assert name in fitted
     assert results.with_name("profile_fit_profile.png").stat().st_size > 10_000
     assert results.with_name("profile_fit_corner.png").stat().st_size > 10_000
@@ -115,7 +119,7 @@ def test_bayesian_credible_intervals_cover_at_95_percent():
         assert binomtest(int(count), trials, 0.95).pvalue > 0.001, hits
 
 
-def test_csv_input_with_scatter(tmp_path):
+def test_csv_input_with_scatter(tmp_path, capfd):
     """10-min-like records at 4 heights: speed = power law + N(0, 0.4) per record; the
     fitted scatter's 95 % interval holds 0.4 and the shear's holds the truth."""
     rng = np.random.default_rng(3)
@@ -128,6 +132,7 @@ def test_csv_input_with_scatter(tmp_path):
     config = tmp_path / "fit.yaml"
     config.write_text("fit: {columns: {height: z, speed: ws}, ensembles: 2}\n")
     assert main(["fit", str(path), "-c", str(config)]) == 0
+    assert "WARNING" not in capfd.readouterr().err          # nothing leaks (issue 16)
     ds = xr.open_dataset(tmp_path / "mast_fit.nc").load()
     assert ds.attrs["rows_dropped_not_finite"] == 1
     row = ds.sel(fit="data")
@@ -157,3 +162,68 @@ def test_results_without_gate_heights_are_refused(tmp_path, capsys):
                  "--set", "outputs=[wind_speed]"]) == 0
     assert main(["fit", str(path)]) == 2
     assert "gate_height" in capsys.readouterr().err
+
+
+def fake_fit(steps, rng, heavy_tail=False):
+    """A Dataset shaped like fit_profile's (2 ensembles x `steps` x 32 walkers x 2
+    parameters), draws N(0, 1) (with a few far outliers when `heavy_tail`)."""
+    chain = rng.standard_normal((2, steps, 32, 2)) + np.array([8.0, 0.12])
+    if heavy_tail:                                     # 15 draws (of the kept) far out
+        chain[0, [100, 200, 300], :5] = 8.0 + 200.0 * rng.standard_normal((3, 5, 2))
+    names = ["reference_speed", "shear"]
+    summary = {f"posterior_{k}": ("parameter", np.quantile(chain.reshape(-1, 2), p, axis=0))
+               for k, p in (("low95", 0.025), ("median", 0.5), ("high95", 0.975))}
+    return xr.Dataset({**summary, "chain": (("ensemble", "step", "walker", "parameter"), chain),
+                       "tau": ("parameter", [10.0, 10.0])},
+                      coords={"parameter": names}, attrs={"burn": 20, "thin": 5})
+
+
+def test_fits_of_different_chain_length_combine():
+    """Issue 16, bug 1: `uq fit` crashed (AlignmentError on `step`) when the propagated
+    and naive fits' chains ended at different lengths. Any pair must combine: the
+    shorter chain is padded with NaN at its end, every value of both kept."""
+    rng = np.random.default_rng(1)
+    short, long = fake_fit(300, rng), fake_fit(700, rng)
+    for first, second in ((short, long), (long, short)):
+        combined = combine_fits({"a": first, "b": second})
+        assert combined.sizes["step"] == 700
+        for name, fit in (("a", first), ("b", second)):
+            chain = combined["chain"].sel(fit=name).values
+            n = fit.sizes["step"]
+            np.testing.assert_array_equal(chain[:, :n], fit["chain"].values)
+            assert np.isnan(chain[:, n:]).all()
+        assert list(combined["burn"].values) == [20, 20]
+        plot_corner(combined, "a" if first is short else "b").clf()   # NaN padding skipped
+
+
+def test_corner_plot_shows_the_bulk_and_leaks_no_warning(caplog):
+    """Issue 16, bug 4: with a few far draws (a short table gives heavy tails), the
+    corner plot's histograms were spikes (the axis spanned the far tail), corner logged
+    `Too few points to create valid contours` on the root logger, and the last title ran
+    off the figure. Now: no log record, the tallest bin of each 1-D histogram holds less
+    than a quarter of the draws (a N(0, 1) bulk over the central 99.5 % in >= 15 bins
+    puts ~10 % in the tallest), and every title lies inside the figure."""
+    dataset = combine_fits({"data": fake_fit(400, np.random.default_rng(2), heavy_tail=True)})
+    with caplog.at_level(logging.WARNING):
+        figure = plot_corner(dataset)
+    assert not caplog.records, [r.getMessage() for r in caplog.records]
+    figure.canvas.draw()
+    box = figure.bbox
+    diagonal = [ax for ax in figure.axes if ax.get_title()]
+    assert len(diagonal) == 2
+    for ax in diagonal:
+        (histogram,) = ax.patches                   # a step outline: x0,0 x0,h0 x1,h0 x1,h1 ..
+        counts = histogram.get_xy()[1:-1:2, 1]
+        assert len(counts) >= 15 and counts.max() < 0.25 * counts.sum(), ax.get_title()
+        extent = ax.title.get_window_extent()
+        assert box.x0 <= extent.x0 and extent.x1 <= box.x1, ax.get_title()
+
+
+def test_fit_file_passes_the_cf_checker(results, fitted, cf_compliance):
+    """Issue 16: the file of `uq fit` has Conventions, a title and history, and a long
+    name for every variable (units where one unit fits; the parameters' units beside
+    them), and passes compliance-checker CF 1.10."""
+    cf_compliance(results.with_name("profile_fit.nc"))
+    assert fitted.attrs["Conventions"] == "CF-1.10" and "uq fit" in fitted.attrs["history"]
+    assert all("long_name" in fitted[name].attrs for name in fitted.variables)
+    assert list(fitted["parameter_units"].values) == ["m s-1", "1"]

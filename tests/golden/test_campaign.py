@@ -110,3 +110,43 @@ def test_bad_config_exits_2_and_writes_nothing(tmp_path, capsys):
     assert err.startswith("uq: error: ") and "golden.synthetic.lidars" in err
     assert len(err.strip().splitlines()) == 1
     assert not (tmp_path / "out").exists() and not list(tmp_path.glob(".*partial"))
+
+
+def test_golden_file_passes_the_cf_checker(campaign, cf_compliance):
+    """Issue 16: the campaign's netCDF file passes compliance-checker CF 1.10; its flags
+    (bins with enough records, significant slopes) are CF flag variables."""
+    folder, ds = campaign
+    cf_compliance(folder / "golden_campaign.nc")
+    assert ds["sufficient"].dtype == bool and ds["sufficient"].attrs["flag_meanings"]
+    assert ds.attrs["title"] and "uq golden" in ds.attrs["history"]
+
+
+def test_golden_figures_label_in_words_and_stack_variances(campaign):
+    """Issue 16: axis labels in words with units (no column names such as
+    turbulence_intensity), p-values rounded (p < 0.001, or two digits), and the stacked
+    calibration terms drawn as variances (they add: the stack's top is u_cal^2 of the
+    Dataset, rtol 1e-12) on an axis in (m/s)^2, not as shares on an axis in m/s."""
+    import matplotlib.pyplot as plt
+
+    from uq.golden import plots
+    _, ds = campaign
+    height = float(ds["height"].max())
+    figure = plots.plot_deviation_against_environment(ds, height)
+    for ax in figure.axes:
+        assert "_" not in ax.get_xlabel() and "[" in ax.get_xlabel(), ax.get_xlabel()
+        legend = ax.get_legend().get_texts()[0].get_text()
+        p = legend.split(", p")[1]
+        assert p == " < 0.001" or len(p.split("= ")[1].replace("0.", "").lstrip("0")) <= 2, legend
+    plt.close(figure)
+    figure = plots.plot_uncertainty_terms(ds, height)
+    ax = figure.axes[0]
+    assert "(m/s)$^2$" in ax.get_ylabel()
+    bins = np.flatnonzero(ds["required"].values)
+    shown = ds.sel(height=height).isel(bin=bins).isel(comparison=0, framework=0)
+    tops = np.zeros(len(bins))
+    for bar in ax.patches:                                  # 4 terms x bins, stacked
+        index = int(np.argmin(np.abs(shown["bin"].values - bar.get_x() - bar.get_width() / 2)))
+        tops[index] = max(tops[index], bar.get_y() + bar.get_height())
+    np.testing.assert_allclose(tops, shown["calibration"].values ** 2, rtol=1e-12)
+    plt.close(figure)
+    assert plots.p_value_text(3e-17) == "p < 0.001" and plots.p_value_text(0.1432) == "p = 0.14"

@@ -5,8 +5,10 @@ import re
 from pathlib import Path
 
 import matplotlib.pyplot as plt
+import numpy as np
 import pytest
 import xarray as xr
+from matplotlib.collections import QuadMesh
 
 import uq
 from uq.cli import main
@@ -104,8 +106,70 @@ def test_bad_results_file_is_bad_input(tmp_path, capsys, command):
     assert "not a uq results file" in capsys.readouterr().err
 
 
-def test_no_figure_for_a_result_without_a_sweep(tmp_path, capsys):
-    single = uq.run(uq.load_scenario({"name": "one", "sampling": {"n": 1000, "seed": 1}}))
+def test_a_single_scene_has_figures_and_its_report_the_single_scene_ones(tmp_path, capsys):
+    """Issue 16: `uq plot` of a run without a sweep draws the single-scene figures (it
+    said "no figure for these sweep dimensions"); its report counts range gates, not
+    scenes, and embeds the same figures, each with a caption."""
+    single = uq.run(uq.load_scenario(ROOT / "scenarios" / "floating_lidar_full.yaml",
+                                     {"sampling.n": 4000}))
     path = write_results(single, tmp_path / "one.nc")
-    assert main(["plot", str(path)]) == 2
-    assert "no figure for these sweep dimensions" in capsys.readouterr().err
+    assert main(["plot", str(path)]) == 0
+    assert sorted(p.name for p in (tmp_path / "one_figures").iterdir()) == [
+        "budget.png", "histogram.png", "uncertainty_against_gate.png"]
+    page = render_report(single)
+    assert len(re.findall("<img ", page)) == len(re.findall("<figcaption><b>[a-z_]+.</b> [A-Za-z]",
+                                                             page)) == 3
+    answers = page.split("Campaign-planning answers")[1].split("<h2>Figures")[0]
+    assert "for 3 of 3 (3 range gates)" in answers and "scene" not in answers
+
+
+def test_report_says_zero_for_rounding_and_folds_the_scenario(results):
+    """Yaw correction of a level ship is exact: its systematic error, ~1e-15 m/s of
+    rounding, is reported as none (within NUMERICAL_ZERO), not as a finding; the vertical
+    wind has no uncertainty at all and says so; the scenario is folded."""
+    page = render_report(results["rubio2022_case_i"])
+    bias = page.split("<h4>Bias: wind speed</h4>")[1].split("</p>")[0]
+    assert "none (at most" in bias and "e-1" not in bias.split("within")[1]
+    assert "No uncertainty in these scenes" in page
+    assert re.search(r"<details><summary>the scenario's YAML \(\d+ lines", page)
+    assert "<pre>name: rubio2022_case_i" in page.split("<details>")[1]
+
+
+def test_paper_figures_show_their_effect(results):
+    """Issue 16: fig4a and fig6 give each panel its own colour scale where one common
+    scale would hide the velocity ratio's or the tilt's effect (each panel's colours span
+    its own values); fig7 has linear axes; fig2's red line has its axis label; fig3's
+    cog lines carry markers at different points, so that coinciding lines stay visible;
+    Monte Carlo is drawn as markers on top of the GUM lines (fig4b, fig5)."""
+    from uq.outputs import figures
+    for name, function in (("rubio2022_velocity_ratio", figures.fig4a_speed_against_velocities),
+                           ("rubio2022_tilt", figures.fig6_tilt_maps)):
+        figure = function(results[name])
+        meshes = [c for ax in figure.axes for c in ax.collections
+                  if isinstance(c, QuadMesh) and ax.get_title()]
+        # a panel flat to rounding (1e-9 relative) gets matplotlib's own widened scale
+        varied = [m for m in meshes if np.ptp(m.get_array()) > 1e-9 * np.abs(m.get_array()).max()]
+        assert varied
+        for mesh in varied:
+            values = mesh.get_array()
+            assert mesh.get_clim() == pytest.approx((values.min(), values.max()), rel=1e-12)
+        plt.close(figure)
+    figure = figures.fig7_half_cone(results["rubio2022_half_cone"])
+    assert {ax.get_yscale() for ax in figure.axes} == {"linear"}
+    plt.close(figure)
+    figure = figures.fig2_speed_maps(results["rubio2022_misalignment"])
+    assert any("direction mean" in ax.get_ylabel() for ax in figure.axes
+               if ax.get_ylabel() and ax.yaxis.get_label_position() == "right")
+    plt.close(figure)
+    figure = figures.fig3_direction_against_misalignment(results["rubio2022_misalignment"])
+    cogs = [line for line in figure.axes[0].lines if line.get_label().startswith("cog")]
+    assert len({line.get_markevery()[0] for line in cogs}) == len(cogs) == 2
+    plt.close(figure)
+    for name, function in (("rubio2022_velocity_ratio", figures.fig4b_relative_against_speed),
+                           ("rubio2022_tilt", figures.fig5_radial_against_direction)):
+        figure = function(results[name])
+        lines = figure.axes[0].lines
+        mc = [line for line in lines if line.get_marker() == "o"]
+        gum = [line for line in lines if line.get_linestyle() == "--"]
+        assert mc and gum and min(m.get_zorder() for m in mc) > max(g.get_zorder() for g in gum)
+        plt.close(figure)

@@ -199,3 +199,15 @@ def test_clearing_keeps_files_uq_did_not_write(tmp_path, caplog):
     with caplog.at_level(logging.WARNING, logger="uq.pipeline.checkpoint"):
         checkpoint.clear()
     assert (directory / "notes.txt").read_text() == "mine" and "kept" in caplog.text
+
+
+def test_a_fresh_run_after_an_interrupted_one_starts_afresh(tmp_path, one_scene_per_chunk):
+    """Without --resume the checkpoint of an interrupted run is replaced (it is uq's own),
+    and the result is the uninterrupted one."""
+    directory = tmp_path / "out.nc.partial"
+    interrupted(one_scene_per_chunk, directory)
+    seen = []
+    again = run(one_scene_per_chunk, progress=lambda d, t: seen.append(d),
+                checkpoint=Checkpoint(directory))
+    assert seen == list(range(1, 9))                # every chunk computed again
+    same(again, run(one_scene_per_chunk))

@@ -1,38 +1,47 @@
 """``uq bench``: run the benchmarks of :mod:`uq.bench.methods`, print the figures, write
 ``bench.nc`` and its plot."""
+import re
 import sys
 from pathlib import Path
 
 from uq.bench import methods as bench
 from uq.errors import ScenarioError
 from uq.files import check_target, save_figure, write_netcdf
+from uq.pipeline.metadata import cf_encode, flag_attributes, history
 
 
-def run_bench(output, quick=False):
-    """Measure, print and write; returns the benchmark Dataset."""
+def run_bench(output, quick=False, sizes=None, repeats=None):
+    """Measure, print and write; returns the benchmark Dataset. `sizes` and `repeats`
+    replace the defaults of a full or ``--quick`` run (a small run for tests)."""
     from uq.outputs.plots import plot_bench
     output = Path(output)
     if output.suffix != ".nc":
         raise ScenarioError("-o", str(output), "the output file must end in .nc")
     check_target(output)                           # before minutes of measuring
     check_target(output.with_suffix(".png"))
-    sizes = [2**k for k in ((10, 13, 16, 18) if quick else (10, 12, 14, 16, 18, 19))]
-    repeats = 3 if quick else 8
+    sizes = sizes or [2**k for k in ((10, 13, 16, 18) if quick else (10, 12, 14, 16, 18, 19))]
+    repeats = repeats or (3 if quick else 8)
     dataset = bench.measure(sizes, repeats,
                             progress=lambda text: print(f"  {text}", file=sys.stderr))
     floors = {name: bench.draw_floor(name, sizes[-1]) for name in bench.SCENES}
     median = dataset["time_s"].median("repeat")
+    ratios = []
     for name, (floor, dimension) in floors.items():
         plain = float(median.sel({"scene": name, "method": "mc", "n": sizes[-1]}))
+        ratios.append(plain / floor)
         dataset.attrs[f"{name}_mc_over_draw_floor"] = plain / floor
         print(f"{name}: plain mc at n = {sizes[-1]} takes {plain:.3f} s, drawing its "
               f"{dimension} normals per trial {floor:.3f} s: {plain / floor:.1f}x the floor")
+    dataset["mc_over_draw_floor"] = ("scene", ratios, {
+        "units": "1", "long_name": f"wall time of plain mc at n = {sizes[-1]} over the time "
+        "to draw its standard normals alone"})
     targets = bench.time_to_target(dataset)
+    _time_to_target(dataset, targets)
     for name in bench.SCENES:
         plain = targets[name, "mc"][0]
         for method in bench.METHODS:
             seconds, extrapolated = targets[name, method]
-            dataset.attrs[f"{name}_{method}_time_to_1e-3_s"] = seconds
+            dataset.attrs[attribute_name(f"{name}_{method}_time_to_1e-3_s")] = seconds
             print(f"{name:22s} {method:9s} time to 1e-3 in 95 % of runs: {seconds:9.3f} s"
                   f"{' (extrapolated)' if extrapolated else ''}  speed-up vs mc "
                   f"{plain / seconds:7.1f}x")
@@ -44,8 +53,53 @@ def run_bench(output, quick=False):
         dataset.attrs.update(scale_1e8_s=seconds, scale_1e8_peak_rss_mb=megabytes)
         print(f"10^8 trials of the same scene: {seconds:.1f} s, peak resident memory "
               f"{megabytes:.0f} MB")
-    write_netcdf(dataset, output)
+    write_netcdf(annotate(dataset), output)
     figure = plot_bench(dataset)
     save_figure(figure, output.with_suffix(".png"), dpi=120)
     print(f"wrote {output} and {output.with_suffix('.png')}")
     return dataset
+
+
+#: Characters allowed in a netCDF/CF attribute name besides letters and digits (CF 2.3).
+_NAME_CHARACTERS = re.compile(r"[^A-Za-z0-9_]")
+
+
+def attribute_name(text):
+    """A valid CF attribute name of `text`: each character other than a letter, digit or
+    underscore becomes an underscore (``sobol+cv`` -> ``sobol_cv``)."""
+    return _NAME_CHARACTERS.sub("_", text)
+
+
+def _time_to_target(dataset, targets):
+    """The time to the target error, per scene and method, as variables (in place)."""
+    scenes, methods = list(dataset["scene"].values), list(dataset["method"].values)
+    seconds = [[targets[s, m][0] for m in methods] for s in scenes]
+    extrapolated = [[targets[s, m][1] for m in methods] for s in scenes]
+    dataset["time_to_target"] = (("scene", "method"), seconds, {
+        "units": "s", "long_name": f"median wall time to a relative error of u(wind speed) "
+        f"<= {bench.TARGET_ERROR:g} in {100 * bench.TARGET_SHARE:g} % of runs"})
+    dataset["time_to_target_extrapolated"] = (("scene", "method"), extrapolated, {
+        "long_name": "the time to target is extrapolated as n^-1/2 from the largest n",
+        **flag_attributes("measured extrapolated")})
+
+
+#: long_name (and units) of the benchmark's coordinates and reference variables.
+BENCH_METADATA = {"scene": ("", "benchmark scene (shipped scenario)"),
+                  "method": ("", "sampling method (+cv: with the control variate)"),
+                  "n": ("1", "Monte Carlo trials"),
+                  "repeat": ("1", "repetition with an independent seed"),
+                  "reference_u": ("m s-1", "reference u(wind speed): sobol with the "
+                                  "control variate at 2^22 trials"),
+                  "reference_relative_error": ("1", "relative standard error of the "
+                                               "reference u")}
+
+
+def annotate(dataset):
+    """CF attributes of the benchmark Dataset, in place; returns it."""
+    for name, (units, long_name) in BENCH_METADATA.items():
+        if name in dataset.variables:
+            dataset[name].attrs.update({"long_name": long_name,
+                                        **({"units": units} if units else {})})
+    dataset.attrs.update(Conventions="CF-1.10", title="uq bench: error of u(wind speed) "
+                         "against wall time per sampling method", history=history("uq bench"))
+    return cf_encode(dataset)

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from uq.files import write_text
 from uq.pipeline import sweep
 from uq.pipeline.runner import run
 from uq.pipeline.scenario import load_scenario
@@ -85,9 +86,7 @@ def main(out=Path("results") / "bench_sweep.json"):
         "draw_floor_ms_per_scene": 1e3 * floor,
         "mc_time_over_draw_floor": (mc_s / mc_scenes) / floor,
     }
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(figures, indent=1))
+    out = write_text(Path(out), json.dumps(figures, indent=1))      # atomic, its folder made
     for key, value in figures.items():
         print(f"{key:34s} {value:12.4g}")
     print(f"wrote {out}")

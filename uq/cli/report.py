@@ -2,7 +2,7 @@
 from pathlib import Path
 
 from uq.cli.common import EXIT_OK, say
-from uq.cli.plot import open_results
+from uq.cli.plot import add_select, open_results, parse_select
 from uq.errors import ScenarioError
 
 
@@ -15,6 +15,7 @@ def add_parser(commands):
     report.add_argument("--target", type=float, action="append", metavar="U",
                         help="target u(wind speed) [m s-1] for the largest velocity ratio; "
                         "repeatable (default 0.05, 0.06 and 0.07)")
+    add_select(report)
     report.set_defaults(handler=command)
     return report
 
@@ -30,7 +31,7 @@ def command(args):
     for target in args.target or []:
         if not target > 0:
             raise ScenarioError("--target", str(target), "allowed: a positive number [m s-1]")
-    write_report(dataset, output, source=path,
+    write_report(dataset, output, source=path, select=parse_select(args.select),
                  **({"targets": tuple(args.target)} if args.target else {}))
     say(args, f"wrote {output}")
     return EXIT_OK

@@ -14,6 +14,7 @@ from uq.errors import DataFileError, ScenarioError
 from uq.fit.fitting import (combine_fits, fit_profile, profile_from_results, profile_from_table,
                       true_parameters)
 from uq.files import check_target, save_figure, write_netcdf
+from uq.pipeline.metadata import history
 from uq.pipeline.results import open_results
 from uq.pipeline.scenario import assign_dotted, load_fit_settings
 
@@ -108,14 +109,16 @@ def _fit_input(path, results, scenario, config):
         fits = {kind: fit_profile(profile_from_results(results, kind, str(path)), config)
                 for kind in ("propagated", "naive")}
         dataset = combine_fits(fits, true_parameters(scenario, config))
-    dataset.attrs.update(source=str(path), fit_settings=yaml.safe_dump(config.to_dict()))
+    dataset.attrs.update(source=str(path), fit_settings=yaml.safe_dump(config.to_dict()),
+                         history=history(f"uq fit {path}"))
     return dataset
 
 
 def fit_table(dataset):
-    """Posterior median [95 % interval] beside least squares, per fit and parameter."""
+    """Posterior median [95 % interval] and the chain's Monte Carlo standard error of
+    the interval's ends (the larger), beside least squares, per fit and parameter."""
     lines = [f"{'fit':<12}{'parameter':<18}{'median':>10}{'95 % credible':>24}"
-             f"{'least squares':>14}{'95 % confidence':>24}{'true':>9}"]
+             f"{'MC error':>10}{'least squares':>15}{'95 % confidence':>24}{'true':>9}"]
     for fit in dataset["fit"].values:
         row = dataset.sel(fit=fit)
         for name in dataset["parameter"].values:
@@ -125,10 +128,18 @@ def fit_table(dataset):
             lines.append(
                 f"{fit:<12}{name:<18}{float(p.posterior_median):>10.4g}"
                 f"{_interval(p.posterior_low95, p.posterior_high95):>24}"
-                f"{float(p.least_squares_value):>14.4g}"
+                f"{_chain_error(p):>10.2g}"
+                f"{float(p.least_squares_value):>15.4g}"
                 f"{_interval(p.least_squares_low95, p.least_squares_high95):>24}"
                 f"{truth:>9.4g}")
     return "\n".join(lines)
+
+
+def _chain_error(row):
+    """The larger Monte Carlo standard error of the two ends of the 95 % interval."""
+    if "posterior_low95_mcse" not in row:
+        return np.nan
+    return max(float(row.posterior_low95_mcse), float(row.posterior_high95_mcse))
 
 
 def _interval(low, high):

@@ -16,7 +16,8 @@ Inputs (:func:`profile_from_results`, :func:`profile_from_table`):
   optional standard uncertainties of speed and height.
 
 Each fit gives the posterior summary (median, 68 % and 95 % central credible
-intervals), the posterior predictive band, the least-squares (``curve_fit``) estimate
+intervals, each with its Monte Carlo standard error ``posterior_<key>_mcse``), the
+posterior predictive band, the least-squares (``curve_fit``) estimate
 with its delta-method intervals beside it, and the chains.
 
 References
@@ -32,6 +33,7 @@ from uq.errors import DataFileError
 from uq.fit.bayesfit import ProfilePosterior, posterior_summary, profile_data, sample_posterior
 from uq.fit.profilefit import least_squares_profile
 from uq.physics.profiles import PROFILES
+from uq.pipeline.metadata import cf_encode, history
 
 #: Heights of the bands: this many points between the lowest and highest gate.
 GRID_POINTS = 60
@@ -131,9 +133,12 @@ def _fit_dataset(data, posterior, chains, least, grid):
     summary = posterior_summary(chains["samples"], names)
     bands = predictive_bands(posterior, chains["samples"], grid)
     k = len(posterior.names)
+    summaries = {f"posterior_{key}": ("parameter", [summary[n][key] for n in names])
+                 for key in SUMMARY_KEYS}
+    summaries.update({f"posterior_{key}_mcse": ("parameter", chains["quantile_mcse"][key])
+                      for key in SUMMARY_KEYS})
     ds = xr.Dataset(
-        {f"posterior_{key}": ("parameter", [summary[n][key] for n in names])
-         for key in SUMMARY_KEYS},
+        summaries,
         coords={"parameter": names, "point": np.arange(grid.size),
                 "gate": np.arange(data.heights.size)})
     ds["grid_height"] = ("point", grid)
@@ -203,9 +208,16 @@ def true_parameters(scenario_settings, config):
 
 
 def combine_fits(fits, truth=None):
-    """Fits by name -> one Dataset with dimension ``fit`` (chains padded with NaN)."""
+    """Fits by name -> one Dataset with dimension ``fit``, with its CF attributes
+    (:func:`annotate`).
+
+    The fits' chains may have different lengths (each ensemble runs until it has
+    converged): the shorter ones are padded with NaN at the end of ``step``, which
+    becomes an index coordinate (0, 1, ...) so that the fits align on it.
+    """
     steps = max(ds.sizes["step"] for ds in fits.values())
-    padded = [ds.reindex(step=np.arange(steps)) for ds in fits.values()]
+    padded = [ds.assign_coords(step=np.arange(ds.sizes["step"])).reindex(step=np.arange(steps))
+              for ds in fits.values()]
     combined = xr.concat(padded, dim="fit", combine_attrs="drop_conflicts")
     combined = combined.assign_coords(fit=list(fits))
     combined["burn"] = ("fit", [ds.attrs["burn"] for ds in fits.values()])
@@ -213,4 +225,87 @@ def combine_fits(fits, truth=None):
     if truth is not None:
         combined["true_value"] = ("parameter", [truth.get(p, np.nan)
                                                 for p in combined["parameter"].values])
-    return combined
+    return annotate(combined)
+
+
+#: Marks a variable whose unit is its parameter's (``parameter_units``): one netCDF
+#: variable holds parameters of different units, so it carries no ``units`` attribute.
+PER_PARAMETER = None
+#: name -> (units or PER_PARAMETER, long_name) of the variables of a fit Dataset.
+FIT_METADATA = {
+    "fit": ("", "fit: propagated (mean gate heights, full covariance), naive (nominal "
+            "heights, independent errors) or data (a table)"),
+    "parameter": ("", "parameter of the profile (ln_sigma: natural logarithm of the extra "
+                  "scatter in m s-1)"),
+    "parameter_units": ("", "units of the parameter"),
+    "point": ("1", "index of the heights of the bands (grid_height)"),
+    "gate": ("1", "index of the observations (range gates or table rows)"),
+    "step": ("1", "step of the chains (before burn-in and thinning)"),
+    "grid_height": ("m", "height of the bands"),
+    "posterior_low95": (PER_PARAMETER, "posterior 2.5 % quantile (lower end of the 95 % "
+                        "credible interval)"),
+    "posterior_low68": (PER_PARAMETER, "posterior 16 % quantile (lower end of the 68 % "
+                        "credible interval)"),
+    "posterior_median": (PER_PARAMETER, "posterior median"),
+    "posterior_high68": (PER_PARAMETER, "posterior 84 % quantile (upper end of the 68 % "
+                         "credible interval)"),
+    "posterior_high95": (PER_PARAMETER, "posterior 97.5 % quantile (upper end of the 95 % "
+                         "credible interval)"),
+    "least_squares_value": (PER_PARAMETER, "least-squares estimate (curve_fit)"),
+    "least_squares_standard_error": (PER_PARAMETER, "standard error of the least-squares "
+                                     "estimate (delta method)"),
+    "least_squares_low95": (PER_PARAMETER, "lower end of the 95 % confidence interval "
+                            "(delta method; on ln z0 for the roughness length)"),
+    "least_squares_high95": (PER_PARAMETER, "upper end of the 95 % confidence interval "
+                             "(delta method; on ln z0 for the roughness length)"),
+    "least_squares_fit": ("m s-1", "least-squares profile at grid_height"),
+    "least_squares_confidence_low": ("m s-1", "lower end of the 95 % confidence band of "
+                                     "the least-squares profile"),
+    "least_squares_confidence_high": ("m s-1", "upper end of the 95 % confidence band of "
+                                      "the least-squares profile"),
+    "least_squares_prediction_low": ("m s-1", "lower end of the 68 % prediction band of a "
+                                     "new measurement (least squares)"),
+    "least_squares_prediction_high": ("m s-1", "upper end of the 68 % prediction band of "
+                                      "a new measurement (least squares)"),
+    "profile_median": ("m s-1", "posterior median of the profile at grid_height"),
+    "profile_low95": ("m s-1", "lower end of the 95 % credible band of the profile"),
+    "profile_high95": ("m s-1", "upper end of the 95 % credible band of the profile"),
+    "predictive_low95": ("m s-1", "lower end of the 95 % posterior predictive band"),
+    "predictive_high95": ("m s-1", "upper end of the 95 % posterior predictive band"),
+    "observed_height": ("m", "height of the observations"),
+    "observed_speed": ("m s-1", "observed wind speed"),
+    "observed_speed_u": ("m s-1", "standard uncertainty of the observed wind speed"),
+    "chain": (PER_PARAMETER, "positions of the walkers of each ensemble at each step "
+              "(missing after the end of a shorter chain)"),
+    "tau": ("1", "integrated autocorrelation time, in steps (largest over the ensembles)"),
+    "rhat": ("1", "rank-normalised split R-hat across the ensembles"),
+    "maximum_a_posteriori": (PER_PARAMETER, "maximum a posteriori (start of the chains)"),
+    "burn": ("1", "steps dropped as burn-in (2 tau)"),
+    "thin": ("1", "thinning of the chains, in steps (tau / 2)"),
+    "true_value": (PER_PARAMETER, "true value of the scenario (missing where it has none)"),
+}
+#: Units of the profile parameters (and of the scatter's logarithm).
+PARAMETER_UNITS = {**{name: unit for _, names, units, _ in PROFILES.values()
+                      for name, unit in zip(names, units)}, "ln_sigma": "1"}
+
+
+def annotate(dataset):
+    """CF attributes of a fit Dataset, in place: units and long_name of every variable
+    (:data:`FIT_METADATA`), the parameters' units as the auxiliary coordinate
+    ``parameter_units``, and the global Conventions, title and history. Returns it."""
+    dataset.coords["parameter_units"] = ("parameter", [PARAMETER_UNITS.get(str(name), "")
+                                                       for name in dataset["parameter"].values])
+    for name, variable in dataset.variables.items():
+        base = name[:-len("_mcse")] if name.endswith("_mcse") else name
+        units, long_name = FIT_METADATA.get(base, ("", name.replace("_", " ")))
+        if name != base:
+            long_name = f"Monte Carlo standard error of the {long_name} (Vehtari et al. 2021)"
+        if units is PER_PARAMETER:
+            long_name += ", in the units of parameter_units"
+        elif units:
+            variable.attrs["units"] = units
+        variable.attrs["long_name"] = long_name
+    profile = dataset.attrs.get("profile", "wind")
+    dataset.attrs.update(Conventions="CF-1.10", title=f"uq fit: {profile} profile",
+                         history=history(f"uq fit, {profile} profile"))
+    return cf_encode(dataset)

@@ -7,8 +7,17 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 LABELS = {"reference_speed": "$U_{ref}$ [m s$^{-1}$]", "shear": r"$\alpha$ [1]",
-          "friction_velocity": "$u_*$ [m s$^{-1}$]", "roughness_length": "$z_0$ [m]",
+          "friction_velocity": "$u_*$ [m s$^{-1}$]", "roughness_length": r"ln $z_0$ [ln m]",
           "ln_sigma": r"ln $\sigma$ [ln(m s$^{-1}$)]"}
+#: Short names for the corner plot's titles (the units are on the axes).
+TITLES = {"reference_speed": "$U_{ref}$", "shear": r"$\alpha$", "friction_velocity": "$u_*$",
+          "roughness_length": r"ln $z_0$", "ln_sigma": r"ln $\sigma$"}
+#: Parameters drawn as their natural logarithm in the corner plot.
+LOGARITHMIC = ("roughness_length",)
+#: Share of the draws each corner axis spans (central): the bulk, not a far tail.
+CORNER_RANGE = 0.995
+#: Bounds of the number of histogram bins of the corner plot.
+MIN_CORNER_BINS, MAX_CORNER_BINS = 15, 50
 
 
 def plot_profile_fit(dataset):
@@ -53,7 +62,14 @@ def _parameter_text(dataset, name):
 
 def plot_corner(dataset, fit=None):
     """Corner plot (corner.py) of the burnt-in, thinned posterior of one fit (default the
-    first), with the true values where the Dataset has them."""
+    first), with the true values where the Dataset has them.
+
+    What a person should see is the bulk of the posterior: each axis spans the central
+    :data:`CORNER_RANGE` of the draws (a far tail of a few draws would otherwise squeeze
+    the histogram into one spike), with a number of bins that grows with the draws. The
+    roughness length is drawn as ln z0, the scale the profile is linear in and the
+    sampler works on. The titles give the median and the 95 % interval.
+    """
     name = dataset["fit"].values[0] if fit is None else fit
     row = dataset.sel(fit=name)
     burn, thin = int(row["burn"]), int(row["thin"])
@@ -61,9 +77,34 @@ def plot_corner(dataset, fit=None):
     samples = chain.reshape(-1, chain.shape[-1])
     samples = samples[np.all(np.isfinite(samples), axis=1)]
     names = list(dataset["parameter"].values)
-    truths = row["true_value"].values if "true_value" in dataset else None
-    figure = corner.corner(samples, labels=[LABELS.get(n, n) for n in names],
-                           quantiles=[0.025, 0.5, 0.975], show_titles=True,
-                           title_fmt=".3g", truths=truths, truth_color="C3")
-    figure.suptitle(f"posterior: {name}", fontsize=10, y=1.04)
+    truths = row["true_value"].values.copy() if "true_value" in dataset else None
+    samples, labels, titles = _corner_scale(samples, names, truths)
+    figure = corner.corner(samples, bins=_corner_bins(len(samples)),
+                           range=[CORNER_RANGE] * len(names), labels=labels, titles=titles,
+                           quantiles=[0.025, 0.5, 0.975], title_quantiles=[0.025, 0.5, 0.975],
+                           show_titles=True, title_fmt=".3g", title_kwargs={"fontsize": 9},
+                           label_kwargs={"fontsize": 9}, truths=truths, truth_color="C3",
+                           quiet=True)   # corner nudges degenerate contour levels itself
+    figure.suptitle(f"posterior: {name} (median, 95 % interval; axes: central "
+                    f"{100 * CORNER_RANGE:g} % of {len(samples)} draws)", fontsize=10)
+    figure.subplots_adjust(top=0.9, left=0.14, bottom=0.14)
     return figure
+
+
+def _corner_scale(samples, names, truths):
+    """Samples, axis labels and titles, with the roughness length as ln z0."""
+    samples = samples.copy()
+    labels, titles = [], []
+    for k, name in enumerate(names):
+        if name in LOGARITHMIC:
+            samples[:, k] = np.log(samples[:, k])
+            if truths is not None and np.isfinite(truths[k]):
+                truths[k] = np.log(truths[k])
+        labels.append(LABELS.get(name, name))
+        titles.append(TITLES.get(name, name))
+    return samples, labels, titles
+
+
+def _corner_bins(draws):
+    """Histogram bins: ~sqrt(draws) / 4, from 15 (a few hundred draws) to 50."""
+    return int(np.clip(np.sqrt(draws) / 4, MIN_CORNER_BINS, MAX_CORNER_BINS))

@@ -8,7 +8,9 @@ respect to the parameters:
 * confidence band of the mean profile: ``f +- t_{(1+p)/2, n-k} sqrt(g^T C g)`` (the
   normal quantile when the speeds' uncertainties are given, i.e. known);
 * prediction band of a new measurement: ``f +- t sqrt(g^T C g + s^2)``, s^2 the residual
-  variance (or the given measurement variance when ``sigma`` is absolute).
+  variance (or the given measurement variance when ``sigma`` is absolute);
+* the interval of a parameter: ``p +- t se(p)``, except for the roughness length z0,
+  which enters the profile as ln z0: ``exp(ln z0 +- t se(z0) / z0)`` (positive).
 
 For a model linear in its parameters these are the textbook regression intervals
 exactly (the tests check it); for the power law they are first-order, as in Matavar
@@ -29,6 +31,10 @@ from uq.physics.profiles import PROFILES
 
 #: Prediction probability of Matavar (2024, App. A.11): the 68 % prediction interval.
 DEFAULT_PREDICTION = 0.68
+#: Parameters that are positive by definition and enter the profile through their
+#: logarithm (the roughness length: U = u*/kappa ln(z/z0)); their confidence interval is
+#: the delta method on ln p, which is the scale the profile is linear in, and stays > 0.
+LOGARITHMIC_PARAMETERS = ("roughness_length",)
 
 
 def least_squares_profile(name, heights, speeds, sigma=None, fixed=None, confidence=0.95,
@@ -83,16 +89,30 @@ def least_squares_profile(name, heights, speeds, sigma=None, fixed=None, confide
     t_confidence = student_t.ppf((1 + confidence) / 2, quantile_dof)
     t_prediction = student_t.ppf((1 + prediction) / 2, quantile_dof)
     errors = np.sqrt(np.diag(covariance))
+    low, high = parameter_interval(names, parameters, errors, t_confidence)
     fit = model(grid, *parameters)
     return {"names": names, "units": units, "parameters": parameters, "standard_errors": errors,
-            "parameter_low": parameters - t_confidence * errors,
-            "parameter_high": parameters + t_confidence * errors,
+            "parameter_low": low, "parameter_high": high,
             "covariance": covariance, "dof": dof, "residual_std": np.sqrt(residual_variance),
             "grid": grid, "fit": fit,
             "confidence_low": fit - t_confidence * np.sqrt(mean_variance),
             "confidence_high": fit + t_confidence * np.sqrt(mean_variance),
             "prediction_low": fit - t_prediction * np.sqrt(mean_variance + noise),
             "prediction_high": fit + t_prediction * np.sqrt(mean_variance + noise)}
+
+
+def parameter_interval(names, parameters, errors, quantile):
+    """Confidence interval of each parameter by the delta method: value +- quantile x
+    standard error, on the logarithmic scale for the parameters of
+    :data:`LOGARITHMIC_PARAMETERS` (``exp(ln p +- quantile x se / p)``), whose
+    interval must stay positive; returns (low, high)."""
+    parameters, errors = np.asarray(parameters, float), np.asarray(errors, float)
+    low, high = parameters - quantile * errors, parameters + quantile * errors
+    for k, name in enumerate(names):
+        if name in LOGARITHMIC_PARAMETERS and parameters[k] > 0:
+            spread = quantile * errors[k] / parameters[k]     # se of ln p, delta method
+            low[k], high[k] = parameters[k] * np.exp(-spread), parameters[k] * np.exp(spread)
+    return low, high
 
 
 def _variances(sigma):

@@ -14,6 +14,7 @@ import numpy as np
 import xarray as xr
 
 from uq.errors import ScenarioError
+from uq.pipeline.metadata import cf_encode, history
 from . import binning, calibration, classification, kpi
 from .records import align, load_records
 
@@ -46,7 +47,9 @@ def analyse(config):
     ds["reference"] = ("comparison", [r for _, r in config.comparisons])
     _chain(config, ds)
     _annotate(ds)
-    ds.attrs.update(Conventions="CF-1.10", name=config.name, description=config.description,
+    ds.attrs.update(Conventions="CF-1.10", title=f"uq golden: verification campaign "
+                    f"{config.name}", history=history(f"uq golden, campaign {config.name}"),
+                    name=config.name, description=config.description,
                     significance=config.significance, route=config.route,
                     bin_width=config.bin_width, required_low=config.required[0],
                     required_high=config.required[1], minimum_records=config.minimum_records,
@@ -282,13 +285,32 @@ METADATA = {
                                    "from north)"),
     "paired_unit_direction": ("degree", "unit wind direction (from, clockwise from north)"),
     "paired_environment": ("1", "environmental variables of the reference (their units)"),
+    "time": ("", "start of the paired 10-min record"),
+    "comparison": ("", "comparison: unit-reference"),
+    "framework": ("", "framework of the deviation term: iec (IEC 61400-12-1) or lusr"),
+    "variable": ("", "environmental variable"),
+    "unit": ("", "instrument verified in the comparison"),
+    "reference": ("", "reference instrument of the comparison"),
 }
+#: CF standard names of the coordinates. "height" is the vertical distance above the
+#: surface, here the sea surface (CF's checker expects it of a coordinate named height).
+STANDARD_NAMES = {"height": "height", "time": "time"}
 
 
 def _annotate(ds):
+    """CF attributes and encodings, in place (:func:`uq.pipeline.metadata.cf_encode`):
+    units (none for texts and the time, which xarray encodes), long names, standard
+    names of the height and time coordinates."""
     for name, (units, long_name) in METADATA.items():
         if name in ds.variables:
-            ds[name].attrs.update(units=units, long_name=long_name)
+            ds[name].attrs.update({"long_name": long_name, **({"units": units} if units
+                                                              else {})})
     for name in ds.data_vars:
-        if name.endswith("_verdict") or name in ("unit", "reference"):
-            ds[name].attrs.update(units="1", long_name=name.replace("_", " "))
+        if name.endswith("_verdict"):
+            ds[name].attrs.update(long_name=name.replace("_", " "))
+    for name, standard_name in STANDARD_NAMES.items():
+        if name in ds.variables:
+            ds[name].attrs["standard_name"] = standard_name
+    if "height" in ds.variables:
+        ds["height"].attrs.update(axis="Z", positive="up")
+    cf_encode(ds)

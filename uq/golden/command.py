@@ -73,7 +73,7 @@ def _write(ds, folder, name):
     (folder / "figures").mkdir(exist_ok=True)
     write_netcdf(ds, folder / f"{name}.nc")
     for table, frame in golden_tables(ds).items():
-        frame.to_csv(folder / "tables" / f"{table}.csv", float_format="%.6g")
+        write_text(folder / "tables" / f"{table}.csv", frame.to_csv(float_format="%.6g"))
     height = float(ds["height"].max())
     figures = {}
     drawings = {"scatter": (plots.plot_scatter, "Unit against reference with the KPI "

@@ -2,11 +2,25 @@
 
 Each function takes the Dataset and a height [m] and returns a matplotlib Figure; no
 numbers are computed here beyond what a plot needs (lines through the stored slopes).
+Axes are labelled in words with units; p-values are rounded (:func:`p_value_text`); the
+calibration terms, which add in quadrature, are stacked as variances on an axis of
+squared units, never as shares drawn on an axis in m/s.
 """
 import matplotlib.pyplot as plt
 import numpy as np
 
 from .classification import percentage_deviation
+
+#: Words and units of the environmental variables of the shipped campaigns (their
+#: columns' units); any other variable is named by its column, "in its own unit".
+ENVIRONMENT_LABELS = {"shear": "shear exponent [1]",
+                      "turbulence_intensity": "turbulence intensity [%]",
+                      "temperature": "air temperature [°C]",
+                      "wind_veer": "wind veer [deg]",
+                      "air_density": "air density [kg m$^{-3}$]",
+                      "significant_wave_height": "significant wave height [m]"}
+#: p-values below this are written as "p < 0.001" (more digits say nothing).
+SMALLEST_P = 1e-3
 
 TERMS = (("reference_calibration", "reference calibration"),
          ("reference_classification", "reference classification"),
@@ -24,8 +38,8 @@ def plot_scatter(ds, height):
         c = ds.sel(comparison=key, height=height)
         _scatter_speed(row[0], c)
         _scatter_direction(row[1], c)
-        row[0].set_title(f"{key} at {height:g} m: wind speed")
-        row[1].set_title(f"{key} at {height:g} m: wind direction")
+        row[0].set_title(f"{_pair(c)} at {height:g} m: wind speed", fontsize=10)
+        row[1].set_title(f"{_pair(c)} at {height:g} m: wind direction", fontsize=10)
     return fig
 
 
@@ -37,7 +51,8 @@ def _scatter_speed(ax, c):
     ax.plot([0, top], [0, top], "k:", lw=1, label="1:1")
     ax.plot([0, top], [0, slope * top], "r-", lw=1.2,
             label=f"y = {slope:.4f} x, R² = {float(c['speed_r_squared']):.4f}")
-    ax.set(xlabel=f"{_name(c, 'reference')} [m/s]", ylabel=f"{_name(c, 'unit')} [m/s]")
+    ax.set(xlabel=f"wind speed of the reference, {_name(c, 'reference')} [m/s]",
+           ylabel=f"wind speed of the unit, {_name(c, 'unit')} [m/s]")
     ax.legend(loc="upper left", fontsize=8)
 
 
@@ -51,8 +66,8 @@ def _scatter_direction(ax, c):
     ax.plot([0, 360], [offset, offset + 360 * slope], "r-", lw=1.2,
             label=f"y = {slope:.4f} x {offset:+.2f}°, R² = "
             f"{float(c['direction_r_squared']):.4f}")
-    ax.set(xlabel=f"{_name(c, 'reference')} [deg]", ylabel=f"{_name(c, 'unit')} [deg]",
-           xlim=(0, 360))
+    ax.set(xlabel=f"wind direction of the reference, {_name(c, 'reference')} [deg]",
+           ylabel=f"wind direction of the unit, {_name(c, 'unit')} [deg]", xlim=(0, 360))
     ax.legend(loc="upper left", fontsize=8)
 
 
@@ -76,9 +91,12 @@ def plot_deviation_against_environment(ds, height):
             line = np.nanpercentile(x, [0.5, 99.5])
             ax.set_xlim(line)
             ax.plot(line, float(s["slope_intercept"]) + float(s["slope"]) * line, "r-",
-                    label=f"m = {float(s['slope']):.3g} ± {float(s['slope_standard_error']):.2g}"
-                    f" %/unit, p = {float(s['slope_p_value']):.2g}")
-            ax.set(xlabel=str(variable), ylabel="deviation [%]", title=f"{key}, {height:g} m")
+                    label=f"slope {float(s['slope']):.3g} ± "
+                    f"{float(s['slope_standard_error']):.2g} %/unit, "
+                    f"{p_value_text(float(s['slope_p_value']))}")
+            ax.set(xlabel=environment_label(str(variable)),
+                   ylabel="unit minus reference\n[% of the reference]")
+            ax.set_title(f"{_pair(c)}, {height:g} m", fontsize=10)
             ax.set_ylim(np.nanpercentile(deviation, [0.5, 99.5]))
             ax.legend(fontsize=7, loc="lower left")
     return fig
@@ -88,8 +106,9 @@ def plot_uncertainty_terms(ds, height, unit=None):
     """Seed Fig. 3: the calibration-uncertainty terms of `unit` per bin, one row per
     reference and one column per framework; a bottom row compares the references.
 
-    Bars stack the terms' shares of the variance, scaled so that the stack's height is
-    u_cal (the terms add in quadrature, not linearly)."""
+    The terms add in quadrature (u_cal^2 = sum of u_i^2), so the bars stack their
+    variances u_i^2 on an axis in (m/s)^2, whose total is u_cal^2; the bottom row gives
+    u_cal itself in m/s."""
     keys = [k for k, u in zip(ds["comparison"].values, ds["unit"].values) if u == unit] \
         if unit else list(ds["comparison"].values)
     frameworks = ds["framework"].values
@@ -99,28 +118,48 @@ def plot_uncertainty_terms(ds, height, unit=None):
     shown = ds.sel(height=height).isel(bin=np.flatnonzero(ds["required"].values))
     for row, key in zip(axes, keys):
         for ax, framework in zip(row, frameworks):
-            _stacked_terms(ax, shown.sel(comparison=key, framework=framework))
-            ax.set_title(f"{key}, {framework.upper()}, {height:g} m")
+            c = shown.sel(comparison=key, framework=framework)
+            _stacked_terms(ax, c)
+            ax.set_title(f"{_pair(c)}, {framework.upper()}, {height:g} m", fontsize=10)
     for ax, framework in zip(axes[-1], frameworks):
         for key in keys:
             c = shown.sel(comparison=key, framework=framework)
-            ax.plot(c["bin"], c["calibration"], "o-", ms=3, label=f"u_cal, {key}")
-        ax.set(xlabel="reference wind speed bin [m/s]", ylabel="u_cal [m/s]",
-               title=f"references compared, {framework.upper()}")
+            ax.plot(c["bin"], c["calibration"], "o-", ms=3, label=f"{_pair(c)}")
+        ax.set(xlabel="reference wind speed bin [m/s]",
+               ylabel="calibration uncertainty\nu$_{cal}$ [m/s]")
+        ax.set_title(f"u$_{{cal}}$ with each reference, {framework.upper()}", fontsize=10)
         ax.legend(fontsize=7)
     axes[0][0].legend(fontsize=7, loc="upper left")
     return fig
 
 
 def _stacked_terms(ax, c):
-    total = c["calibration"].values
-    bottom = np.zeros_like(total)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        for (name, label), colour in zip(TERMS, COLOURS):
-            share = np.nan_to_num(c[name].values ** 2 / total ** 2 * total)
-            ax.bar(c["bin"], share, bottom=bottom, width=0.4, color=colour, label=label)
-            bottom = bottom + share
-    ax.set(ylabel="u_cal [m/s]")
+    """The terms' variances stacked (they add); the stack's top is u_cal^2."""
+    bottom = np.zeros(c["bin"].size)
+    for (name, label), colour in zip(TERMS, COLOURS):
+        variance = np.nan_to_num(c[name].values ** 2)
+        ax.bar(c["bin"], variance, bottom=bottom, width=0.4, color=colour,
+               label=f"{label}$^2$")
+        bottom = bottom + variance
+    ax.set(ylabel="variance u$^2$ [(m/s)$^2$]\n(stack: u$_{cal}^2$)")
+
+
+def environment_label(variable):
+    """An environmental variable in words with its unit (its column's name otherwise)."""
+    return ENVIRONMENT_LABELS.get(variable, f"{variable.replace('_', ' ')} "
+                                  "(in the unit of its column)")
+
+
+def p_value_text(p):
+    """``p = 0.14``, ``p = 0.017``, ``p < 0.001``: two significant digits, no more."""
+    if not np.isfinite(p):
+        return "p: none"
+    return f"p < {SMALLEST_P:g}" if p < SMALLEST_P else f"p = {p:.2g}"
+
+
+def _pair(c):
+    """``flsa against mast``."""
+    return f"{_name(c, 'unit')} against {_name(c, 'reference')}"
 
 
 def _name(c, role):

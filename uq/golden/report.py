@@ -11,6 +11,7 @@ import numpy as np
 
 from uq.files import SIGNATURE
 from .findings import chain_roles, reference_comparison, thin_bins
+from .plots import p_value_text
 
 STYLE = """body{font-family:system-ui,sans-serif;max-width:1150px;margin:2em auto;color:#222}
 table{border-collapse:collapse;margin:.6em 0}td,th{border:1px solid #bbb;padding:3px 7px;
@@ -120,7 +121,7 @@ def _sensitivity_rows(ds):
                 s = ds.sel(comparison=k, height=h, variable=v)
                 rows.append([str(k), f"{h:g}", str(v), f"{float(s['slope']):.4g}",
                              f"{float(s['slope_standard_error']):.2g}",
-                             f"{float(s['slope_p_value']):.2g}",
+                             p_value_text(float(s['slope_p_value'])).removeprefix("p = "),
                              f"{float(s['slope_r_squared']):.3f}",
                              int(s["slope_n_records"]),
                              "yes" if bool(s["slope_significant"]) else "no"])

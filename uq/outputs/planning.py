@@ -13,7 +13,7 @@ References
 """
 import numpy as np
 
-from uq.constants import FULL_CIRCLE_DEG
+from uq.constants import FULL_CIRCLE_DEG, NUMERICAL_ZERO
 
 MODEL_NAMES = {"paper_u": "paper (Rubio & Gottschall 2022)", "gum_u": "GUM, physical",
                "mc_u": "Monte Carlo, physical"}
@@ -22,9 +22,18 @@ MODEL_NAMES = {"paper_u": "paper (Rubio & Gottschall 2022)", "gum_u": "GUM, phys
 DEFAULT_TARGETS = (0.05, 0.06, 0.07)
 #: Velocity ratios VR = sog / Vh of the paper's Fig. 4 [1].
 VELOCITY_RATIOS = (0.5, 1.0, 2.0)
+#: Standard errors of the Monte Carlo mean beyond which a bias counts as one (about a
+#: 0.3 % chance per value for a normal mean without bias).
+BIAS_STANDARD_ERRORS = 3
 #: Relative size under which two uncertainties count as equal in a finding [1]: 0.5 %, far
 #: above the GUM's rounding and below any effect the paper discusses (2 % and more).
 EQUAL_WITHIN = 0.005
+
+
+def uncertain(dataset, quantity):
+    """Has `quantity` an uncertainty anywhere: some model's u above NUMERICAL_ZERO?"""
+    return any(np.nanmax(np.abs(dataset[f"{quantity}_{m}"].values), initial=0.0) > NUMERICAL_ZERO
+               for m in models(dataset, quantity))
 
 
 def models(dataset, quantity):
@@ -133,20 +142,30 @@ def bias_answer(dataset, quantity="wind_speed"):
     Returns
     -------
     dict
-        {"correction": largest |nominal - true| and where, "mc": largest |mc_bias| and
-        where, "significant": share of scenes where |mc_bias| > 3 standard errors
-        (u / sqrt(N)), or None without Monte Carlo}.
+        {"correction": largest |nominal - true| and where, with "zero" when it is within
+        NUMERICAL_ZERO (rounding, not a systematic error), "mc": largest |mc_bias| and
+        where, "significant": share of the compared values (scenes x gates) where
+        |mc_bias| > 3 standard errors (u / sqrt(N)) and > NUMERICAL_ZERO (a scene without
+        uncertainty has a standard error of zero), "significant_count" and "compared"
+        (their numbers), "mc_significant": the largest of those (None if there is none);
+        the Monte Carlo keys are absent without Monte Carlo}.
     """
     truth, nominal = dataset[f"{quantity}_true"], dataset[f"{quantity}_nominal"]
     difference = nominal - truth
     if quantity == "wind_direction":
         difference = (difference + FULL_CIRCLE_DEG / 2) % FULL_CIRCLE_DEG - FULL_CIRCLE_DEG / 2
     answer = {"correction": _largest(difference)}
+    answer["correction"]["zero"] = bool(abs(answer["correction"]["value"]) <= NUMERICAL_ZERO) \
+        if np.isfinite(answer["correction"]["value"]) else False
     if f"{quantity}_mc_bias" in dataset:
         bias = dataset[f"{quantity}_mc_bias"]
         error = dataset[f"{quantity}_mc_u"] / np.sqrt(dataset["mc_n_samples"])
+        beyond = (np.abs(bias) > BIAS_STANDARD_ERRORS * error) & (np.abs(bias) > NUMERICAL_ZERO)
         answer["mc"] = _largest(bias)
-        answer["significant"] = float((np.abs(bias) > 3 * error).mean())
+        answer["significant"] = float(beyond.mean())
+        answer["significant_count"] = int(beyond.sum())
+        answer["compared"] = int(beyond.size)
+        answer["mc_significant"] = _largest(bias.where(beyond)) if beyond.any() else None
     return answer
 
 
@@ -251,6 +270,8 @@ def _velocity_ratio_findings(dataset):
         lines = {ratio: velocity_ratio_line(dataset, f"wind_speed_{model}", ratio)
                  for ratio in VELOCITY_RATIOS}
         common = np.intersect1d(lines[0.5][0], lines[2.0][0])
+        if common.size == 0:            # no swept Vh whose sog reaches VR = 2: not testable
+            continue
         pick = lambda r: lines[r][1][np.isin(lines[r][0], common)]   # noqa: E731
         ordered = np.all(pick(0.5) <= pick(1.0)) and np.all(pick(1.0) <= pick(2.0))
         gain = float(np.mean(pick(2.0) / pick(0.5) - 1))
@@ -263,6 +284,8 @@ def _velocity_ratio_findings(dataset):
 
 def _tilt_findings(dataset):
     rows = []
+    if not (np.isin(0.0, dataset["ship_pitch"].values) and np.isin(0.0, dataset["ship_roll"].values)):
+        return rows                     # no level ship on the grid to compare with
     for quantity in ("wind_speed", "wind_direction"):
         for model in models(dataset, quantity):
             grid = mean_over(dataset, f"{quantity}_{model}", ("ship_pitch", "ship_roll"))
@@ -279,9 +302,13 @@ def _tilt_findings(dataset):
 
 
 def gum_validity_answer(dataset, quantity="wind_speed"):
-    """Share of scenes whose GUM interval Monte Carlo validates (JCGM 101 clause 8), and
-    the share where that verdict is conclusive; None without Monte Carlo."""
+    """Share (and number) of the values (scenes x range gates) whose GUM interval Monte
+    Carlo validates (JCGM 101 clause 8), and of those where that verdict is conclusive;
+    None without Monte Carlo."""
     if f"{quantity}_gum_valid" not in dataset:
         return None
-    return {"valid": float(dataset[f"{quantity}_gum_valid"].mean()),
-            "conclusive": float(dataset[f"{quantity}_gum_validation_conclusive"].mean())}
+    valid = dataset[f"{quantity}_gum_valid"].values
+    conclusive = dataset[f"{quantity}_gum_validation_conclusive"].values
+    return {"valid": float(valid.mean()), "conclusive": float(conclusive.mean()),
+            "valid_count": int(valid.sum()), "conclusive_count": int(conclusive.sum()),
+            "compared": int(valid.size)}

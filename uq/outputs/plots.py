@@ -1,9 +1,40 @@
-"""Figures from finished result Datasets (no physics, no I/O beyond saving)."""
+"""Figures from finished result Datasets, for any run (no physics; no I/O but the
+trials of a single scene, drawn again by :mod:`uq.outputs.samples`).
+
+* a single scene: the variance budget as bars in the output's units
+  (:func:`plot_budget`), u against the range gate (:func:`plot_against_gate`), and the
+  Monte Carlo histogram with the GUM's Gaussian and both 95 % intervals, the picture of
+  the JCGM 101 clause 8 validation (:func:`plot_histogram`);
+* a 1-D sweep: u of each model against the swept value (:func:`plot_against_sweep`);
+* a 2-D sweep, or a 3-D one with a short third dimension: maps per model
+  (:func:`plot_maps`), on one colour scale where every panel's variation shows on it,
+  else one scale per panel (:func:`shared_scale`).
+
+Each takes a Dataset and returns a matplotlib Figure; :mod:`uq.outputs.figures` decides
+which a result gets.
+"""
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 from matplotlib.ticker import NullFormatter  # noqa: E402
+from scipy.stats import norm  # noqa: E402
+
+from uq.constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, NUMERICAL_ZERO  # noqa: E402
+from uq.outputs.labels import (QUANTITIES, SWEEP_QUANTITIES, coordinate_label,  # noqa: E402
+                               model_style, quantity_label)
+from uq.outputs.planning import models as available_models  # noqa: E402
+from uq.outputs.planning import uncertain  # noqa: E402
+
+#: A colour scale is shared by the panels of a map figure when each panel spans at least
+#: this share of the common range: viridis then still gives its variation ~80 of its 256
+#: colours. Below it, a panel's own pattern would fade into one colour: one scale each.
+SHARED_SCALE_FRACTION = 0.3
+#: Gates drawn where a figure has room for a few: the lowest, the middle, the highest.
+SHOWN_GATES = 3
+#: Histogram bins of the Monte Carlo trials.
+HISTOGRAM_BINS = 80
 
 
 def plot_uncertainty_against_direction(results, axes_pair=None):
@@ -63,3 +94,268 @@ def plot_bench(dataset):
         ax.grid(alpha=0.3, which="both")
     axes[0, 0].legend(fontsize=7, title="method (points: runs; line: median)", title_fontsize=7)
     return figure
+
+
+def sweep_quantities(dataset):
+    """The wind outputs of the result that have an uncertainty somewhere (some model's u
+    above NUMERICAL_ZERO; e.g. not the vertical wind of a scene with no vertical error),
+    in order."""
+    return [q for q in SWEEP_QUANTITIES if f"{q}_gum_u" in dataset and uncertain(dataset, q)]
+
+
+def shown_gates(dataset):
+    """Indices of the range gates a figure draws: all up to SHOWN_GATES, else the lowest,
+    the middle and the highest."""
+    n = dataset.sizes.get("range", 1) if "range" in dataset.dims else 1
+    if n <= SHOWN_GATES:
+        return list(range(n))
+    return sorted({0, n // 2, n - 1})
+
+
+def middle_gate(dataset):
+    """The result at its middle range gate (unchanged without a range dimension), and a
+    text naming the gate (empty without gates)."""
+    if "range" not in dataset.dims:
+        gate = f"range gate {float(dataset['range']):g} m" if "range" in dataset.coords else ""
+        return dataset, gate
+    index = dataset.sizes["range"] // 2
+    at = dataset.isel(range=index)
+    return at, f"range gate {float(at['range']):g} m (middle of {dataset.sizes['range']})"
+
+
+def shared_scale(panels):
+    """Do the panels (arrays) share one colour scale (see SHARED_SCALE_FRACTION)? Panels
+    that are flat (to NUMERICAL_ZERO) have no variation to show and do not count: if all
+    are, one scale shows how they differ."""
+    ranges = [float(np.nanmax(p) - np.nanmin(p)) for p in panels]
+    common = max(float(np.nanmax(p)) for p in panels) - min(float(np.nanmin(p)) for p in panels)
+    varied = [r for r in ranges if r > NUMERICAL_ZERO]
+    return not varied or min(varied) >= SHARED_SCALE_FRACTION * common
+
+
+def plot_budget(dataset):
+    """Single scene: each input's contribution |c_i| u_i to the GUM uncertainty, in the
+    output's units, as horizontal bars (largest on top); one panel per output, one bar
+    colour per shown range gate; the dashed line is the combined GUM u (the bars add in
+    quadrature, not linearly)."""
+    quantities = [q for q in sweep_quantities(dataset) if f"{q}_budget" in dataset]
+    inputs = [str(name) for name in dataset["input"].values]
+    figure, axes = plt.subplots(1, len(quantities), figsize=(4.6 * len(quantities),
+                                                             1.2 + 0.42 * len(inputs)),
+                                constrained_layout=True, squeeze=False)
+    gates = shown_gates(dataset)
+    height = 0.8 / len(gates)
+    for ax, quantity in zip(axes[0], quantities):
+        budget = np.sqrt(np.atleast_2d(dataset[f"{quantity}_budget"].values.T).T)
+        budget = budget.reshape(len(inputs), -1)                # inputs x gates
+        order = np.argsort(budget.max(axis=1))
+        gum_u = np.atleast_1d(dataset[f"{quantity}_gum_u"].values)
+        for k, gate in enumerate(gates):
+            colour = f"C{k}"
+            label = _gate_text(dataset, gate)
+            ax.barh(np.arange(len(inputs)) + (k - (len(gates) - 1) / 2) * height,
+                    budget[order, gate], height=height, color=colour, label=label)
+            ax.axvline(gum_u[gate], color=colour, ls="--", lw=1)
+        ax.set_yticks(np.arange(len(inputs)), [inputs[i] for i in order], fontsize=8)
+        ax.set_xlabel(f"contribution |c$_i$| u$_i$ [{QUANTITIES[quantity][2]}]")
+        ax.set_title(f"{QUANTITIES[quantity][0]} (dashed: GUM u)", fontsize=9)
+        ax.grid(alpha=0.3, axis="x")
+    if len(gates) > 1:
+        axes[0, 0].legend(fontsize=7, loc="lower right")
+    return figure
+
+
+def _gate_text(dataset, gate):
+    if "range" not in dataset.dims:
+        return "GUM"
+    return f"range gate {float(dataset['range'].values[gate]):g} m"
+
+
+def plot_against_gate(dataset):
+    """Single scene with several range gates: u of each model (Monte Carlo with +-2
+    standard errors of u) against the range gate; one panel per output."""
+    quantities = sweep_quantities(dataset)
+    figure, axes = plt.subplots(1, len(quantities), figsize=(4.2 * len(quantities), 4),
+                                sharey=True, constrained_layout=True, squeeze=False)
+    gates = dataset["range"].values
+    for ax, quantity in zip(axes[0], quantities):
+        for model in available_models(dataset, quantity):
+            values = dataset[f"{quantity}_{model}"].values
+            ax.plot(values, gates, **model_style(model))
+            if model == "mc_u":
+                ax.errorbar(values, gates, xerr=2 * u_standard_error(dataset, quantity),
+                            fmt="none", ecolor="k", elinewidth=0.8, zorder=4)
+        ax.set_xlabel(quantity_label(quantity))
+        ax.grid(alpha=0.3)
+    axes[0, 0].set_ylabel(coordinate_label(dataset, "range"))
+    axes[0, 0].legend(fontsize=7)
+    return figure
+
+
+def u_standard_error(dataset, quantity):
+    """Standard error of the Monte Carlo u: the run's own, from independent batches
+    (``q_mc_u_standard_error``), or, where it has fewer than two batches (NaN), that of
+    the standard deviation of N normal draws, u / sqrt(2 (N - 1))."""
+    u = dataset[f"{quantity}_mc_u"]
+    normal = u / np.sqrt(2 * (dataset["mc_n_samples"] - 1))
+    stored = dataset.get(f"{quantity}_mc_u_standard_error")
+    return (normal if stored is None else stored.fillna(normal)).values
+
+
+def plot_histogram(dataset, trials):
+    """Single scene, the picture of JCGM 101 clause 8: per output, the histogram of the
+    Monte Carlo trials (density), the GUM's Gaussian N(y, u^2), the Monte Carlo 95 %
+    interval (solid) and the GUM's y +- k u (dashed), and the validation's verdict with
+    the endpoint differences against their tolerance delta.
+
+    Parameters
+    ----------
+    trials : dict
+        output -> (n, n_gates) trials (:func:`uq.outputs.samples.scene_trials`).
+    """
+    at, gate_text = middle_gate(dataset)
+    quantities = [q for q in sweep_quantities(dataset) if q in trials]
+    figure, axes = plt.subplots(1, len(quantities), figsize=(4.6 * len(quantities), 3.8),
+                                constrained_layout=True, squeeze=False)
+    gate = dataset.sizes["range"] // 2 if "range" in dataset.dims else 0
+    for ax, quantity in zip(axes[0], quantities):
+        _histogram_panel(ax, at, quantity, trials[quantity].reshape(len(trials[quantity]), -1)
+                         [:, gate])
+    n = len(next(iter(trials.values())))
+    figure.suptitle(f"Monte Carlo ({n:,} trials) against the GUM"
+                    + (f", {gate_text}" if gate_text else ""), fontsize=10)
+    return figure
+
+
+def _histogram_panel(ax, at, quantity, values):
+    value, u = float(at[f"{quantity}_gum_value"]), float(at[f"{quantity}_gum_u"])
+    low, high = float(at[f"{quantity}_mc_low"]), float(at[f"{quantity}_mc_high"])
+    if quantity == "wind_direction":                 # on the circle: about the GUM value
+        values, low, high = (_near(v, value) for v in (values, low, high))
+    values = values[np.isfinite(values)]
+    ax.hist(values, bins=HISTOGRAM_BINS, density=True, color="0.75",
+            label="Monte Carlo trials")
+    k = norm.ppf((1 + COVERAGE_PROBABILITY) / 2)
+    if u > 0:
+        grid = np.linspace(min(values.min(), value - 4 * u), max(values.max(), value + 4 * u),
+                           400)
+        ax.plot(grid, norm.pdf(grid, value, u), color="tab:orange",
+                label="GUM: N(y, u$^2$)")
+    for end in (low, high):
+        ax.axvline(end, color="k", lw=1.5, label="Monte Carlo 95 % interval"
+                   if end == low else None)
+    for end in (value - k * u, value + k * u):
+        ax.axvline(end, color="tab:orange", ls="--", lw=1.5, label="GUM 95 % interval"
+                   if end < value else None)
+    ax.set_xlabel(f"{QUANTITIES[quantity][0]} [{QUANTITIES[quantity][2]}]")
+    ax.set_ylabel("probability density")
+    ax.set_title(_validation_text(at, quantity, value - k * u - low, value + k * u - high),
+                 fontsize=8)
+    ax.legend(fontsize=6, loc="upper left")
+
+
+def _near(values, centre):
+    """Angles [deg] moved by whole turns to within half a turn of `centre`."""
+    half = FULL_CIRCLE_DEG / 2
+    return (np.asarray(values) - centre + half) % FULL_CIRCLE_DEG - half + centre
+
+
+def _validation_text(at, quantity, d_low, d_high):
+    """The clause 8 verdict and its numbers, for a panel's title."""
+    name = f"{quantity}_gum_valid"
+    if name not in at:
+        return QUANTITIES[quantity][0]
+    verdict = "GUM validated" if bool(at[name]) else "GUM not validated"
+    delta = at.get(f"{quantity}_mc_numerical_tolerance")
+    tolerance = f", delta {float(delta):.2g}" if delta is not None else ""
+    return (f"{QUANTITIES[quantity][0]}: {verdict} (JCGM 101 cl. 8)\n"
+            f"endpoint differences {d_low:+.2g}, {d_high:+.2g}{tolerance}")
+
+
+def plot_against_sweep(dataset, dim=None):
+    """Any 1-D sweep: u of each model against the swept value, one panel per output;
+    with range gates, a colour per shown gate (model by line style and marker); Monte
+    Carlo with +-2 standard errors of u."""
+    dim = dim or dataset["mc_n_samples"].dims[0]
+    quantities = sweep_quantities(dataset)
+    figure, axes = plt.subplots(1, len(quantities), figsize=(4.5 * len(quantities), 3.6),
+                                constrained_layout=True, squeeze=False)
+    gates = shown_gates(dataset)
+    x = dataset[dim].values
+    for ax, quantity in zip(axes[0], quantities):
+        for k, gate in enumerate(gates):
+            at = dataset.isel(range=gate) if "range" in dataset.dims else dataset
+            for model in available_models(dataset, quantity):
+                style = model_style(model)
+                style.setdefault("marker", ".")          # a value alone still shows
+                if len(gates) > 1:
+                    style.update(color=f"C{k}", label=f"{style['label']}, "
+                                 f"{_gate_text(dataset, gate)}")
+                ax.plot(x, at[f"{quantity}_{model}"].values, **style)
+                if model == "mc_u":                     # +-2 standard errors of u
+                    ax.errorbar(x, at[f"{quantity}_mc_u"].values,
+                                yerr=2 * u_standard_error(at, quantity), fmt="none",
+                                ecolor=style["color"], elinewidth=0.7, zorder=4)
+        ax.set_xlabel(coordinate_label(dataset, dim))
+        ax.set_ylabel(quantity_label(quantity))
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=6)
+    return figure
+
+
+def plot_maps(dataset, quantity, x, y, facet=None):
+    """Maps of u(`quantity`) over the sweep dimensions `x` and `y`, one column per model
+    and one row per value of `facet` (a third sweep dimension); a shared colour scale or
+    one per panel (:func:`shared_scale`). With range gates, the middle gate."""
+    at, gate_text = middle_gate(dataset)
+    models = available_models(at, quantity)
+    rows = [None] if facet is None else list(at[facet].values)
+    panels = [[at[f"{quantity}_{m}"].sel({facet: r}) if facet else at[f"{quantity}_{m}"]
+               for m in models] for r in rows]
+    shared = shared_scale([p.values for row in panels for p in row])
+    figure, axes = plt.subplots(len(rows), len(models),
+                                figsize=(4.3 * len(models) + 0.8, 3.3 * len(rows) + 0.5),
+                                constrained_layout=True, squeeze=False, sharex=True,
+                                sharey=True)
+    flat = [p.values for row in panels for p in row]
+    limits = (min(np.nanmin(v) for v in flat), max(np.nanmax(v) for v in flat))
+    for i, (row, value) in enumerate(zip(panels, rows)):
+        for j, (panel, model) in enumerate(zip(row, models)):
+            ax = axes[i, j]
+            mesh = ax.pcolormesh(_positions(at[x]), _positions(at[y]),
+                                 panel.transpose(y, x).values, shading="nearest",
+                                 cmap="viridis",
+                                 **({"vmin": limits[0], "vmax": limits[1]} if shared else {}))
+            _name_ticks(ax.xaxis, at[x])
+            _name_ticks(ax.yaxis, at[y])
+            if not shared:
+                figure.colorbar(mesh, ax=ax, label=quantity_label(quantity))
+            title = model_style(model)["label"]
+            if facet is not None:
+                title += f"\n{coordinate_label(at, facet)} = {value:g}"
+            ax.set_title(title, fontsize=9)
+            if i == len(rows) - 1:
+                ax.set_xlabel(coordinate_label(at, x))
+            if j == 0:
+                ax.set_ylabel(coordinate_label(at, y))
+    if shared:
+        figure.colorbar(mesh, ax=axes, label=quantity_label(quantity))
+    scale = "one colour scale" if shared else "one colour scale per panel"
+    figure.suptitle(f"u({QUANTITIES[quantity][0]}), {scale}"
+                    + (f", {gate_text}" if gate_text else ""), fontsize=10)
+    return figure
+
+
+def _positions(coordinate):
+    """Positions of a coordinate's values on an axis: the numbers, or 0, 1, ... for texts
+    and flags (named by :func:`_name_ticks`)."""
+    values = coordinate.values
+    return values if values.dtype.kind in "iuf" else np.arange(values.size)
+
+
+def _name_ticks(axis, coordinate):
+    """Ticks named by the values of a text or flag coordinate."""
+    values = coordinate.values
+    if values.dtype.kind not in "iuf":
+        axis.set_ticks(np.arange(values.size), [str(v).lower() if values.dtype == bool
+                                               else str(v) for v in values])

@@ -1,8 +1,13 @@
 """A self-contained HTML report of one run: scenario, figures, tables, planning answers.
 
-Figures are embedded as base64 PNG, so the single file can be mailed or archived. The
-numbers come from :mod:`uq.outputs.planning`; the figures from :mod:`uq.outputs.figures`. Written
-atomically (:func:`uq.files.write_text`).
+Figures are embedded as base64 PNG, so the single file can be mailed or archived; each
+has a caption that says what to see. The numbers come from :mod:`uq.outputs.planning`;
+the figures from :mod:`uq.outputs.figures` (a single scene gets the single-scene
+figures). Counts say what they count: scenes of the sweep, and range gates within a
+scene, separately. A deterministic number within :data:`uq.constants.NUMERICAL_ZERO`
+is reported as zero, a Monte Carlo bias only beyond 3 of its standard errors. The
+scenario as run is folded (``<details>``). Written atomically
+(:func:`uq.files.write_text`).
 """
 import base64
 import html
@@ -11,32 +16,42 @@ import io
 import matplotlib.pyplot as plt
 import numpy as np
 
+from uq.constants import NUMERICAL_ZERO
 from uq.files import SIGNATURE, write_text
 from uq.outputs import planning
-from uq.outputs.figures import figure_plan
+from uq.outputs.figures import (caption, figure_plan, no_figure_reason, select_scenes,
+                                sweep_dimensions)
+from uq.outputs.labels import KEY_WORDS
 
 QUANTITY_UNITS = {"wind_speed": "m/s", "wind_direction": "deg", "vertical_wind": "m/s"}
+#: NUMERICAL_ZERO as the text writes it (1e-9).
+_ZERO = f"{NUMERICAL_ZERO:.0e}".replace("e-0", "e-")
+#: Units as the report's text writes them.
+HTML_UNITS = {"degree": "deg", "m s-1": "m/s", "1": ""}
 STYLE = """body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;color:#222}
 table{border-collapse:collapse;margin:.6em 0}td,th{border:1px solid #bbb;padding:3px 8px;
 font-size:90%;text-align:left}th{background:#eee}pre{background:#f6f6f6;padding:.8em;
-overflow-x:auto;font-size:85%}img{max-width:100%}.no{color:#a00}.yes{color:#070}"""
+overflow-x:auto;font-size:85%}img{max-width:100%}.no{color:#a00}.yes{color:#070}
+figure{margin:1em 0}figcaption{font-size:90%;color:#444;max-width:900px}
+summary{cursor:pointer;font-weight:bold}"""
 
 
-def write_report(dataset, path, source="", targets=planning.DEFAULT_TARGETS):
+def write_report(dataset, path, source="", targets=planning.DEFAULT_TARGETS, select=None):
     """Write the report of `dataset` to `path` (HTML); returns the path."""
-    page = render_report(dataset, source=source, targets=targets)
+    page = render_report(dataset, source=source, targets=targets, select=select)
     return write_text(path, page)
 
 
-def render_report(dataset, source="", targets=planning.DEFAULT_TARGETS):
-    """The report as one HTML string."""
+def render_report(dataset, source="", targets=planning.DEFAULT_TARGETS, select=None):
+    """The report as one HTML string. `select` (``{dim: value}``) picks the scenes the
+    figures show (:func:`uq.outputs.figures.select_scenes`); the tables cover them all."""
     name = dataset.attrs.get("title", "uq results")
     parts = [f"<!DOCTYPE html><!-- {SIGNATURE} --><html><head><meta charset='utf-8'>"
              f"<title>{_e(name)}</title>"
              f"<style>{STYLE}</style></head><body><h1>{_e(name)}</h1>",
              _run_table(dataset, source), _answers(dataset, targets), _findings(dataset),
-             _summary_tables(dataset), _figures(dataset),
-             "<h2>Scenario as run</h2><pre>", _e(dataset.attrs.get("scenario", "")), "</pre>",
+             _summary_tables(dataset), _figures(select_scenes(dataset, select)),
+             _scenario(dataset),
              "</body></html>"]
     return "\n".join(parts)
 
@@ -49,6 +64,23 @@ def _table(header, rows):
     head = "".join(f"<th>{_e(h)}</th>" for h in header)
     body = "".join("<tr>" + "".join(f"<td>{cell}</td>" for cell in row) + "</tr>" for row in rows)
     return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def extent(dataset, variable):
+    """What the values of `variable` are, counted: ``36 scenes x 3 range gates``."""
+    dims = sweep_dimensions(dataset)
+    scenes = int(np.prod([dataset.sizes[d] for d in dims])) if dims else 1
+    parts = [f"{scenes} scene{'s' if scenes != 1 else ''}"] if dims else []
+    for dim, word in (("range", "range gate"), ("beam", "beam")):
+        if dim in dataset[variable].dims:
+            n = dataset.sizes[dim]
+            parts.append(f"{n} {word}{'s' if n != 1 else ''}")
+    return " x ".join(parts) or "the scene"
+
+
+def _share(count, total, dataset, variable):
+    """``34 of 36 (scenes x range gates)``."""
+    return f"{count} of {total} ({extent(dataset, variable)})"
 
 
 def _run_table(dataset, source):
@@ -81,10 +113,21 @@ def _answers(dataset, targets):
                 "Vh on the swept grid, for every swept wind speed (direction-averaged u).</p>",
                 _table(("target u(Vh) [m/s]", "model", "largest VR", "limiting Vh [m/s]"), rows)]
     for quantity in ("wind_speed", "wind_direction", "vertical_wind"):
-        if f"{quantity}_budget" in dataset:
-            out += [_budget(dataset, quantity), _disagreement(dataset, quantity),
-                    _bias(dataset, quantity)]
+        if f"{quantity}_budget" not in dataset:
+            continue
+        if not planning.uncertain(dataset, quantity):
+            out.append(_no_uncertainty(quantity))
+            continue
+        out += [_budget(dataset, quantity), _disagreement(dataset, quantity),
+                _bias(dataset, quantity)]
     return "\n".join(out)
+
+
+def _no_uncertainty(quantity):
+    unit = QUANTITY_UNITS[quantity]
+    return (f"<h3>{quantity.replace('_', ' ').capitalize()}</h3><p>No uncertainty in these "
+            f"scenes: u at most {_ZERO} {unit} (rounding) in every model, so no "
+            "budget, no comparison and no bias to report.</p>")
 
 
 def _ratio(value):
@@ -97,23 +140,26 @@ def _budget(dataset, quantity):
     rows = [(_e(name), f"{100 * share:.1f} %") for name, share in
             planning.budget_answer(dataset, quantity)]
     validity = planning.gum_validity_answer(dataset, quantity)
+    variable = f"{quantity}_gum_u"
     note = "" if validity is None else (
-        f"<p>GUM interval validated by Monte Carlo (JCGM 101 clause 8) in "
-        f"{100 * validity['valid']:.0f} % of scenes; the verdict is conclusive (not decided "
-        f"by sampling noise) in {100 * validity['conclusive']:.0f} %.</p>")
+        f"<p>GUM interval validated by Monte Carlo (JCGM 101 clause 8) for "
+        f"{_share(validity['valid_count'], validity['compared'], dataset, variable)}; the "
+        f"verdict is conclusive (not decided by sampling noise) for "
+        f"{validity['conclusive_count']} of the {validity['compared']}.</p>")
     return (f"<h3>Uncertainty budget of {quantity.replace('_', ' ')}</h3><p>Share of the GUM "
-            f"variance, averaged over the grid; the first input dominates.</p>"
-            + _table(("input", "share"), rows) + note)
+            f"variance, averaged over {extent(dataset, variable)}; the first input "
+            f"dominates.</p>" + _table(("input", "share"), rows) + note)
 
 
 def _disagreement(dataset, quantity):
     answer = planning.disagreement_answer(dataset, quantity)
     title = f"<h4>Paper model against sampling: {quantity.replace('_', ' ')}</h4>"
     if answer is None:
-        return title + "<p>The scenes are outside the paper's model (or it has no such output).</p>"
-    where = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
-                      for k, v in answer["where_max"].items())
-    return title + (f"<p>u(paper) / u({answer['reference']}) over {answer['scenes']} scenes: "
+        return title + "<p>Outside the paper's model (or the model has no such output).</p>"
+    where = _where({"where": answer["where_max"]}, dataset)
+    reference = planning.MODEL_NAMES[answer["reference"]]
+    return title + (f"<p>u(paper) / u({reference}) over {answer['scenes']} values "
+                    f"({extent(dataset, f'{quantity}_paper_u')}): "
                     f"median {answer['median']:.3f}, range {answer['min']:.3f} to "
                     f"{answer['max']:.3f}; largest disagreement at {_e(where)}.</p>")
 
@@ -121,19 +167,43 @@ def _disagreement(dataset, quantity):
 def _bias(dataset, quantity):
     answer = planning.bias_answer(dataset, quantity)
     unit = QUANTITY_UNITS[quantity]
-    text = (f"<h4>Bias: {quantity.replace('_', ' ')}</h4><p>Largest systematic error of the "
-            f"correction (reconstruction with zero errors minus truth): "
-            f"{answer['correction']['value']:+.3g} {unit} at {_e(_where(answer['correction']))}.")
+    correction = answer["correction"]
+    text = f"<h4>Bias: {quantity.replace('_', ' ')}</h4><p>Systematic error of the correction " \
+        "(reconstruction with zero errors minus truth): "
+    if correction["zero"]:
+        text += (f"none (at most {abs(correction['value']):.1g} {unit}, within the "
+                 f"{_ZERO} {unit} of rounding).")
+    else:
+        text += f"largest {correction['value']:+.3g} {unit} at {_e(_where(correction, dataset))}."
     if "mc" in answer:
-        text += (f" Largest Monte Carlo bias (mean minus truth): {answer['mc']['value']:+.3g} "
-                 f"{unit} at {_e(_where(answer['mc']))}; larger than 3 standard errors in "
-                 f"{100 * answer['significant']:.0f} % of scenes.")
+        variable = f"{quantity}_mc_bias"
+        if answer["mc_significant"] is None:
+            text += (f" Monte Carlo mean minus truth within {planning.BIAS_STANDARD_ERRORS} "
+                     f"standard errors everywhere ({extent(dataset, variable)}; largest "
+                     f"{answer['mc']['value']:+.2g} {unit}): no bias beyond sampling noise.")
+        else:
+            largest = answer["mc_significant"]
+            text += (f" Monte Carlo bias (mean minus truth) beyond "
+                     f"{planning.BIAS_STANDARD_ERRORS} standard errors for "
+                     f"{_share(answer['significant_count'], answer['compared'], dataset, variable)}"
+                     f"; largest {largest['value']:+.3g} {unit} at {_e(_where(largest, dataset))}.")
     return text + "</p>"
 
 
-def _where(item):
-    return ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
-                     for k, v in item["where"].items()) or "every scene"
+def _where(item, dataset=None):
+    """``wind direction = 30 deg, range gate 160 m``: where a value was found."""
+    parts = []
+    for key, value in item["where"].items():
+        if key == "range":
+            parts.append(f"range gate {value:g} m")
+        elif isinstance(value, float):
+            unit = dataset[key].attrs.get("units", "") if dataset is not None and \
+                key in dataset.coords else ""
+            unit = HTML_UNITS.get(unit, unit)
+            parts.append(f"{KEY_WORDS.get(key, key)} {value:g}{' ' + unit if unit else ''}")
+        else:
+            parts.append(f"{key} = {value}")
+    return ", ".join(parts) or "every scene"
 
 
 def _findings(dataset):
@@ -147,28 +217,59 @@ def _findings(dataset):
 
 
 def _summary_tables(dataset):
-    out = ["<h2>Uncertainty over the grid</h2>"]
+    """u of each model: per range gate for a single scene, else min, median and max over
+    the scenes (and gates), with the number of values outside the model."""
+    single = not sweep_dimensions(dataset)
+    out = ["<h2>Uncertainty</h2>"]
     for quantity, unit in QUANTITY_UNITS.items():
-        rows = []
-        for model, label in planning.MODEL_NAMES.items():
-            name = f"{quantity}_{model}"
-            if name in dataset and np.isfinite(dataset[name].values).any():
-                v = dataset[name].values
-                rows.append((label, f"{np.nanmin(v):.4g}", f"{np.nanmedian(v):.4g}",
-                             f"{np.nanmax(v):.4g}", f"{int(np.isnan(v).sum())}"))
-        if rows:
-            out += [f"<h3>u({quantity.replace('_', ' ')}) [{unit}]</h3>",
-                    _table(("model", "min", "median", "max", "NaN scenes"), rows)]
+        if f"{quantity}_gum_u" in dataset and not planning.uncertain(dataset, quantity):
+            out.append(f"<h3>u({quantity.replace('_', ' ')}) [{unit}]</h3><p>none (at most "
+                       f"{_ZERO} {unit} in every model)</p>")
+            continue
+        names = [(label, f"{quantity}_{model}") for model, label in planning.MODEL_NAMES.items()]
+        names = [(label, name) for label, name in names
+                 if name in dataset and np.isfinite(dataset[name].values).any()]
+        if not names:
+            continue
+        if single:
+            gates = np.atleast_1d(dataset["range"].values)
+            header = ("model",) + tuple(f"range gate {g:g} m" for g in gates)
+            rows = [(label,) + tuple(_number(v) for v in np.atleast_1d(dataset[name].values))
+                    for label, name in names]
+        else:
+            header = ("model", "min", "median", "max", "outside the model")
+            rows = [(label, _number(np.nanmin(v)), _number(np.nanmedian(v)),
+                     _number(np.nanmax(v)), f"{int(np.isnan(v).sum())} of {v.size}")
+                    for label, name in names for v in [dataset[name].values]]
+            header = header[:-1] + (f"outside the model (of {extent(dataset, names[0][1])})",)
+        out += [f"<h3>u({quantity.replace('_', ' ')}) [{unit}]</h3>", _table(header, rows)]
     return "\n".join(out)
+
+
+def _number(value):
+    """A value with 4 significant digits; 0 within NUMERICAL_ZERO (rounding)."""
+    return "0" if abs(value) <= NUMERICAL_ZERO else f"{value:.4g}"
 
 
 def _figures(dataset):
     out = ["<h2>Figures</h2>"]
+    reason = no_figure_reason(dataset)
+    if reason:
+        out.append(f"<p>{_e(reason)}.</p>")
     for name, function in figure_plan(dataset):
         figure = function(dataset)
         buffer = io.BytesIO()
         figure.savefig(buffer, format="png", dpi=100)
         plt.close(figure)
         data = base64.b64encode(buffer.getvalue()).decode("ascii")
-        out.append(f"<h3>{_e(name)}</h3><img alt='{_e(name)}' src='data:image/png;base64,{data}'>")
+        out.append(f"<figure><img alt='{_e(name)}' src='data:image/png;base64,{data}'>"
+                   f"<figcaption><b>{_e(name)}.</b> {_e(caption(name))}</figcaption></figure>")
     return "\n".join(out)
+
+
+def _scenario(dataset):
+    """The scenario as run, folded: it is long, and the report's reader wants the answers."""
+    text = dataset.attrs.get("scenario", "")
+    lines = text.count("\n")
+    return (f"<h2>Scenario as run</h2><details><summary>the scenario's YAML ({lines} lines, "
+            f"defaults filled in)</summary><pre>{_e(text)}</pre></details>")

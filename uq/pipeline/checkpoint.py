@@ -142,7 +142,8 @@ class Checkpoint:
                                       "version; allowed: resume the same run, or run without "
                                       "--resume to start afresh")
             return
-        self._remove_chunks()
+        self._remove_chunks()                 # a fresh start: the folder is ours (marked)
+        self._remove(self.directory / MANIFEST)
         write_text(self.directory / MANIFEST, json.dumps(manifest, indent=1))
 
     def load(self):

@@ -1,8 +1,27 @@
-"""CF-style attributes of the result variables (units, long_name, standard_name).
+"""CF attributes and netCDF encodings of the result variables (CF conventions 1.10).
 
 Standard names are from the CF standard-name table; uncertainties use the CF modifier
-``standard_error`` (CF conventions 1.10, Appendix C).
+``standard_error`` (CF conventions 1.10, Appendix C). What a file needs beyond the
+attributes of each variable, for every writer of the tool (:func:`cf_encode`):
+
+* coordinate variables carry no ``_FillValue`` and no missing value (CF 2.5.1);
+* string-valued coordinates (``input``, ``fit``, ``parameter``, ...) are stored as
+  character arrays, so that no string-valued variable is taken for a numeric coordinate
+  variable (CF 2.2, 5; xarray reads them back as strings);
+* booleans are CF flag variables: ``flag_values`` 0 and 1, ``flag_meanings`` (CF 3.5);
+* a ``history`` line says what wrote the file (CF 2.6.2, :func:`history`).
+
+Beams (dimension ``beam``): the beam number 0, 1, ... (the slanted beams in the order of
+``lidar.azimuths``, then the vertical beam), with the auxiliary coordinates
+``beam_azimuth`` (clockwise from the lidar's reference beam; missing for the vertical
+beam, whose azimuth is undefined: CF allows missing values in an auxiliary coordinate)
+and ``beam_vertical`` (a flag).
 """
+import datetime
+
+import numpy as np
+
+from uq._version import __version__
 
 QUANTITIES = {
     "wind_speed": {"units": "m s-1", "long_name": "horizontal wind speed",
@@ -57,7 +76,9 @@ def variable_attributes(quantity, statistic):
         attrs["units"] = "1"
     elif statistic in ("budget", "mc_covariance", "gum_covariance"):
         attrs["units"] = SQUARED_UNITS[base["units"]]
-    elif statistic not in ("gum_valid", "gum_validation_conclusive"):
+    elif statistic in FLAG_MEANINGS:
+        attrs.update(flag_attributes(FLAG_MEANINGS[statistic]))
+    else:
         attrs["units"] = base["units"]
     if statistic in ("true", "nominal", "gum_value", "mc_mean"):
         attrs["standard_name"] = base["standard_name"]
@@ -70,7 +91,95 @@ COORDINATES = {
     "range": {"units": "m", "long_name": "range-gate height above a level lidar"},
     "range_other": {"units": "m", "long_name": "range-gate height above a level lidar "
                     "(second index of a covariance)"},
-    "beam": {"units": "degree", "long_name": "beam azimuth from the reference beam "
-             "(clockwise; vertical beam: NaN)"},
+    "beam": {"long_name": "beam number: the slanted beams in the order of lidar.azimuths, "
+             "then the vertical beam"},
+    "beam_azimuth": {"units": "degree", "long_name": "beam azimuth, clockwise from the "
+                     "lidar's reference beam (missing for the vertical beam)"},
+    "beam_vertical": {"long_name": "the beam is the vertical beam",
+                      "flag_values": np.array([0, 1], dtype=np.int8),
+                      "flag_meanings": "slanted vertical"},
     "input": {"long_name": "uncertain input (dotted scenario key)"},
 }
+
+#: flag_meanings of the boolean statistics (false first, then true).
+FLAG_MEANINGS = {"gum_valid": "not_validated validated",
+                 "gum_validation_conclusive": "inconclusive conclusive"}
+#: Units of the scenario's own unit names (docs/scenario.md) in UDUNITS, as CF wants.
+SCENARIO_UNITS = {"deg": "degree", "m s-1": "m s-1", "m": "m", "1": "1"}
+#: Units of an error's size (``ins.<quantity>.<parameter>``), by quantity.
+ERROR_UNITS = {"heading": "degree", "pitch": "degree", "roll": "degree", "cog": "degree",
+               "sog": "m s-1", "heave": "m s-1", "half_cone": "degree",
+               "misalignment": "degree", "radial_velocity": "m s-1", "height": "m"}
+#: Parameters of an error distribution that are numbers without unit.
+DIMENSIONLESS_PARAMETERS = ("dof",)
+#: Statistics linked to their quantity's Monte Carlo mean and GUM value
+#: (``ancillary_variables``, CF 3.4): the interval's ends, uncertainties and diagnostics.
+ANCILLARY = {"mc_mean": ("mc_low", "mc_high", "mc_u", "mc_u_standard_error",
+                         "mc_numerical_error", "mc_numerical_tolerance", "mc_n_invalid",
+                         "mc_circular_std", "mc_covariance"),
+             "gum_value": ("gum_u", "gum_valid", "gum_validation_conclusive", "budget",
+                           "gum_covariance")}
+
+
+def swept_key_attributes(key, linked_to=None):
+    """long_name and units (where it has one) of the coordinate of a swept scenario key
+    (``wind.direction`` -> ``wind_direction``), or of a key linked to one."""
+    long_name = f"swept scenario key {key}" if linked_to is None else \
+        f"scenario key {key}, linked to the swept key {linked_to}"
+    units = scenario_key_units(key)
+    return {"long_name": long_name, **({"units": units} if units else {})}
+
+
+def scenario_key_units(key):
+    """UDUNITS units of a dotted scenario key, or None (a choice, a text, a flag)."""
+    from uq.pipeline.reference import meaning
+    parts = key.split(".")
+    if parts[0] in ("ins", "lidar") and len(parts) >= 3 and \
+            (parts[0] == "ins" or parts[1] == "errors"):
+        quantity, parameter = parts[-2], parts[-1]
+        if parameter in DIMENSIONLESS_PARAMETERS:
+            return "1"
+        return ERROR_UNITS.get(quantity)
+    found = meaning(key)
+    return SCENARIO_UNITS.get(found[0]) if found else None
+
+
+def ancillary_variables(dataset, quantity):
+    """``{name: "space-separated ancillary names"}`` for the Monte Carlo mean and the
+    GUM value of `quantity` (only the statistics the Dataset has)."""
+    links = {}
+    for head, statistics in ANCILLARY.items():
+        names = [f"{quantity}_{s}" for s in statistics if f"{quantity}_{s}" in dataset]
+        if f"{quantity}_{head}" in dataset and names:
+            links[f"{quantity}_{head}"] = " ".join(names)
+    return links
+
+
+def flag_attributes(meanings="false true"):
+    """Attributes of a boolean stored as a CF flag variable (0 = false, 1 = true)."""
+    return {"flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings": meanings}
+
+
+def cf_encode(dataset):
+    """Make `dataset` ready for a CF netCDF file, in place (see the module docstring):
+    no ``_FillValue`` on coordinates, string coordinates as character arrays, booleans
+    as flag variables (a long_name from the name where none is set). Returns it."""
+    for name, variable in dataset.variables.items():
+        if name in dataset.coords:          # a missing value only where one is missing
+            missing = name not in dataset.dims and variable.dtype.kind == "f" and \
+                bool(np.isnan(variable.values).any())
+            variable.encoding["_FillValue"] = np.nan if missing else None
+            if variable.dtype.kind in "OUS":
+                variable.encoding["dtype"] = "S1"
+        if variable.dtype == bool:
+            variable.attrs.pop("units", None)          # a flag has no unit (CF 3.5)
+            if "flag_values" not in variable.attrs:
+                variable.attrs.update(flag_attributes())
+            variable.attrs.setdefault("long_name", name.replace("_", " "))
+    return dataset
+
+
+def history(command):
+    """One line of the CF ``history`` attribute: UTC time, the tool and what it did."""
+    now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    return f"{now} uq {__version__}: {command}"

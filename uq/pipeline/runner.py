@@ -20,7 +20,8 @@ from uq.engine.inputs import Input, UniformCircle
 from uq.physics.ins import gauss_markov_correlation
 from uq.pipeline import motionsection
 from uq.physics.measurement import ANGULAR_NAVIGATION, OUTPUTS, Scene, measurement_model, true_values
-from uq.pipeline.metadata import COORDINATES, QUANTITIES, variable_attributes
+from uq.pipeline.metadata import (COORDINATES, QUANTITIES, ancillary_variables, cf_encode,
+                                  history, swept_key_attributes, variable_attributes)
 from uq.engine.propagate import propagate
 from uq.physics.rubio2022 import rubio2022_scene_uncertainty
 from uq.engine.sampling import new_seed
@@ -281,8 +282,17 @@ def _scene_dataset(scene, settings, outputs, engine):
     if "range_other" in engine.dims:
         coords["range_other"] = list(scene.ranges)
     if "beam" in engine.dims:
-        coords["beam"] = list(np.rad2deg(scene.azimuths)) + [np.nan] * int(scene.vertical_beam)
+        coords.update(_beam_coordinates(scene))
     return engine.assign(data).assign_coords(coords)      # one merge each (xarray's cost)
+
+
+def _beam_coordinates(scene):
+    """The beam number and its auxiliary coordinates (:mod:`uq.pipeline.metadata`)."""
+    vertical = int(scene.vertical_beam)
+    azimuths = list(np.rad2deg(scene.azimuths)) + [np.nan] * vertical
+    return {"beam": np.arange(len(azimuths)),
+            "beam_azimuth": ("beam", azimuths),
+            "beam_vertical": ("beam", [False] * len(scene.azimuths) + [True] * vertical)}
 
 
 def _paper_uncertainty(scene, settings, gate_speeds):
@@ -354,15 +364,18 @@ def _annotate(ds, scenario):
         units="1", long_name="what stopped Monte Carlo sampling",
         flag_values=np.arange(len(STOPPED_BY), dtype=np.int8),
         flag_meanings=" ".join(name.replace(" ", "_") for name in STOPPED_BY))
+    for quantity in QUANTITIES:
+        for name, links in ancillary_variables(ds, quantity).items():
+            ds.variables[name].attrs["ancillary_variables"] = links
     for name, attrs in COORDINATES.items():
         if name in ds.coords:
             ds.variables[name].attrs.update(attrs)
     for key, _ in scenario.sweep:
-        ds.variables[key.replace(".", "_")].attrs["long_name"] = f"swept scenario key {key}"
+        ds.variables[key.replace(".", "_")].attrs.update(swept_key_attributes(key))
     for follower, leader in scenario.links:
-        ds.variables[follower.replace(".", "_")].attrs["long_name"] = \
-            f"scenario key {follower}, linked to the swept key {leader}"
-    return ds
+        ds.variables[follower.replace(".", "_")].attrs.update(
+            swept_key_attributes(follower, linked_to=leader))
+    return cf_encode(ds)
 
 
 def skipped_work(settings, outputs):
@@ -386,6 +399,7 @@ def _global_attributes(scenario, seed, dataset, started):
     return {"title": f"uq results: {scenario.name}",
             "skipped": skipped_work(scenario.settings, scenario.outputs),
             "Conventions": "CF-1.10",
+            "history": history(f"uq run, scenario {scenario.name}"),
             "scenario": scenario.text,
             "uq_version": __version__,
             "sampling_method": scenario.sampling["method"],
