@@ -53,13 +53,9 @@ SWEEP_CHUNK_ELEMENTS = 2**20
 #: scenes per chunk instead of 1).
 SWEEP_CHUNK_ELEMENTS_COMPILED = 2**22
 
-#: Most scenes in one call of the compiled model [1] (:func:`uq.fused.applicable`). It
-#: evaluates the scenes of a batch one after the other, with ~0.3 ms of set-up each
-#: (pseudo-inverse, rotations, block buffers); the numpy model vectorises over scenes,
-#: so large batches with few trials (GUM grids of 10^5 scenes: 13 us per scene) stay
-#: with it. Compiled sweeps are chunked at this many scenes at most. The choice depends
-#: only on the batch's shape, so the GUM value and the trials of one call of
-#: :func:`uq.propagate` take the same code path.
+#: Most scenes of one chunk of a Monte Carlo sweep [1] (:func:`uq.pipeline.sweep.
+#: scenes_per_chunk`): the compiled model evaluates any number of scenes in one call
+#: (:mod:`uq.physics.fused`), so this bounds the chunk's outputs and statistics instead.
 FUSED_MAX_SCENES = 64
 
 #: von Karman constant [1]: 0.40, the value of Hogstrom (1996), Boundary-Layer

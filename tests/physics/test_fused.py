@@ -1,7 +1,9 @@
 """The compiled trial loop (uq.physics.fused) against the numpy measurement model.
 
 The two are independent implementations of the same physics (scalar loop vs array
-passes), so agreement over every correction model and error source checks both.
+passes), so agreement over every correction model, error source, output, INS
+correlation (one reading per scan or per beam), independent draws per scene and
+complex-step evaluation (the GUM Jacobian) checks both.
 """
 import dataclasses
 
@@ -12,25 +14,39 @@ from hypothesis import strategies as st
 
 from conftest import make_scene
 from uq.physics import fused
-from uq.physics.measurement import measurement_model
+from uq.engine.gum import complex_step_jacobian
+from uq.engine.inputs import Input, input_set
+from uq.physics.measurement import OUTPUTS, measurement_model
 
 WIND = ("wind_speed", "wind_direction", "vertical_wind")
+EVERY = OUTPUTS
 # The two orders of summation differ by a few ulps of the largest term (the ship and
 # wind velocities, <= ~20 m/s): 1e-12 m/s is ~50 ulps of 20 m/s.
 ATOL = 1e-12
 
 
-def errors(rng, n, scene, sources):
-    """Random errors of each named source, in the shapes of the measurement model."""
-    shapes = {"lidar_radial_velocity": (n, scene.n_beams, len(scene.ranges))}
+def errors(rng, n, scene, sources, per_beam=(), scenes=()):
+    """Random errors of each named source, in the shapes of the measurement model: INS
+    errors named in `per_beam` with one value per beam (n, beams), the others one per
+    scan (n,); with `scenes` (the batch's shape) independent draws per scene, the scene
+    axes after the first (INS errors then (n, *scenes, k))."""
+    beams, gates = scene.n_beams, len(scene.ranges)
+
+    def shape(name):
+        if name == "lidar_radial_velocity":
+            return (n, *scenes, beams, gates)
+        if name.startswith("ins_"):
+            if name in per_beam:
+                return (n, *scenes, beams)
+            return (n, *scenes, 1) if scenes else (n,)
+        return (n, *scenes)
     scales = {"lidar_height": 0.5, "ins_sog": 0.2, "ins_heave": 0.1, "lidar_radial_velocity": 0.1}
-    return {name: scales.get(name, 0.3) * rng.standard_normal(shapes.get(name, (n,)))
-            for name in sources}
+    return {name: scales.get(name, 0.3) * rng.standard_normal(shape(name)) for name in sources}
 
 
-def both(scene, outputs=WIND, **err):
-    compiled = measurement_model(scene, outputs, compiled=True, **err)
-    plain = measurement_model(scene, outputs, compiled=False, **err)
+def both(scene, outputs=EVERY, scene_draws=False, **err):
+    compiled = measurement_model(scene, outputs, scene_draws, compiled=True, **err)
+    plain = measurement_model(scene, outputs, scene_draws, compiled=False, **err)
     return compiled, plain
 
 
@@ -118,18 +134,124 @@ def test_only_requested_outputs():
     assert set(out) == {"wind_speed"} and out["wind_speed"].shape == (3, 1)
 
 
-def test_not_applicable_where_the_numpy_model_is_needed():
+def test_applicable_to_every_static_scene_and_output():
     scene = make_scene()
-    assert not fused.applicable(scene, ("radial_velocity",), {})
-    assert not fused.applicable(scene, WIND, {"ins_heading": np.zeros((3, 4))})   # beam INS
-    assert not fused.applicable(scene, WIND, {"lidar_half_cone": np.zeros(3) + 1e-20j})
-    assert not fused.applicable(scene, WIND, {}, scene_draws=True)
-    assert fused.applicable(scene, WIND, {"ins_heading": np.zeros((3, 1))})    # scan INS
-    # a large batch (a GUM grid): the numpy model vectorises over its scenes
-    from uq.constants import FUSED_MAX_SCENES
-    for scenes, expected in ((FUSED_MAX_SCENES, True), (FUSED_MAX_SCENES + 1, False)):
-        batch = dataclasses.replace(scene, wind_speed=np.full(scenes, 5.0))
-        assert fused.applicable(batch, WIND, {}) is expected
+    n = 3
+    assert fused.applicable(scene, EVERY, {})
+    assert fused.applicable(scene, EVERY, {"ins_heading": np.zeros((n, 4))})       # beam INS
+    assert fused.applicable(scene, EVERY, {"ins_heading": np.zeros((n, 1))})       # scan INS
+    assert fused.applicable(scene, EVERY, {"lidar_half_cone": np.zeros(n) + 1e-20j})  # GUM
+    batch = dataclasses.replace(scene, wind_speed=np.full((2, 5), 5.0))
+    assert fused.applicable(batch, EVERY, {"ins_sog": np.zeros((n, 2, 5, 1))}, scene_draws=True)
+    # shapes it does not take go to the numpy model, which says what is wrong
+    assert not fused.applicable(scene, EVERY, {"ins_heading": np.zeros((n, 3))})   # 3 of 4 beams
+    assert not fused.applicable(batch, EVERY, {"ins_sog": np.zeros((n, 5, 2, 1))},
+                                scene_draws=True)                               # wrong scenes
+    assert not fused.applicable(scene, EVERY, {"lidar_radial_velocity": np.zeros((n, 4))})
+
+
+def test_not_applicable_to_a_time_resolved_scene():
+    """Motion within the scan is the numpy model of uq.physics.timeresolved."""
+    from uq.physics.scene import TimeResolved
+    scene = dataclasses.replace(make_scene(), time_resolved=TimeResolved())
+    assert not fused.applicable(scene, EVERY, {})
+
+
+@pytest.mark.parametrize("model", ["none", "yaw", "tilt2d", "full"])
+@pytest.mark.parametrize("per_beam", [("ins_heading", "ins_pitch", "ins_roll", "ins_sog",
+                                       "ins_cog", "ins_heave"), ("ins_sog",), ("ins_pitch",)])
+def test_agrees_with_numpy_with_a_reading_per_beam(model, per_beam, rng):
+    """ins.correlation beam (every INS error one value per beam) and a correlation time
+    on some of them (those (n, beams), the others (n,)): point-wise correction, every
+    output, every error source on, shear and tilt."""
+    scene = make_scene(**{"correction": model, "wind.shear": 0.14, "ship.pitch": 4.0,
+                          "ship.roll": -3.0, "ship.heading": 40.0, "ship.sog": 3.0,
+                          "ship.cog": 60.0, "ship.heave": 0.3, "lidar.misalignment": 10.0,
+                          "lidar.vertical_beam": True, "lidar.ranges": [40, 100, 160]})
+    err = errors(rng, 300, scene, ALL_SOURCES, per_beam=per_beam)
+    assert fused.applicable(scene, EVERY, err)
+    assert_same(*both(scene, **err))
+
+
+@pytest.mark.parametrize("model", ["yaw", "tilt2d", "full"])
+@pytest.mark.parametrize("sources", [ALL_SOURCES, ("ins_heading", "ins_sog")])
+def test_independent_draws_per_scene_agree_with_numpy(model, sources, rng):
+    """scene_draws: each scene of a batch (2 x 3) its own draws (the errors carry the
+    scene axes), with and without geometry errors (truth per trial or per scene), scan
+    and per-beam readings; each scene's outputs are those of the scene alone with its
+    slice of the draws."""
+    base = make_scene(**{"correction": model, "wind.shear": 0.12, "ship.pitch": 2.0,
+                         "lidar.ranges": [50, 120]})
+    grid = np.ones((2, 3))
+    batch = dataclasses.replace(base, wind_speed=np.array([[4.0], [8.0]]) * grid,
+                                wind_direction=np.deg2rad([0.0, 90.0, 359.0]) * grid,
+                                shear=np.array([0.0, 0.1, 0.2]) * grid)
+    for per_beam in ((), ("ins_heading",)):
+        err = errors(rng, 40, base, sources, per_beam=per_beam, scenes=(2, 3))
+        assert fused.applicable(batch, EVERY, err, scene_draws=True)
+        compiled, plain = both(batch, scene_draws=True, **err)
+        assert compiled["radial_velocity"].shape == (40, 2, 3, base.n_beams, 2)
+        assert_same(compiled, plain)
+        single = dataclasses.replace(base, wind_speed=8.0, wind_direction=np.deg2rad(90.0),
+                                     shear=0.1)
+        alone = measurement_model(single, EVERY, **{k: v[:, 1, 1] for k, v in err.items()})
+        for name in EVERY:
+            np.testing.assert_array_equal(alone[name], compiled[name][:, 1, 1], err_msg=name)
+
+
+def _jacobians(scene, inputs):
+    """Complex-step Jacobians of every output by the compiled and by the numpy model."""
+    laid = input_set(inputs)
+    return [complex_step_jacobian(
+        lambda **e: measurement_model(scene, EVERY, compiled=compiled, **e), laid)
+        for compiled in (True, False)]
+
+
+@pytest.mark.parametrize("model", ["none", "yaw", "tilt2d", "full"])
+@pytest.mark.parametrize("correlation", ["scan", "beam"])
+def test_complex_step_jacobian_agrees_with_numpy(model, correlation):
+    """The GUM: complex errors run the compiled loop in complex arithmetic. Its value
+    and Jacobian equal the numpy model's (every output, every error source, a batch of
+    three scenes, geometry errors so the truth varies per perturbation). Tolerance
+    1e-12 per unit of the input (m/s per deg, m per m, ...): the derivatives are at most
+    ~3 (m of gate height per deg of half-cone at 160 m), the two implementations' sums
+    differ by a few ulps of their terms."""
+    from scipy import stats
+    scene = make_scene(**{"correction": model, "wind.shear": 0.14, "ship.pitch": 4.0,
+                          "ship.roll": -3.0, "ship.heading": 40.0, "ship.sog": 3.0,
+                          "ship.cog": 60.0, "ship.heave": 0.3, "lidar.vertical_beam": True,
+                          "lidar.ranges": [40, 100, 160]})
+    batch = dataclasses.replace(scene, wind_direction=np.deg2rad([10.0, 100.0, 250.0]),
+                                misalignment=np.deg2rad([0.0, 5.0, -30.0]))
+    shape = (scene.n_beams,) if correlation == "beam" else ()
+    inputs = {f"ins_{key}": Input(stats.norm(0.1, 0.2), shape) for key in
+              ("heading", "pitch", "roll", "sog", "cog", "heave")}
+    inputs.update(lidar_half_cone=stats.norm(0, 0.1), lidar_misalignment=stats.norm(0.2, 0.3),
+                  lidar_height=stats.norm(-1.0, 0.5),
+                  lidar_radial_velocity=Input(stats.norm(0, 0.1), (scene.n_beams, 3)))
+    (value_c, jac_c), (value_n, jac_n) = _jacobians(batch, inputs)
+    for name in EVERY:
+        assert jac_c[name].shape == jac_n[name].shape == (input_set(inputs).dimension,) \
+            + value_n[name].shape
+        assert np.abs(jac_n[name]).max() > 0.01                    # the check can fail
+        np.testing.assert_allclose(jac_c[name], jac_n[name], rtol=0, atol=ATOL, err_msg=name)
+    assert_same(value_c, value_n)
+
+
+def test_complex_step_of_a_large_grid_without_geometry_errors():
+    """A GUM grid (the truth per scene, INS errors only, the paper's Table B1): the
+    compiled Jacobian of 500 scenes equals the numpy one."""
+    from scipy import stats
+    scene = make_scene(**{"correction": "yaw", "ship.sog": 2.0, "wind.speed": 5.0})
+    rng = np.random.default_rng(3)
+    batch = dataclasses.replace(scene, wind_direction=rng.uniform(0, 2 * np.pi, 500),
+                                misalignment=rng.uniform(-np.pi, np.pi, 500))
+    inputs = {"ins_heading": stats.norm(0, 0.1), "ins_sog": stats.norm(0, 0.1),
+              "ins_cog": stats.norm(0, 0.1)}
+    (value_c, jac_c), (value_n, jac_n) = _jacobians(batch, inputs)
+    for name in EVERY:
+        np.testing.assert_allclose(jac_c[name], jac_n[name], rtol=0, atol=ATOL, err_msg=name)
+    assert_same(value_c, value_n)
 
 
 @pytest.mark.parametrize("model", ["yaw", "full"])
@@ -154,28 +276,25 @@ def test_a_batch_of_scenes_agrees_with_numpy_scene_by_scene(model, rng):
 
 
 @pytest.mark.parametrize("base", [0.0, 0.5, -2.0, 3.1])
-def test_angle_trig_equals_libm(base, rng):
-    """Taylor polynomials + angle addition within SMALL_ANGLE, libm beyond: cos and sin
-    of base + error to 4 ulp of 1 (two roundings of the addition theorem, and the
-    rounding of base + error that the direct call makes)."""
+def test_reading_trigonometry_equals_libm(base, rng):
+    """Taylor polynomials of the error (ins_trig) + angle addition within SMALL_ANGLE,
+    libm beyond: cos and sin of base + error to 4 ulp of 1 (two roundings of the addition
+    theorem, and the rounding of base + error that the direct call makes)."""
     from uq.constants import SMALL_ANGLE
-    from uq.physics.fusedkernels import angle_trig
+    from uq.physics import fusedkernels as kernels
     errors_deg = np.concatenate([rng.normal(0, 3, 2000), [0.0, -0.0, np.nan, 1e-300],
                                  np.rad2deg([SMALL_ANGLE, -SMALL_ANGLE, 0.2499999, 0.2500001,
                                              1.0, -3.0, 100.0])])
-    strided = np.repeat(errors_deg, 3)[::3]                        # any stride
-    cos, sin = np.empty(len(errors_deg)), np.empty(len(errors_deg))
-    angle_trig(strided, base, 0, len(errors_deg), cos, sin)
+    n = len(errors_deg)
+    strided = np.repeat(errors_deg, 3)[::3].reshape(n, 1, 1)           # any stride
+    zero = np.zeros((1, 1, 1))
+    cos_x, sin_x = np.empty((4, 1, n)), np.empty((4, 1, n))
+    kernels.ins_trig((strided, zero, zero, zero, zero, zero), np.zeros((1, 1)), 0, 1, 0, n,
+                     False, cos_x, sin_x, np.empty(n))
+    cos, sin = np.array([kernels._angle.py_func(base, np.cos(base), np.sin(base),
+                                                np.deg2rad(e), c, s)
+                         for e, c, s in zip(errors_deg, cos_x[0, 0], sin_x[0, 0])]).T
     exact = base + np.deg2rad(errors_deg)
     np.testing.assert_allclose(cos, np.cos(exact), rtol=0, atol=4 * 2.2e-16)
     np.testing.assert_allclose(sin, np.sin(exact), rtol=0, atol=4 * 2.2e-16)
     assert np.isnan(cos[2002]) and np.isnan(sin[2002])
-
-
-def test_angle_trig_of_a_constant_error_fills_the_block():
-    from uq.physics.fusedkernels import angle_trig
-    cos, sin = np.full(5, -9.0), np.full(5, -9.0)
-    angle_trig(np.array([30.0]), 0.0, 10, 14, cos, sin)
-    np.testing.assert_allclose(cos[:4], np.cos(np.deg2rad(30.0)), rtol=1e-15)
-    np.testing.assert_allclose(sin[:4], 0.5, rtol=1e-15)
-    assert cos[4] == -9.0                                  # nothing past the block

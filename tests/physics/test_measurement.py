@@ -191,3 +191,27 @@ def test_scene_draws_are_per_scene_and_equal_common_draws_when_equal():
     replicated = measurement_model(batch, scene_draws=True, **{
         k: np.repeat(v, 3, axis=1) for k, v in common.items()})
     np.testing.assert_allclose(replicated["wind_speed"], crn["wind_speed"], rtol=1e-13)
+
+
+@pytest.mark.parametrize("correction", ["yaw", "tilt2d", "full"])
+def test_a_velocity_read_per_beam_is_corrected_point_wise(correction):
+    """A correlation time on the velocity only (sog one value per beam, heading one per
+    scan): each beam is freed of its own reading. Before the fix the scan formula took
+    beam 0's reading for every beam, so beam 2's reading changed nothing."""
+    scene = make_scene(**{"correction": correction, "ship.sog": 2.0, "wind.speed": 5.0})
+    n = 3
+    heading = np.full((n, 1), 0.1)
+    base = measurement_model(scene, ("wind_speed",), compiled=False, ins_heading=heading,
+                             ins_sog=np.zeros((n, 4)))["wind_speed"]
+    sog = np.zeros((n, 4))
+    sog[:, 2] = 0.2                                   # only beam 2 reads a faster ship
+    moved = measurement_model(scene, ("wind_speed",), compiled=False, ins_heading=heading,
+                              ins_sog=sog)["wind_speed"]
+    assert np.all(np.abs(moved - base) > 0.05)
+    # equal readings: the point-wise result is the scan formula's (least squares
+    # commutes with the common rotation), to the rounding of the 3 x 3 solve
+    same = measurement_model(scene, ("wind_speed",), compiled=False, ins_heading=heading,
+                             ins_sog=np.full((n, 4), 0.2))["wind_speed"]
+    scan = measurement_model(scene, ("wind_speed",), compiled=False, ins_heading=heading,
+                             ins_sog=np.full((n, 1), 0.2))["wind_speed"]
+    np.testing.assert_allclose(same, scan, rtol=0, atol=1e-13)

@@ -318,3 +318,40 @@ def test_results_files_pass_the_cf_checker(tmp_path, cf_compliance):
                  ("wind_direction", "ship_cog", "ship_heading", "ins_sog_u")}
         assert units == {"wind_direction": "degree", "ship_cog": "degree",
                          "ship_heading": "degree", "ins_sog_u": "m s-1"}
+
+
+#: Compiled against numpy model through the whole pipeline: the two models' trials agree
+#: to 1e-12 m/s (tests/physics/test_fused.py); a mean, an order statistic or a standard
+#: deviation moves by at most the largest change of a trial, a covariance of outputs of
+#: spread ~1 (m/s, m) by ~2x that, the GUM's u by the Jacobians' 1e-12 per unit times the
+#: inputs' u (<= 1). 1e-11 leaves a factor of 5 over these bounds; directions [deg] carry
+#: the 1e-12 m/s of a vector of >= 0.1 m/s as <= 6e-10 deg.
+PIPELINE_ATOL, DIRECTION_ATOL = 1e-11, 1e-9
+
+
+@pytest.mark.parametrize("changes", [
+    {},                                                       # as shipped: five outputs
+    {"ins.correlation": "beam", "correction": "tilt2d"},      # point-wise, each beam read
+    {"ins.sog.correlation_time": 2.0, "ins.heading.correlation_time": 0.5,
+     "ins.pitch.correlation_time": 1.0},                      # Gauss-Markov, by the copula
+    {"correction": "yaw", "ins.sog.correlation_time": 2.0}])  # only the velocity per beam
+def test_compiled_run_equals_the_numpy_model(changes, monkeypatch):
+    """floating_lidar_full with every output (gate-to-gate covariances included): a run
+    with the compiled model equals one with the numpy model forced, variable by
+    variable, Monte Carlo and GUM."""
+    scenario = uq.load_scenario(ROOT / "scenarios" / "floating_lidar_full.yaml",
+                                {"sampling.n": 2**12, **changes})
+    compiled = uq.run(scenario)
+    monkeypatch.setattr("uq.physics.fused.applicable", lambda *args, **kwargs: False)
+    plain = uq.run(scenario)
+    assert "wind_speed_mc_covariance" in plain and "gate_height_gum_covariance" in plain
+    assert set(compiled.data_vars) == set(plain.data_vars)
+    for name in plain.data_vars:
+        a, b = compiled[name].values, plain[name].values
+        if a.dtype.kind not in "fc":
+            np.testing.assert_array_equal(a, b, err_msg=name)
+            continue
+        atol = DIRECTION_ATOL if name.startswith("wind_direction") else PIPELINE_ATOL
+        if name.startswith("wind_direction_mc_") and name[18:] in ("mean", "low", "high"):
+            a = np.mod(a - b + 180.0, 360.0) - 180.0 + b       # on the circle
+        np.testing.assert_allclose(a, b, rtol=1e-13, atol=atol, err_msg=name)

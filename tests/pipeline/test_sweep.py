@@ -124,6 +124,7 @@ def test_results_do_not_depend_on_sampling_chunk_size():
 def many_chunks(monkeypatch):
     """One scene per chunk, so a short sweep has several chunks."""
     monkeypatch.setattr(uq.pipeline.sweep, "SWEEP_CHUNK_ELEMENTS", 1)
+    monkeypatch.setattr(uq.pipeline.sweep, "SWEEP_CHUNK_ELEMENTS_COMPILED", 1)
     return small(**{"sweep": {"wind.direction": [0.0, 90.0, 180.0, 270.0],
                               "ins.heading.u": [0.2, 0.5]}, "sampling.seed": None})
 

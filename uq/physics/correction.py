@@ -107,7 +107,7 @@ def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navig
     rotation = correction_rotation(model, nav["heading"], nav["pitch"], nav["roll"],
                                    nominal_heading)
     ship = correction_ship_velocity(model, nav["sog"], nav["cog"], nav["heave"])
-    if rotation.shape[-3] == 1:
+    if rotation.shape[-3] == 1 and ship.shape[-2] == 1:    # one reading for all beams
         return _scan_correction(radial_velocity, model, operator, rotation[..., 0, :, :],
                                 ship[..., 0, :])
     wind = _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship)

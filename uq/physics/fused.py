@@ -13,11 +13,19 @@ SIMD ``log`` and ``exp`` on the whole block, the direction from numpy's SIMD ``a
 It is a second, independent implementation of the physics (scalar code, written from
 the conventions of :mod:`uq.physics.rotation`, :mod:`uq.physics.beams`, :mod:`uq.physics.wind` and
 :mod:`uq.physics.correction`, not from the array code); ``tests/physics/test_fused.py`` checks that the
-two agree to 1e-12 for every correction model and error source. The numpy model stays
-the reference: it alone runs complex-step (the GUM Jacobian), point-wise correction
-(``ins.correlation: beam``), independent draws per scene, and the outputs
-``radial_velocity`` and ``gate_height``; :func:`applicable` says when the fused loop
-is used. A batch of scenes (a sweep's chunk) is evaluated scene after scene.
+two agree to 1e-12 for every correction model, error source and output, one INS reading
+per scan or per beam (point-wise correction: ``ins.correlation: beam`` and errors with a
+``correlation_time``, whose correlation the engine's copula imposes), independent draws
+per scene and complex errors (the complex-step GUM Jacobian, in complex arithmetic). The
+numpy model stays the reference, and is the model of a time-resolved scan
+(:mod:`uq.physics.timeresolved`); :func:`applicable` says when the fused loop is used.
+
+A batch of scenes (a sweep's chunk, a GUM grid) is evaluated in one compiled loop: the
+scenes' constants are rows of a table (:func:`scene_table`), the work that depends only
+on the draws (the errors' sines and cosines) is done once per block of trials and shared
+by every scene that sees those draws; with independent draws per scene each scene has
+its own. The truth (true beams, gate heights, power law) is computed once per scene
+when no geometry error varies it, else per trial.
 
 Conventions (as in the modules named above): earth frame (north, east, up); ship frame
 (bow, starboard, up); body-to-earth ``Rz(heading) Ry(pitch) Rx(roll)``, pitch positive
@@ -30,168 +38,192 @@ References
 .. [2] Lam, S. K., Pitrou, A. and Seibert, S. (2015). Numba: a LLVM-based Python JIT
    compiler. Proc. LLVM-HPC 2015.
 """
-import dataclasses
-import functools
 import math
 
 import numpy as np
 
+from uq import complexstep
 from uq.physics import fusedkernels as kernels
-from uq.physics.beams import least_squares_operator, slant_distances
-from uq.constants import FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS, FUSED_MAX_SCENES
+from uq.physics import wind as wind_formulas
+from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
+from uq.constants import FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS
 from uq.physics.correction import CORRECTION_MODELS
-from uq.physics.scene import COMPILED_OUTPUTS, NAVIGATION, SCENE_FIELDS, sample_count
+from uq.physics.scene import OUTPUTS, SCENE_FIELDS, sample_count
 from uq.physics.rotation import attitude_matrix
 
-#: Outputs the fused loop computes; any other requested output uses the numpy model.
-FUSED_OUTPUTS = COMPILED_OUTPUTS
-_INS_ANGLES = ("heading", "pitch", "roll", "cog")
+#: Outputs the fused loop computes: all of them.
+FUSED_OUTPUTS = OUTPUTS
+_INS = tuple(f"ins_{key}" for key in kernels.INS_ORDER)
+_GEOMETRY = tuple(f"lidar_{key}" for key in kernels.GEO_ORDER)
+_NOISE = "lidar_radial_velocity"
 
 
 def applicable(scene, outputs, errors, scene_draws=False):
     """Can the fused loop evaluate this call of the measurement model?
 
-    At most :data:`~uq.constants.FUSED_MAX_SCENES` scenes, common draws for every
-    scene of the batch (not ``scene_draws``), only
-    :data:`FUSED_OUTPUTS`, real errors, one INS reading per scan (``scan``) and radial
-    noise of shape (n, beams, gates) if any.
+    Every static scene (not time-resolved: that is its own model), every output, real
+    (Monte Carlo) or complex (complex-step GUM) errors in the shapes of
+    :func:`uq.physics.measurement.measurement_model`: INS errors (n,), (n, 1) or
+    (n, beams) (one reading per scan or per beam), geometry errors (n,), radial noise
+    (n, beams, gates); with `scene_draws` each with the scene axes after the first.
     """
-    if scene_draws or scene.time_resolved is not None or \
-            not set(outputs) <= set(FUSED_OUTPUTS) or \
-            math.prod(scene.shape) > FUSED_MAX_SCENES:
+    if scene.time_resolved is not None or not set(outputs) <= set(FUSED_OUTPUTS):
         return False
-    if any(np.iscomplexobj(value) for value in errors.values()):
+    try:
+        _shaped(scene, errors, scene_draws)
+    except _Unsupported:
         return False
-    if any(np.ndim(errors.get(f"ins_{key}", 0.0)) > 1 and np.shape(errors[f"ins_{key}"])[1:] != (1,)
-           for key in NAVIGATION):
-        return False                                  # one reading per beam (``beam``)
-    noise = errors.get("lidar_radial_velocity")
-    return noise is None or np.ndim(noise) == 3
+    return True
 
 
-def measurement_model(scene, outputs, **errors):
+class _Unsupported(ValueError):
+    """An error array of a shape the fused loop does not take."""
+
+
+def measurement_model(scene, outputs, scene_draws=False, **errors):
     """The fused equivalent of :func:`uq.measurement.measurement_model` (same inputs,
-    degrees for angular errors; same outputs, each shape (n, *S, n_gates) for a batch
-    of scenes of shape S). The scenes of a batch are evaluated one after the other,
-    each with the same draws (common random numbers)."""
-    shape, gates = scene.shape, len(scene.ranges)
+    degrees for angular errors; same outputs, shape (n, *S, n_gates), radial velocity
+    (n, *S, n_beams, n_gates)). Complex errors give complex outputs (complex step)."""
+    shape, n_gates, n_beams = scene.shape, len(scene.ranges), scene.n_beams
+    scenes = math.prod(shape)
     n = sample_count(errors)
-    result = {q: np.empty((n,) + shape + (gates,)) for q in FUSED_OUTPUTS if q in outputs}
-    scratch = {q: np.empty((n, gates)) for q in FUSED_OUTPUTS if q not in outputs}
-    for index in np.ndindex(*shape):
-        into = {q: result[q][(slice(None),) + index] if q in result else scratch[q]
-                for q in FUSED_OUTPUTS}                       # (n, gates) views
-        evaluate = _Blocks(_one_scene(scene, index), errors, into, "wind_direction" in outputs)
-        for start in range(0, n, FUSED_BLOCK_TRIALS):
-            evaluate(start, min(n, start + FUSED_BLOCK_TRIALS))
-    return {q: result[q] for q in outputs}
+    ins, geo, noise, dtype = _shaped(scene, errors, scene_draws)
+    table = scene_table(scene)
+    structure = np.array([len(scene.azimuths), int(scene.vertical_beam), n_gates,
+                          CORRECTION_MODELS.index(scene.correction)]
+                         + [int(q in outputs) for q in ("wind_speed", "wind_direction",
+                                                        "vertical_wind", "radial_velocity",
+                                                        "gate_height")], dtype=np.int64)
+    out = {q: np.empty((n, scenes) + ((n_beams,) if q == "radial_velocity" else ())
+                       + (n_gates,), dtype=dtype) if q in outputs else np.empty(
+                           (1, 1, 1) + ((1,) if q == "radial_velocity" else ()), dtype=dtype)
+           for q in FUSED_OUTPUTS}
+    from_east = np.empty_like(out["wind_direction"])
+    per_trial = any(np.shape(g)[0] > 1 for g in geo)        # geometry errors: truth per trial
+    block = FUSED_BLOCK_TRIALS
+    trials = min(n, block)
+    group = max(1, block // trials) if (scene_draws or per_trial) else scenes
+    rows = group * trials if scene_draws else trials
+    cos_trig = np.empty((4, n_beams, rows), dtype=dtype)
+    sin_trig = np.empty_like(cos_trig)
+    scratch = np.empty(trials, dtype=dtype)
+    truth_rows = group * trials if per_trial else scenes
+    beams = np.empty((truth_rows, n_beams, 3), dtype=dtype)
+    profile = np.empty((truth_rows, n_beams, n_gates), dtype=dtype)
+    exponent = np.empty(truth_rows)
+    if not per_trial:                        # the truth of every scene, common to its trials
+        _truth(table, structure, geo, 0, scenes, 0, 1, False, beams, profile, exponent)
+    for t0 in range(0, n, trials):
+        t1 = min(n, t0 + trials)
+        if not scene_draws:                 # the draws' trigonometry, shared by the scenes
+            kernels.ins_trig(ins, table, 0, 1, t0, t1, False, cos_trig, sin_trig, scratch)
+        for s0 in range(0, scenes, group):
+            s1 = min(scenes, s0 + group)
+            if scene_draws:
+                kernels.ins_trig(ins, table, s0, s1, t0, t1, True, cos_trig, sin_trig,
+                                 scratch)
+            if per_trial:
+                _truth(table, structure, geo, s0, s1, t0, t1, True, beams, profile, exponent)
+            kernels.wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile,
+                         geo[2], s0, s1, t0, t1, scene_draws, per_trial,
+                         out["wind_speed"], out["vertical_wind"], out["wind_direction"],
+                         from_east, out["radial_velocity"], out["gate_height"])
+    if "wind_direction" in outputs:
+        _direction(out["wind_direction"], from_east, out["wind_direction"])
+    return {q: out[q].reshape((n,) + shape + out[q].shape[2:]) for q in outputs}
 
 
-def _one_scene(scene, index):
-    """Scene `index` of a batch, with float fields."""
-    return dataclasses.replace(scene, **{
-        name: float(np.broadcast_to(getattr(scene, name), scene.shape)[index])
-        for name in SCENE_FIELDS})
-
-
-class _Blocks:
-    """One call of the model, evaluated block by block (the three kernels of
-    :mod:`uq.physics.fusedkernels` and numpy's SIMD log/exp between them) into ``out``."""
-
-    def __init__(self, scene, errors, out, want_direction):
-        self.scene, self.out, self.want_direction = scene, out, want_direction
-        self.constants = scene_constants(scene)
-        self.column = {name: _column(errors.get(name)) for name in (
-            "lidar_half_cone", "lidar_misalignment", "lidar_height", "ins_sog", "ins_heave",
-            *(f"ins_{key}" for key in _INS_ANGLES))}
-        noise = errors.get("lidar_radial_velocity")
-        self.noise = np.zeros((1, scene.n_beams, len(scene.ranges))) if noise is None \
-            else np.require(noise, dtype=float, requirements="W")
-        # the truth (beams, gate heights) is common to all trials without geometry errors
-        self.fixed_truth = all(len(self.column[name]) == 1 for name in (
-            "lidar_half_cone", "lidar_misalignment", "lidar_height"))
-        block = 1 if self.fixed_truth else FUSED_BLOCK_TRIALS
-        self.geometry_trig = np.empty((2, 2, block))
-        self.beams = np.empty((block, scene.n_beams, 3))
-        self.profile = np.empty((block, scene.n_beams, len(scene.ranges)))
-        self.trig = np.empty((4, 2, FUSED_BLOCK_TRIALS))
-        self.from_east = np.empty((FUSED_BLOCK_TRIALS, len(scene.ranges)))
-        self.from_north = np.empty_like(self.from_east)
-        if self.fixed_truth:
-            self._truth(0, 1)
-
-    def __call__(self, start, stop):
-        if not self.fixed_truth:
-            self._truth(start, stop - start)
-        scene = self.scene
-        for k, key in enumerate(_INS_ANGLES):
-            kernels.angle_trig(self.column[f"ins_{key}"], getattr(scene, key), start, stop,
-                               self.trig[k, 0], self.trig[k, 1])
-        kernels.wind(self.constants, self.beams, self.profile, len(self.beams), self.trig,
-                     self.column["ins_sog"], self.column["ins_heave"], self.noise,
-                     CORRECTION_MODELS.index(scene.correction), start, stop,
-                     self.out["wind_speed"], self.out["vertical_wind"], self.from_north,
-                     self.from_east)
-        if self.want_direction:
-            _direction(self.from_north[:stop - start], self.from_east[:stop - start],
-                       self.out["wind_direction"][start:stop])
-
-    def _truth(self, start, rows):
-        """Beams and the power-law profile U(z) / U_ref of trials start .. start + rows."""
-        scene, trig = self.scene, self.geometry_trig
-        for k, (name, base) in enumerate((("lidar_half_cone", scene.half_cone),
-                                          ("lidar_misalignment", scene.misalignment))):
-            kernels.angle_trig(self.column[name], base, start, start + rows, trig[k, 0],
-                               trig[k, 1])
-        profile = self.profile[:rows]
-        kernels.geometry(self.constants, trig[0], trig[1], self.column["lidar_height"], start,
-                         rows, scene.shear != 0.0, self.beams, self.profile)
-        if scene.shear != 0.0:                      # (z / z_ref)^alpha, SIMD; NaN stays NaN
-            np.log(profile, out=profile)
-            profile *= scene.shear
-            np.exp(profile, out=profile)
+def _truth(table, structure, geo, s0, s1, t0, t1, per_trial, beams, profile, exponent):
+    """True beams and the power-law profile U(z) / U_ref (z / z_ref)^alpha of the rows
+    of a rectangle (:func:`uq.physics.fusedkernels.geometry`); numpy's SIMD log and exp,
+    NaN stays NaN (1 where there is no shear: exp(0 log 1) is exactly 1)."""
+    kernels.geometry(table, structure, geo, s0, s1, t0, t1, per_trial, beams, profile,
+                     exponent)
+    rows = (s1 - s0) * ((t1 - t0) if per_trial else 1)
+    ratio = profile[:rows]
+    np.log(ratio, out=ratio)
+    ratio *= exponent[:rows, None, None]
+    np.exp(ratio, out=ratio)
 
 
 def _direction(from_north, from_east, out):
     """Meteorological direction [deg] in [0, 360) of the "from" vector, into out
-    (as :func:`uq.wind.wind_direction`)."""
+    (as :func:`uq.wind.wind_direction`); complex-step safe for complex input."""
+    if np.iscomplexobj(from_north):
+        out[...] = wind_formulas.wind_direction(-from_north, -from_east)
+        return
     np.arctan2(from_east, from_north, out=out)
     np.multiply(out, 180.0 / math.pi, out=out)
     np.add(out, FULL_CIRCLE_DEG, out=out, where=out < 0.0)
     np.subtract(out, FULL_CIRCLE_DEG, out=out, where=out >= FULL_CIRCLE_DEG)   # -1e-17 + 360
 
 
-def _column(value):
-    """An error as a writable float array of length n (per trial, any stride) or 1
-    (absent or constant: the kernels read element 0)."""
-    if value is None:
-        return np.zeros(1)
-    value = np.asarray(value, dtype=float)
-    value = value if value.ndim == 1 else np.atleast_1d(value).ravel()
-    return value if value.flags.writeable else value.copy()
+def _shaped(scene, errors, scene_draws):
+    """The errors as 3-D arrays (trials, scenes, k) for the kernels, any axis of length
+    1 broadcasting: INS (k = 1 or beams), geometry (k = 1), noise (k = beams x gates);
+    and their common dtype (complex128 if any is complex, else float64)."""
+    scenes = math.prod(scene.shape)
+    s_axis = scene.shape if scene_draws else ()
+    values = {name: np.asarray(errors[name]) for name in (*_INS, *_GEOMETRY, _NOISE)
+              if errors.get(name) is not None}
+    unknown = set(errors) - set(_INS) - set(_GEOMETRY) - {_NOISE}
+    if unknown:
+        raise _Unsupported(f"unknown errors {sorted(unknown)}")
+    dtype = complex if any(np.iscomplexobj(v) for v in values.values()) else float
+    beams, gates = scene.n_beams, len(scene.ranges)
+
+    def laid(name, trailing, k):
+        value = values.get(name)
+        if value is None:
+            return np.zeros((1, 1, 1), dtype=dtype)
+        if value.ndim == 0:
+            return np.full((1, 1, 1), value, dtype=dtype)
+        n = value.shape[0]
+        if value.shape[1:1 + len(s_axis)] != s_axis:
+            raise _Unsupported(name)
+        rest = value.shape[1 + len(s_axis):]
+        if rest not in trailing:
+            raise _Unsupported(name)
+        array = value.reshape((n, scenes if scene_draws else 1, k if rest else 1))
+        return np.require(array, dtype=dtype, requirements="W")
+
+    ins = tuple(laid(name, ((), (1,), (beams,)), beams if _per_beam(values.get(name), len(
+        s_axis)) else 1) for name in _INS)
+    geo = tuple(laid(name, ((),), 1) for name in _GEOMETRY)
+    noise = laid(_NOISE, ((beams, gates),), beams * gates)
+    return ins, geo, noise, dtype
 
 
-def scene_constants(scene):
-    """The scene as one float vector (numba takes no dataclass); read by the accessors
-    at the end of :mod:`uq.physics.fusedkernels`. Computed once per scene (a pseudo-inverse and
-    a few rotations, ~0.4 ms: the model is called once per slice of trials)."""
-    try:
-        return _scene_constants(scene)
-    except TypeError:                       # a field that cannot be hashed: no cache
-        return _scene_constants.__wrapped__(scene)
+def _per_beam(value, scene_axes):
+    return value is not None and value.ndim == 2 + scene_axes and value.shape[-1] > 1
 
 
-@functools.lru_cache(maxsize=256)
-def _scene_constants(scene):
+def scene_table(scene):
+    """The scenes of a batch as rows of one float table (numba takes no dataclass),
+    laid out as :data:`uq.physics.fusedkernels.TABLE` says: the scalars, the slanted
+    beams' azimuths' cos and sin, the true attitude, the least-squares operator, the
+    slant distances and the configured ship-frame beams, shape (scenes, width).
+
+    The least-squares operator (a pseudo-inverse, ~20 us) is computed once per distinct
+    (half-cone, misalignment): a GUM grid of 518,400 scenes has 360 of them."""
+    scenes = math.prod(scene.shape)
+    field = {name: np.broadcast_to(np.asarray(getattr(scene, name), dtype=float),
+                                   scene.shape).reshape(scenes) for name in SCENE_FIELDS}
     azimuths = np.asarray(scene.azimuths, dtype=float)
-    operator = least_squares_operator(scene.nominal_unit_vectors())           # (3, b)
-    slant = slant_distances(scene.ranges, scene.half_cone, len(azimuths),
-                            scene.vertical_beam)                             # (b, g)
-    head = {"n_slanted": len(azimuths), "vertical_beam": int(scene.vertical_beam),
-            "n_gates": len(scene.ranges), "to_north": -math.cos(scene.wind_direction),
-            "to_east": -math.sin(scene.wind_direction)}      # (wind "from": blows to -e)
-    head = [head[name] if name in head else getattr(scene, name) for name in kernels.HEAD]
-    attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
-    return np.concatenate([np.asarray(head, dtype=float), np.cos(azimuths),
-                           np.sin(azimuths), attitude.ravel(),
-                           operator.ravel(), slant.ravel()])
+    n_slanted, n_gates = len(azimuths), len(scene.ranges)
+    geometry = np.stack([field["half_cone"], field["misalignment"]], axis=-1)
+    distinct, index = np.unique(geometry, axis=0, return_inverse=True)
+    units = beam_unit_vectors(distinct[:, 0], azimuths, distinct[:, 1],
+                              scene.vertical_beam)                             # (u, b, 3)
+    operator = least_squares_operator(units)                                  # (u, 3, b)
+    index = index.reshape(-1)
+    slant = slant_distances(scene.ranges, field["half_cone"], n_slanted,
+                            scene.vertical_beam)                             # (S, b, g)
+    attitude = attitude_matrix(field["heading"], field["pitch"], field["roll"])
+    scalars = np.stack([field[name] for name in kernels.TABLE], axis=-1)
+    table = np.concatenate([scalars, np.broadcast_to(np.cos(azimuths), (scenes, n_slanted)),
+                            np.broadcast_to(np.sin(azimuths), (scenes, n_slanted)),
+                            attitude.reshape(scenes, 9), operator[index].reshape(scenes, -1),
+                            slant.reshape(scenes, -1), units[index].reshape(scenes, -1)],
+                           axis=1)
+    return np.ascontiguousarray(table)

@@ -1,16 +1,25 @@
 """Compiled (numba) loops of :mod:`uq.physics.fused`: the measurement model trial by trial.
 
-Three kernels work on a block of trials; between them numpy's SIMD ``log`` and ``exp``
-evaluate the power law for the whole block (:func:`uq.fused.measurement_model`):
+The loops run over a *rectangle* of scenes x trials (scenes ``[s0, s1)``, trials
+``[t0, t1)``); numpy's SIMD ``log`` and ``exp`` evaluate the power law between them
+(:func:`uq.physics.fused.measurement_model`):
 
-1. :func:`angle_trig`: cos and sin of configured angle + error, by the angle-addition
-   theorem with the error's sine and cosine from their Taylor polynomials. The loop
-   has no calls, so it compiles to SIMD code (libm's sin/cos cost ~10 ns each, and
-   numba has no vector math library here). Errors beyond :data:`SMALL_ANGLE` use libm.
+1. :func:`ins_trig`: cos and sin of each INS angle *error* (heading, pitch, roll, course),
+   from their Taylor polynomials, once per trial and beam reading. With common draws the
+   scenes of a batch share them (the work that depends only on the draws); each scene
+   then adds its own angle by the addition theorem, four multiplications. The loop has
+   no calls, so it compiles to SIMD code (libm's sin/cos cost ~10 ns each, and numba has
+   no vector math library here). Errors beyond :data:`SMALL_ANGLE` use libm.
 2. :func:`geometry`: earth-frame unit vectors of the true beams (Eq. 1 of [1], rotated
-   by the true attitude) and the ratio z / z_ref of each beam's true gate heights.
+   by the true attitude) and the ratio z / z_ref of each beam's true gate heights, per
+   scene (no geometry error: the truth is common to all trials) or per trial.
 3. :func:`wind`: true radial velocities, the INS reading, the correction (Eq. 13 of
-   [1]) and the reconstructed wind.
+   [1]; or point-wise, each beam with its own reading, when an INS error has one value
+   per beam) and the outputs: the reconstructed wind, the motion-corrected radial
+   velocities and the mean true gate heights.
+
+Every kernel is compiled for float64 (Monte Carlo) and complex128 (complex-step GUM:
+the same arithmetic carries the imaginary perturbation; comparisons use real parts).
 
 Conventions (as in :mod:`uq.physics.rotation`, :mod:`uq.physics.beams`, :mod:`uq.physics.wind`,
 :mod:`uq.physics.correction`): earth frame (north, east, up); ship frame (bow, starboard, up);
@@ -21,11 +30,13 @@ starboard down; beams ``(sin t cos(m + a), sin t sin(m + a), cos t)``; wind dire
 References
 ----------
 .. [1] Rubio, H. and Gottschall, J. (2022). J. Phys.: Conf. Ser. 2362 012034.
+.. [2] Matavar, A. (2024). Wind field reconstruction from floating lidars. MSc thesis,
+   TU Delft (point-wise correction, Sec. 3.2).
 """
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
 
 from uq.constants import HYPOT_SAFE_MAX, HYPOT_SAFE_MIN, SMALL_ANGLE
 
@@ -35,218 +46,467 @@ _DEG = math.pi / 180.0
 _S = tuple((-1) ** k / math.factorial(2 * k + 1) for k in range(8))
 _C = tuple((-1) ** k / math.factorial(2 * k) for k in range(9))
 
-# explicit signatures, any-layout arrays: one compilation (cached on disk) for the
-# strided columns of the input matrix and the length-1 placeholders alike
-_V, _M, _T = "float64[:]", "float64[:, :]", "float64[:, :, :]"
+#: Columns of the scene table (:func:`uq.physics.fused.scene_table`), one row per scene:
+#: these scalars, then the cosines and sines of the slanted beams' azimuths, the true
+#: attitude (3 x 3, row-major), the least-squares operator A^+ (3 x b), the slant
+#: distances (b x g) and the configured ship-frame beams (b x 3) (:func:`_offsets`).
+TABLE = ("lidar_height", "wind_speed", "reference_height", "shear", "wind_direction",
+         "vertical_wind", "sog", "cog", "heave", "heading", "pitch", "roll", "half_cone",
+         "misalignment")
+(_LIDAR_HEIGHT, _SPEED, _REFERENCE, _SHEAR, _DIRECTION, _VERTICAL, _SOG, _COG, _HEAVE,
+ _HEADING, _PITCH, _ROLL, _HALF_CONE, _MISALIGNMENT) = range(len(TABLE))
+#: The structure vector (int64): beams, gates, correction model and wanted outputs.
+STRUCTURE = ("n_slanted", "vertical_beam", "n_gates", "model", "want_speed", "want_direction",
+             "want_vertical", "want_radial", "want_height")
+#: The INS errors, in the order of the ``ins`` tuple; the angles among them (degrees).
+INS_ORDER = ("heading", "pitch", "roll", "sog", "cog", "heave")
+_INS_ANGLES = (0, 1, 2, 4)          # heading, pitch, roll, cog in INS_ORDER
+#: The geometry errors, in the order of the ``geo`` tuple.
+GEO_ORDER = ("half_cone", "misalignment", "height")
 
 
-@njit(cache=True)
-def _reading_rotation(model, trig, j, nominal):
+def _signatures(kind):
+    """Explicit signatures, float64 and complex128, any-layout arrays: one compilation
+    each (cached on disk) for strided views and length-1 placeholders alike."""
+    out = []
+    for dtype in (types.float64, types.complex128):
+        a1, a2, a3, a4 = (types.Array(dtype, d, "A") for d in (1, 2, 3, 4))
+        c1 = types.Array(dtype, 1, "C")
+        table = types.Array(types.float64, 2, "C")
+        ints = types.Array(types.int64, 1, "C")
+        ins, geo = types.UniTuple(a3, 6), types.UniTuple(a3, 3)
+        i8, b1 = types.int64, types.boolean
+        if kind == "trig":
+            out.append(types.void(ins, table, i8, i8, i8, i8, b1, a3, a3, c1))
+        elif kind == "geometry":
+            out.append(types.void(table, ints, geo, i8, i8, i8, i8, b1, a3, a3,
+                                  types.Array(types.float64, 1, "C")))
+        else:
+            out.append(types.void(table, ints, ins, a3, a3, a3, a3, a3, a3, i8, i8, i8, i8,
+                                  b1, b1, a3, a3, a3, a3, a4, a3))
+    return out
+
+
+@njit(inline="always")
+def _taylor(x):
+    """(cos x, sin x) of a small angle x [rad] from their Taylor polynomials."""
+    x2 = x * x
+    sin_x = x * (_S[0] + x2 * (_S[1] + x2 * (_S[2] + x2 * (_S[3] + x2 * (
+        _S[4] + x2 * (_S[5] + x2 * (_S[6] + x2 * _S[7])))))))
+    cos_x = _C[0] + x2 * (_C[1] + x2 * (_C[2] + x2 * (_C[3] + x2 * (_C[4] + x2 * (
+        _C[5] + x2 * (_C[6] + x2 * (_C[7] + x2 * _C[8])))))))
+    return cos_x, sin_x
+
+
+@njit(inline="always")
+def _angle(base, cos_base, sin_base, x, cos_x, sin_x):
+    """cos and sin of base + x [rad]: the addition theorem with the error's (cos_x,
+    sin_x) from :func:`_taylor` where |x| <= SMALL_ANGLE, libm beyond (and for NaN)."""
+    if abs(x) <= SMALL_ANGLE:
+        return cos_base * cos_x - sin_base * sin_x, sin_base * cos_x + cos_base * sin_x
+    return np.cos(base + x), np.sin(base + x)
+
+
+@njit(inline="always")
+def _pick(array, i, s, k):
+    """Element (i, s, k) of an error array whose axes of length 1 broadcast."""
+    return array[i if array.shape[0] > 1 else 0, s if array.shape[1] > 1 else 0,
+                 k if array.shape[2] > 1 else 0]
+
+
+@njit(_signatures("trig"), cache=True)
+def ins_trig(ins, table, s0, s1, t0, t1, per_scene, cos_out, sin_out, scratch):
+    """cos and sin of the INS angle errors (heading, pitch, roll, course) of trials
+    [t0, t1) into out[a, k, row] (a in that order, k the reading); the row is the
+    trial's within [t0, t1), and with `per_scene` (independent draws per scene)
+    (s - s0) (t1 - t0) + (i - t0). Errors constant over trials are skipped (the wind
+    kernel takes libm for them). `scratch` holds at least t1 - t0 values."""
+    count = t1 - t0
+    for a in range(4):
+        error = ins[_INS_ANGLES[a]]
+        if error.shape[0] == 1:
+            continue
+        scenes = s1 - s0 if per_scene else 1
+        for index in range(scenes):
+            s = s0 + index
+            for k in range(error.shape[2]):
+                at = index * count
+                for j in range(count):            # gather the (strided) column first:
+                    scratch[j] = _pick(error, t0 + j, s, k) * _DEG   # unit stride: SIMD
+                for j in range(count):            # no calls, unit stride: SIMD
+                    cos_x, sin_x = _taylor(scratch[j])
+                    cos_out[a, k, at + j] = cos_x
+                    sin_out[a, k, at + j] = sin_x
+
+
+@njit(inline="always")
+def _offsets(n_slanted, n_beams, n_gates):
+    """Columns of the azimuths, attitude, operator, slant distances and configured beams
+    in a row of the scene table, and the row's length."""
+    azimuths = len(TABLE)
+    attitude = azimuths + 2 * n_slanted
+    operator = attitude + 9
+    slant = operator + 3 * n_beams
+    units = slant + n_beams * n_gates
+    return azimuths, attitude, operator, slant, units, units + 3 * n_beams
+
+
+def table_width(n_slanted, n_beams, n_gates):
+    """Length of a row of the scene table."""
+    return _offsets.py_func(n_slanted, n_beams, n_gates)[-1]
+
+
+@njit(_signatures("geometry"), cache=True)
+def geometry(table, structure, geo, s0, s1, t0, t1, per_trial, beams, ratio, shear):
+    """True earth-frame beams into beams[row] (b, 3), z / z_ref of their gates into
+    ratio[row] (b, g) and the scene's shear exponent into shear[row]; NaN at a height
+    <= 0 (outside the power law). Rows: with `per_trial`, (s - s0) (t1 - t0) + (i - t0)
+    for the trials of the rectangle; else one row per scene, s - s0, with the errors of
+    trial t0 (constant over trials). Without shear the ratio is not needed: 1 (or NaN).
+    Geometry errors constant over trials take libm's cos and sin (as one reading does).
+    """
+    n_slanted, n_gates = structure[0], structure[2]
+    n_beams = n_slanted + structure[1]
+    azimuths, attitude, _, slant, _, _ = _offsets(n_slanted, n_beams, n_gates)
+    row = 0
+    for s in range(s0, s1):
+        scene = table[s]
+        cone, misalignment = scene[_HALF_CONE], scene[_MISALIGNMENT]
+        cos_cone, sin_cone = math.cos(cone), math.sin(cone)
+        cos_mis, sin_mis = math.cos(misalignment), math.sin(misalignment)
+        reference, exponent = scene[_REFERENCE], scene[_SHEAR]
+        for i in range(t0, t1 if per_trial else t0 + 1):
+            x_cone = _pick(geo[0], i, s, 0) * _DEG
+            x_mis = _pick(geo[1], i, s, 0) * _DEG
+            if geo[0].shape[0] == 1:
+                cos_t, sin_t = np.cos(cone + x_cone), np.sin(cone + x_cone)
+            else:
+                cos_x, sin_x = _taylor(x_cone)
+                cos_t, sin_t = _angle(cone, cos_cone, sin_cone, x_cone, cos_x, sin_x)
+            if geo[1].shape[0] == 1:
+                cos_m, sin_m = np.cos(misalignment + x_mis), np.sin(misalignment + x_mis)
+            else:
+                cos_x, sin_x = _taylor(x_mis)
+                cos_m, sin_m = _angle(misalignment, cos_mis, sin_mis, x_mis, cos_x, sin_x)
+            base = scene[_LIDAR_HEIGHT] + _pick(geo[2], i, s, 0)
+            for b in range(n_beams):
+                if b < n_slanted:
+                    cos_a, sin_a = scene[azimuths + b], scene[azimuths + n_slanted + b]
+                    x = sin_t * (cos_m * cos_a - sin_m * sin_a)       # sin t cos(m + a)
+                    y = sin_t * (sin_m * cos_a + cos_m * sin_a)       # sin t sin(m + a)
+                    z = cos_t
+                else:
+                    x, y, z = 0.0, 0.0, 1.0
+                for k in range(3):
+                    beams[row, b, k] = scene[attitude + 3 * k] * x + \
+                        scene[attitude + 3 * k + 1] * y + scene[attitude + 3 * k + 2] * z
+                for g in range(n_gates):
+                    height = base + scene[slant + b * n_gates + g] * beams[row, b, 2]
+                    if not height.real > 0:      # outside the model (also a NaN height)
+                        ratio[row, b, g] = np.nan
+                    elif exponent != 0.0:
+                        ratio[row, b, g] = height / reference
+                    else:
+                        ratio[row, b, g] = 1.0
+            shear[row] = exponent
+            row += 1
+
+
+@njit(inline="always")
+def _rotation(model, ch, sh, cp, sp, cr, sr, cos_nominal, sin_nominal):
     """Row-major body-to-earth rotation the correction believes: Rz(heading) Ry(pitch)
     Rx(roll) of the INS reading (tilt2d, full), its heading alone (yaw) or the
     configured heading (none) (:mod:`uq.physics.rotation`)."""
     if model == 0:
-        ch, sh, cp, sp, cr, sr = nominal[0], nominal[1], 1.0, 0.0, 1.0, 0.0
+        ch, sh, cp, sp, cr, sr = cos_nominal, sin_nominal, 1.0, 0.0, 1.0, 0.0
     elif model == 1:
-        ch, sh, cp, sp, cr, sr = trig[0, 0, j], trig[0, 1, j], 1.0, 0.0, 1.0, 0.0
-    else:
-        ch, sh = trig[0, 0, j], trig[0, 1, j]
-        cp, sp, cr, sr = trig[1, 0, j], trig[1, 1, j], trig[2, 0, j], trig[2, 1, j]
+        cp, sp, cr, sr = 1.0, 0.0, 1.0, 0.0
     return (ch * cp, ch * sp * sr - sh * cr, -ch * sp * cr - sh * sr,
             sh * cp, sh * sp * sr + ch * cr, -sh * sp * cr + ch * sr,
             sp, -cp * sr, cp * cr)
 
 
-@njit(cache=True)
-def _truth(beams, profile, speed_ref, to_north, to_east, w, ship, out):
-    """True radial velocities (b, g): U(z) (n_h . e_wind) + n_up w - n . u_ship."""
-    for b in range(out.shape[0]):
-        along = beams[b, 0] * to_north + beams[b, 1] * to_east
-        moving = beams[b, 0] * ship[0] + beams[b, 1] * ship[1] + beams[b, 2] * ship[2]
-        for g in range(out.shape[1]):
-            out[b, g] = speed_ref * profile[b, g] * along + beams[b, 2] * w - moving
-
-
-@njit(cache=True)
-def _solve(operator, radial, out):
-    """out (3, g) = A^+ radial: the least-squares lidar-frame wind of each gate."""
-    for g in range(radial.shape[1]):
-        for k in range(3):
-            total = 0.0
-            for b in range(radial.shape[0]):
-                total += operator[k, b] * radial[b, g]
-            out[k, g] = total
-
-
-@njit(cache=True)
+@njit(inline="always")
 def _hypot(x, y):
-    """sqrt(x^2 + y^2), libm's hypot where the squares could over- or underflow (as
-    :func:`uq.complexstep.hypot`)."""
-    radius = math.sqrt(x * x + y * y)
-    return radius if HYPOT_SAFE_MIN < radius < HYPOT_SAFE_MAX else math.hypot(x, y)
+    """sqrt(x^2 + y^2); for real input libm's hypot where the squares could over- or
+    underflow (as :func:`uq.complexstep.hypot`)."""
+    radius = np.sqrt(x * x + y * y)
+    if x.imag == 0.0 and y.imag == 0.0 and not HYPOT_SAFE_MIN < radius.real < HYPOT_SAFE_MAX:
+        radius = math.hypot(x.real, y.real)
+    return radius
 
 
-#: The scene vector (:func:`uq.fused.scene_constants`) starts with these scalars, by
-#: index; then come the azimuths' cosines and sines, the true attitude (3 x 3), the
-#: least-squares operator (3 x b) and the slant ranges (b x g).
-HEAD = ("n_slanted", "vertical_beam", "n_gates", "lidar_height", "wind_speed",
-        "reference_height", "to_north", "to_east", "vertical_wind", "sog", "cog", "heave",
-        "heading")
-_HEAD = len(HEAD)
-
-
-@njit(cache=True)
-def _azimuths(constants):
-    return constants[_HEAD:_HEAD + 2 * int(constants[0])]
-
-
-@njit(cache=True)
-def _attitude(constants):
-    at = _HEAD + 2 * int(constants[0])
-    return constants[at:at + 9].reshape(3, 3)
-
-
-@njit(cache=True)
-def _operator(constants):
-    n_beams = int(constants[0]) + int(constants[1])
-    at = _HEAD + 9 + 2 * int(constants[0])
-    return constants[at:at + 3 * n_beams].reshape(3, n_beams)
-
-
-@njit(cache=True)
-def _slant(constants):
-    n_beams = int(constants[0]) + int(constants[1])
-    at = _HEAD + 9 + 2 * int(constants[0]) + 3 * n_beams
-    return constants[at:at + n_beams * int(constants[2])].reshape(n_beams, int(constants[2]))
-
-
-@njit(f"void({_V}, float64, int64, int64, float64[::1], float64[::1])", cache=True)
-def angle_trig(error, base, start, stop, cos_out, sin_out):
-    """cos and sin of ``base + error[i] * pi / 180`` for i in [start, stop) into
-    out[:stop - start]; an error of length 1 is the same for every trial.
-
-    base [rad]; error [deg].
-    """
-    count = stop - start
-    if error.shape[0] == 1:
-        angle = base + error[0] * _DEG
-        cos_out[:count], sin_out[:count] = math.cos(angle), math.sin(angle)
-        return
-    cos_base, sin_base = math.cos(base), math.sin(base)
-    for j in range(count):                        # gather the (strided) column first:
-        cos_out[j] = error[start + j] * _DEG      # unit stride lets the next loop be SIMD
-    for j in range(count):                        # no calls, unit stride: SIMD
-        x = cos_out[j]
-        x2 = x * x
-        sin_x = x * (_S[0] + x2 * (_S[1] + x2 * (_S[2] + x2 * (_S[3] + x2 * (
-            _S[4] + x2 * (_S[5] + x2 * (_S[6] + x2 * _S[7])))))))
-        cos_x = _C[0] + x2 * (_C[1] + x2 * (_C[2] + x2 * (_C[3] + x2 * (_C[4] + x2 * (
-            _C[5] + x2 * (_C[6] + x2 * (_C[7] + x2 * _C[8])))))))
-        cos_out[j] = cos_base * cos_x - sin_base * sin_x          # cos(b + x)
-        sin_out[j] = sin_base * cos_x + cos_base * sin_x          # sin(b + x)
-    for j in range(count):                        # large errors (and NaN): libm
-        x = error[start + j] * _DEG
-        if not abs(x) <= SMALL_ANGLE:
-            cos_out[j], sin_out[j] = math.cos(base + x), math.sin(base + x)
-
-
-@njit(f"void(float64[::1], {_M}, {_M}, {_V}, int64, int64, boolean, {_T}, {_T})", cache=True)
-def geometry(constants, cone, misalignment, height_error, start, rows, shear, beams, ratio):
-    """True earth-frame beams into beams[j] (b, 3) and z / z_ref of their gates into
-    ratio[j] (b, g) for trials start + j, j < rows; NaN at a height <= 0 (outside
-    the power law). ``cone`` and ``misalignment`` hold (cos, sin) rows from
-    :func:`angle_trig`. Without ``shear`` the ratio is not needed: 1 (or NaN)."""
-    n_slanted, vertical_beam, n_gates = int(constants[0]), int(constants[1]), int(constants[2])
-    lidar_height, reference_height = constants[3], constants[5]
-    azimuths, attitude, slant = _azimuths(constants), _attitude(constants), _slant(constants)
-    for j in range(rows):
-        base = lidar_height + height_error[start + j if height_error.shape[0] > 1 else 0]
-        for b in range(n_slanted + vertical_beam):
-            if b < n_slanted:
-                cos_a, sin_a = azimuths[b], azimuths[n_slanted + b]
-                cos_m, sin_m = misalignment[0, j], misalignment[1, j]
-                x = cone[1, j] * (cos_m * cos_a - sin_m * sin_a)          # sin t cos(m + a)
-                y = cone[1, j] * (sin_m * cos_a + cos_m * sin_a)          # sin t sin(m + a)
-                z = cone[0, j]
-            else:
-                x, y, z = 0.0, 0.0, 1.0
+@njit(inline="always")
+def _solve3(m, rhs):
+    """Solution of the 3 x 3 system m x = rhs (Gaussian elimination with partial
+    pivoting on the real parts, as LAPACK's gesv; m and rhs are overwritten)."""
+    for c in range(3):
+        pivot = c
+        for r in range(c + 1, 3):
+            if abs(m[r, c].real) > abs(m[pivot, c].real):
+                pivot = r
+        if pivot != c:
             for k in range(3):
-                beams[j, b, k] = attitude[k, 0] * x + attitude[k, 1] * y + attitude[k, 2] * z
-            for g in range(n_gates):
-                height = base + slant[b, g] * beams[j, b, 2]
-                if not height > 0:               # outside the model (also a NaN height)
-                    ratio[j, b, g] = math.nan
-                else:
-                    ratio[j, b, g] = height / reference_height if shear else 1.0
+                m[c, k], m[pivot, k] = m[pivot, k], m[c, k]
+            rhs[c], rhs[pivot] = rhs[pivot], rhs[c]
+        for r in range(c + 1, 3):
+            factor = m[r, c] / m[c, c]
+            for k in range(c, 3):
+                m[r, k] -= factor * m[c, k]
+            rhs[r] -= factor * rhs[c]
+    rhs[2] = rhs[2] / m[2, 2]
+    rhs[1] = (rhs[1] - m[1, 2] * rhs[2]) / m[1, 1]
+    rhs[0] = (rhs[0] - m[0, 1] * rhs[1] - m[0, 2] * rhs[2]) / m[0, 0]
 
 
-@njit(f"void(float64[::1], {_T}, {_T}, int64, {_T}, {_V}, {_V}, {_T}, int64, int64, int64, "
-      f"{_M}, {_M}, {_M}, {_M})", cache=True)
-def wind(constants, beams, profile, rows, trig, sog_error, heave_error, noise, model, start,
-         stop, speed, vertical, from_north, from_east):
-    """Reconstructed wind of trials [start, stop): speed, vertical wind and the "from"
-    vector (north, east) [m s-1], each (n, g) (from_* rows relative to start).
+@njit(inline="always")
+def _gate_heights(scene, beams, r, height_error, n_slanted, n_gates, at_slant, out):
+    """Mean true height of the slanted beams at each gate [m] (as the numpy model:
+    lidar height + error, plus slant distance x the true beam's up component)."""
+    base = scene[_LIDAR_HEIGHT] + height_error
+    for g in range(n_gates):
+        total = base + scene[at_slant + g] * beams[r, 0, 2]
+        for b in range(1, n_slanted):
+            total += base + scene[at_slant + b * n_gates + g] * beams[r, b, 2]
+        out[g] = total / n_slanted
 
-    ``profile`` (rows, b, g) is U(z) / U_ref of each beam's gates (1 row: the same for
-    every trial); ``trig`` (4, 2, count) the (cos, sin) of the INS heading, pitch, roll
-    and course; ``model`` 0 none, 1 yaw, 2 tilt2d, 3 full (:mod:`uq.physics.correction`).
+
+@njit(_signatures("wind"), cache=True)
+def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
+         s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
+         radial, gate_height):
+    """The outputs of scenes [s0, s1) x trials [t0, t1), into arrays (n, S, ...).
+
+    ``beams`` and ``profile`` (U(z) / U_ref of each beam's gates) are rows of
+    :func:`geometry`: one per trial of the rectangle (`per_trial`) or one per scene
+    (row s: the truth common to all trials). ``cos_trig``, ``sin_trig`` are the INS
+    angle errors of :func:`ins_trig` (rows per trial, or per scene and trial with
+    `per_scene`). Where an INS error has one value per beam (``beam`` correlation or a
+    correlation time) each beam is corrected with its own reading, then least squares
+    (point-wise, [2]; ``tilt2d`` then projects as Eq. 13 of [1] with the mean reading,
+    as :func:`uq.physics.correction.reconstruct_wind`); otherwise Eq. 13 of [1] with one
+    reading. ``from_north``, ``from_east`` get the "from" vector (the direction is then
+    taken by numpy's SIMD arctan2). Model: 0 none, 1 yaw, 2 tilt2d, 3 full.
 
     One long loop on purpose: split into helper functions for the per-trial truth and
     least squares it ran 1.5x slower (57 -> 87 ns per trial on floating_lidar_full),
     as the values then go through memory instead of registers.
     """
-    n_slanted, vertical_beam, n_gates = int(constants[0]), int(constants[1]), int(constants[2])
+    n_slanted, vertical_beam, n_gates, model = structure[0], structure[1], structure[2], \
+        structure[3]
+    want_speed, want_direction, want_vertical = structure[4], structure[5], structure[6]
+    want_radial, want_height = structure[7], structure[8]
     n_beams = n_slanted + vertical_beam
-    speed_ref, to_north, to_east, w = constants[4], constants[6], constants[7], constants[8]
-    sog0, cog0, heave0, heading0 = constants[9], constants[10], constants[11], constants[12]
-    true_ship = (sog0 * math.cos(cog0), sog0 * math.sin(cog0), heave0)
-    operator = _operator(constants)
-    nominal = (math.cos(heading0), math.sin(heading0))
-    truth = np.empty((n_beams, n_gates))             # true radial velocities of a trial
-    lidar_frame = np.empty((3, n_gates))             # A^+ truth: the noise-free wind
-    for i in range(start, stop):
-        j = i - start
-        r = j if rows > 1 else 0
-        row = i if noise.shape[0] > 1 else 0
-        if rows > 1:                                 # this trial's true radial velocities
+    _, _, at_operator, at_slant, at_units, _ = _offsets(n_slanted, n_beams, n_gates)
+    pointwise = False
+    for a in range(6):
+        pointwise = pointwise or ins[a].shape[2] > 1
+    has_noise = noise.shape[2] > 1                  # (absent: a (1, 1, 1) placeholder)
+    zero = beams[0, 0, 0] * 0.0                      # 0 of the kernel's number type
+    truth = np.full((n_beams, n_gates), zero)        # true radial velocities of a trial
+    lidar_frame = np.full((3, n_gates), zero)        # A^+ truth: the noise-free wind
+    heights = np.full(n_gates, zero)                 # mean true gate heights
+    cos_read = np.full((4, n_beams), zero)           # (cos, sin) of each reading's angles
+    sin_read = np.full((4, n_beams), zero)
+    cos_fixed = np.full((4, n_beams), zero)          # ... of readings constant over trials
+    sin_fixed = np.full((4, n_beams), zero)
+    cos_base, sin_base, base = np.empty(4), np.empty(4), np.empty(4)
+    normal = np.full((n_beams, 3), zero)             # point-wise: believed earth beams
+    along = np.full(n_beams, zero)                   # ... the ship velocity along them
+    mean = np.full(6, zero)                          # ... and the mean reading (tilt2d)
+    matrix = np.full((3, 3), zero)
+    rhs = np.full(3, zero)
+    one = zero + 1.0
+    mean_rot = _rotation(3, one, zero, one, zero, one, zero, 1.0, 0.0)
+    mean_ship = (zero, zero)
+    count = t1 - t0
+    for s in range(s0, s1):
+        scene = table[s]
+        speed_ref, w = scene[_SPEED], scene[_VERTICAL]
+        to_north, to_east = -math.cos(scene[_DIRECTION]), -math.sin(scene[_DIRECTION])
+        sog0, cog0, heave0, heading0 = scene[_SOG], scene[_COG], scene[_HEAVE], scene[_HEADING]
+        true_ship = (sog0 * math.cos(cog0), sog0 * math.sin(cog0), heave0)
+        cos_nominal, sin_nominal = math.cos(heading0), math.sin(heading0)
+        base[0], base[1], base[2], base[3] = heading0, scene[_PITCH], scene[_ROLL], cog0
+        operator = scene[at_operator:at_operator + 3 * n_beams].reshape(3, n_beams)
+        units = scene[at_units:at_units + 3 * n_beams].reshape(n_beams, 3)
+        for a in range(4):
+            cos_base[a], sin_base[a] = math.cos(base[a]), math.sin(base[a])
+            error = ins[_INS_ANGLES[a]]
+            if error.shape[0] == 1:          # a reading constant over trials: libm
+                for k in range(error.shape[2]):
+                    angle = base[a] + _pick(error, 0, s, k) * _DEG
+                    cos_fixed[a, k], sin_fixed[a, k] = np.cos(angle), np.sin(angle)
+        if not per_trial:                    # one truth for all trials: A^+ truth once
+            r = s
             for b in range(n_beams):
-                along = beams[r, b, 0] * to_north + beams[r, b, 1] * to_east
-                moving = (beams[r, b, 0] * true_ship[0] + beams[r, b, 1] * true_ship[1]
-                          + beams[r, b, 2] * true_ship[2])
+                along_wind = beams[r, b, 0] * to_north + beams[r, b, 1] * to_east
+                moving = beams[r, b, 0] * true_ship[0] + beams[r, b, 1] * true_ship[1] + \
+                    beams[r, b, 2] * true_ship[2]
                 for g in range(n_gates):                          # U(z) (n_h . e) + n_up w
-                    truth[b, g] = speed_ref * profile[r, b, g] * along + beams[r, b, 2] * w \
-                        - moving
-        elif i == start:                             # one truth for all: A^+ truth once
-            _truth(beams[0], profile[0], speed_ref, to_north, to_east, w, true_ship, truth)
-            _solve(operator, truth, lidar_frame)
-        if model != 0 or i == start:             # none: the configured heading, fixed
-            rotation = _reading_rotation(model, trig, j, nominal)
-        sog = sog0 + sog_error[i if sog_error.shape[0] > 1 else 0]
-        heave = heave0 + heave_error[i if heave_error.shape[0] > 1 else 0]
-        moving = model != 0
-        ship = (sog * trig[3, 0, j] if moving else 0.0, sog * trig[3, 1, j] if moving else 0.0,
-                heave if model == 3 else 0.0)
-        for g in range(n_gates):                     # the lidar-frame wind A^+ v
-            if rows > 1:                             # v = truth + noise
-                x = y = z = 0.0
+                    truth[b, g] = speed_ref * profile[r, b, g] * along_wind + \
+                        beams[r, b, 2] * w - moving
+            for g in range(n_gates):
+                for k in range(3):
+                    total = zero
+                    for b in range(n_beams):
+                        total += operator[k, b] * truth[b, g]
+                    lidar_frame[k, g] = total
+            if want_height:
+                _gate_heights(scene, beams, r, _pick(height_error, t0, s, 0), n_slanted,
+                              n_gates, at_slant, heights)
+        for i in range(t0, t1):
+            j = i - t0
+            tr = (s - s0) * count + j if per_scene else j
+            if per_trial:                           # this trial's true radial velocities
+                r = (s - s0) * count + j
                 for b in range(n_beams):
-                    value = truth[b, g] + noise[row, b, g]
-                    x += operator[0, b] * value
-                    y += operator[1, b] * value
-                    z += operator[2, b] * value
-            else:                                    # A^+ truth + A^+ noise
-                x, y, z = lidar_frame[0, g], lidar_frame[1, g], lidar_frame[2, g]
+                    along_wind = beams[r, b, 0] * to_north + beams[r, b, 1] * to_east
+                    moving = (beams[r, b, 0] * true_ship[0] + beams[r, b, 1] * true_ship[1]
+                              + beams[r, b, 2] * true_ship[2])
+                    for g in range(n_gates):
+                        truth[b, g] = speed_ref * profile[r, b, g] * along_wind + \
+                            beams[r, b, 2] * w - moving
+                if want_height:
+                    _gate_heights(scene, beams, r, _pick(height_error, i, s, 0), n_slanted,
+                                  n_gates, at_slant, heights)
+            if want_height:
+                for g in range(n_gates):
+                    gate_height[i, s, g] = heights[g]
+            for a in range(4):                       # the readings' cos and sin
+                error = ins[_INS_ANGLES[a]]
+                for k in range(error.shape[2]):
+                    if error.shape[0] == 1:
+                        cos_read[a, k], sin_read[a, k] = cos_fixed[a, k], sin_fixed[a, k]
+                    else:
+                        cos_read[a, k], sin_read[a, k] = _angle(
+                            base[a], cos_base[a], sin_base[a], _pick(error, i, s, k) * _DEG,
+                            cos_trig[a, k, tr], sin_trig[a, k, tr])
+            if not pointwise:
+                # ---- one reading per scan: Eq. 13 [1]
+                if model == 0:                       # none: the configured heading, fixed
+                    rot = _rotation(0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, cos_nominal, sin_nominal)
+                else:
+                    rot = _rotation(model, cos_read[0, 0], sin_read[0, 0], cos_read[1, 0],
+                                    sin_read[1, 0], cos_read[2, 0], sin_read[2, 0],
+                                    cos_nominal, sin_nominal)
+                sog = sog0 + _pick(ins[3], i, s, 0)
+                heave = heave0 + _pick(ins[5], i, s, 0)
+                moving = model != 0
+                ship = (sog * cos_read[3, 0] if moving else zero,
+                        sog * sin_read[3, 0] if moving else zero,
+                        heave if model == 3 else zero)
+                for g in range(n_gates):                 # the lidar-frame wind A^+ v
+                    if per_trial:                        # v = truth + noise
+                        x = y = z = zero
+                        for b in range(n_beams):
+                            value = truth[b, g] + _pick(noise, i, s, b * n_gates + g) \
+                                if has_noise else truth[b, g]
+                            x += operator[0, b] * value
+                            y += operator[1, b] * value
+                            z += operator[2, b] * value
+                    else:                                # A^+ truth + A^+ noise
+                        x, y, z = lidar_frame[0, g], lidar_frame[1, g], lidar_frame[2, g]
+                        if has_noise:
+                            for b in range(n_beams):
+                                value = _pick(noise, i, s, b * n_gates + g)
+                                x += operator[0, b] * value
+                                y += operator[1, b] * value
+                                z += operator[2, b] * value
+                    north = rot[0] * x + rot[1] * y + ship[0]                # Eq. 13 [1]
+                    east = rot[3] * x + rot[4] * y + ship[1]
+                    up = z
+                    if model == 3:
+                        north += rot[2] * z
+                        east += rot[5] * z
+                        up = rot[6] * x + rot[7] * y + rot[8] * z + ship[2]
+                    if want_speed:
+                        speed[i, s, g] = _hypot(north, east)
+                    if want_vertical:
+                        vertical[i, s, g] = up
+                    if want_direction:
+                        from_north[i, s, g], from_east[i, s, g] = -north, -east
+                if want_radial:        # measured + (R n_lidar) . ship: motion-free radial
+                    for b in range(n_beams):
+                        e0 = rot[0] * units[b, 0] + rot[1] * units[b, 1] + rot[2] * units[b, 2]
+                        e1 = rot[3] * units[b, 0] + rot[4] * units[b, 1] + rot[5] * units[b, 2]
+                        e2 = rot[6] * units[b, 0] + rot[7] * units[b, 1] + rot[8] * units[b, 2]
+                        removed = e0 * ship[0] + e1 * ship[1] + e2 * ship[2]
+                        for g in range(n_gates):
+                            measured = truth[b, g] + _pick(noise, i, s, b * n_gates + g) \
+                                if has_noise else truth[b, g]
+                            radial[i, s, b, g] = measured + removed
+                continue
+            # ---- a reading per beam: point-wise correction, then least squares [2]
+            for b in range(n_beams):
+                if model == 0:
+                    rot = _rotation(0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, cos_nominal, sin_nominal)
+                else:
+                    kh = b if ins[0].shape[2] > 1 else 0
+                    kp = b if ins[1].shape[2] > 1 else 0
+                    kr = b if ins[2].shape[2] > 1 else 0
+                    rot = _rotation(model, cos_read[0, kh], sin_read[0, kh], cos_read[1, kp],
+                                    sin_read[1, kp], cos_read[2, kr], sin_read[2, kr],
+                                    cos_nominal, sin_nominal)
+                for k in range(3):
+                    normal[b, k] = rot[3 * k] * units[b, 0] + rot[3 * k + 1] * units[b, 1] \
+                        + rot[3 * k + 2] * units[b, 2]
+                if model == 0:
+                    along[b] = zero
+                else:
+                    kc = b if ins[4].shape[2] > 1 else 0
+                    sog = sog0 + _pick(ins[3], i, s, b)
+                    heave = heave0 + _pick(ins[5], i, s, b) if model == 3 else zero
+                    along[b] = normal[b, 0] * (sog * cos_read[3, kc]) + \
+                        normal[b, 1] * (sog * sin_read[3, kc]) + normal[b, 2] * heave
+            if want_radial:
                 for b in range(n_beams):
-                    x += operator[0, b] * noise[row, b, g]
-                    y += operator[1, b] * noise[row, b, g]
-                    z += operator[2, b] * noise[row, b, g]
-            north = rotation[0] * x + rotation[1] * y + ship[0]            # Eq. 13 [1]
-            east = rotation[3] * x + rotation[4] * y + ship[1]
-            up = z
-            if model == 3:
-                north += rotation[2] * z
-                east += rotation[5] * z
-                up = rotation[6] * x + rotation[7] * y + rotation[8] * z + ship[2]
-            speed[i, g] = _hypot(north, east)
-            vertical[i, g] = up
-            from_north[j, g], from_east[j, g] = -north, -east
+                    for g in range(n_gates):
+                        measured = truth[b, g] + _pick(noise, i, s, b * n_gates + g) \
+                            if has_noise else truth[b, g]
+                        radial[i, s, b, g] = measured + along[b]
+            if not (want_speed or want_direction or want_vertical):
+                continue
+            if model == 2:                           # tilt2d: the mean reading (Eq. 13 [1])
+                for a in range(4):                   # the angles, read per beam or once
+                    error = ins[_INS_ANGLES[a]]
+                    total = zero
+                    for k in range(error.shape[2]):
+                        total += base[a] + _pick(error, i, s, k) * _DEG
+                    mean[a] = total / error.shape[2]
+                total = zero
+                for k in range(ins[3].shape[2]):
+                    total += sog0 + _pick(ins[3], i, s, k)
+                mean[4] = total / ins[3].shape[2]
+                mean_rot = _rotation(3, np.cos(mean[0]), np.sin(mean[0]), np.cos(mean[1]),
+                                     np.sin(mean[1]), np.cos(mean[2]), np.sin(mean[2]),
+                                     cos_nominal, sin_nominal)
+                mean_ship = (mean[4] * np.cos(mean[3]), mean[4] * np.sin(mean[3]))
+            for g in range(n_gates):
+                for k in range(3):
+                    total = zero
+                    for b in range(n_beams):
+                        total += normal[b, k] * (
+                            (truth[b, g] + _pick(noise, i, s, b * n_gates + g) if has_noise
+                             else truth[b, g]) + along[b])
+                    rhs[k] = total
+                    for m in range(3):
+                        total = zero
+                        for b in range(n_beams):
+                            total += normal[b, k] * normal[b, m]
+                        matrix[k, m] = total
+                _solve3(matrix, rhs)
+                north, east, up = rhs[0], rhs[1], rhs[2]
+                if model == 2:         # R_m^T (u - s_m), then its horizontal part rotated
+                    d0, d1, d2 = north - mean_ship[0], east - mean_ship[1], up
+                    x = mean_rot[0] * d0 + mean_rot[3] * d1 + mean_rot[6] * d2
+                    y = mean_rot[1] * d0 + mean_rot[4] * d1 + mean_rot[7] * d2
+                    up = mean_rot[2] * d0 + mean_rot[5] * d1 + mean_rot[8] * d2
+                    north = mean_rot[0] * x + mean_rot[1] * y + mean_ship[0]
+                    east = mean_rot[3] * x + mean_rot[4] * y + mean_ship[1]
+                if want_speed:
+                    speed[i, s, g] = _hypot(north, east)
+                if want_vertical:
+                    vertical[i, s, g] = up
+                if want_direction:
+                    from_north[i, s, g], from_east[i, s, g] = -north, -east

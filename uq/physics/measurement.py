@@ -146,10 +146,10 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
     if scene.time_resolved is not None:       # motion within the scan: its own model
         from uq.physics import timeresolved
         return timeresolved.measurement_model(scene, outputs, scene_draws, **errors)
-    if compiled and not scene_draws and set(outputs) <= set(COMPILED_OUTPUTS):
+    if compiled:
         from uq.physics import fused  # (numba: imported only where it may apply)
         if fused.applicable(scene, outputs, errors, scene_draws):
-            return fused.measurement_model(scene, outputs, **errors)   # the same, compiled
+            return fused.measurement_model(scene, outputs, scene_draws, **errors)
     n = sample_count(errors)
     scenes = scene.shape if scene_draws else (1,) * len(scene.shape)
     err = {name: _error_shape(np.asarray(errors.get(name, 0.0)), name, scenes, scene_draws)

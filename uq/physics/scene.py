@@ -19,8 +19,8 @@ SCENE_FIELDS = ("wind_speed", "wind_direction", "vertical_wind", "shear", "refer
                 "sog", "cog", "heading", "pitch", "roll", "heave", "lidar_height",
                 "half_cone", "misalignment")
 OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity", "gate_height")
-#: The outputs the compiled model (:mod:`uq.physics.fused`) computes.
-COMPILED_OUTPUTS = OUTPUTS[:3]
+#: The outputs the compiled model (:mod:`uq.physics.fused`) computes: all of them.
+COMPILED_OUTPUTS = OUTPUTS
 NAVIGATION = ("heading", "pitch", "roll", "sog", "cog", "heave")
 ANGULAR_NAVIGATION = ("heading", "pitch", "roll", "cog")
 

@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 
+from uq.pipeline import motionsection
 from uq.constants import (DEFAULT_BLOCKS_PER_CHUNK, FUSED_MAX_SCENES, RNG_BLOCK_SIZE,
                         SWEEP_CHUNK_ELEMENTS, SWEEP_CHUNK_ELEMENTS_COMPILED)
 
@@ -113,18 +114,17 @@ def scenes_per_chunk(scenario):
     else:
         rows = min(sampling["n"], DEFAULT_BLOCKS_PER_CHUNK * RNG_BLOCK_SIZE)
         if _compiled(scenario):          # no (trial, scene, beam, gate) temporaries
-            outputs = len(scenario.settings["outputs"])
-            return int(np.clip(SWEEP_CHUNK_ELEMENTS_COMPILED // (rows * gates * outputs),
+            values = sum(beams * gates if q == "radial_velocity" else gates
+                         for q in scenario.settings["outputs"])
+            return int(np.clip(SWEEP_CHUNK_ELEMENTS_COMPILED // (rows * values),
                                1, FUSED_MAX_SCENES))
     return max(1, SWEEP_CHUNK_ELEMENTS // (rows * beams * gates))
 
 
 def _compiled(scenario):
     """Will the Monte Carlo trials run the compiled model (:func:`uq.fused.applicable`:
-    wind outputs only, one INS reading per scan)?"""
-    from uq.physics.measurement import COMPILED_OUTPUTS
-    return set(scenario.settings["outputs"]) <= set(COMPILED_OUTPUTS) and \
-        scenario.settings["ins"]["correlation"] == "scan"
+    every static scene; a time-resolved scan runs the numpy model)?"""
+    return not motionsection.is_time_resolved(scenario.settings)
 
 
 def group_assignments(scenario, plan, group):
