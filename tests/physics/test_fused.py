@@ -289,8 +289,9 @@ def test_reading_trigonometry_equals_libm(base, rng):
     strided = np.repeat(errors_deg, 3)[::3].reshape(n, 1, 1)           # any stride
     zero = np.zeros((1, 1, 1))
     cos_x, sin_x = np.empty((4, 1, n)), np.empty((4, 1, n))
-    kernels.ins_trig((strided, zero, zero, zero, zero, zero), np.zeros((1, 1)), 0, 1, 0, n,
-                     False, cos_x, sin_x, np.empty(n))
+    ins_trig = kernels.compiled(float)["ins_trig"]
+    ins_trig((strided, zero, zero, zero, zero, zero), np.zeros((1, 1)), 0, 1, 0, n, False,
+             cos_x, sin_x, np.empty(n))
     cos, sin = np.array([kernels._angle.py_func(base, np.cos(base), np.sin(base),
                                                 np.deg2rad(e), c, s)
                          for e, c, s in zip(errors_deg, cos_x[0, 0], sin_x[0, 0])]).T

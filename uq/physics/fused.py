@@ -39,6 +39,7 @@ References
    compiler. Proc. LLVM-HPC 2015.
 """
 import math
+import weakref
 
 import numpy as np
 
@@ -48,7 +49,7 @@ from uq.physics import wind as wind_formulas
 from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
 from uq.constants import FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS
 from uq.physics.correction import CORRECTION_MODELS
-from uq.physics.scene import OUTPUTS, SCENE_FIELDS, sample_count
+from uq.physics.scene import OUTPUTS, SCENE_FIELDS
 from uq.physics.rotation import attitude_matrix
 
 #: Outputs the fused loop computes: all of them.
@@ -67,39 +68,38 @@ def applicable(scene, outputs, errors, scene_draws=False):
     (n, beams) (one reading per scan or per beam), geometry errors (n,), radial noise
     (n, beams, gates); with `scene_draws` each with the scene axes after the first.
     """
-    if scene.time_resolved is not None or not set(outputs) <= set(FUSED_OUTPUTS):
-        return False
-    try:
-        _shaped(scene, errors, scene_draws)
-    except _Unsupported:
-        return False
-    return True
-
-
-class _Unsupported(ValueError):
-    """An error array of a shape the fused loop does not take."""
+    return _prepared(scene, outputs, errors, scene_draws) is not None
 
 
 def measurement_model(scene, outputs, scene_draws=False, **errors):
     """The fused equivalent of :func:`uq.measurement.measurement_model` (same inputs,
     degrees for angular errors; same outputs, shape (n, *S, n_gates), radial velocity
     (n, *S, n_beams, n_gates)). Complex errors give complex outputs (complex step)."""
-    shape, n_gates, n_beams = scene.shape, len(scene.ranges), scene.n_beams
+    result = evaluate(scene, outputs, scene_draws, errors)
+    if result is None:
+        raise ValueError("the compiled model does not apply to this call (see applicable)")
+    return result
+
+
+def evaluate(scene, outputs, scene_draws, errors):
+    """:func:`measurement_model` where :func:`applicable`, else None (one pass over the
+    arguments for both: the model is called once per slice of ~2^13 trials)."""
+    prepared = _prepared(scene, outputs, errors, scene_draws)
+    return None if prepared is None else _run(scene, outputs, scene_draws, *prepared)
+
+
+def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype):
+    n_gates, n_beams = len(scene.ranges), scene.n_beams
     scenes = math.prod(shape)
-    n = sample_count(errors)
-    ins, geo, noise, dtype = _shaped(scene, errors, scene_draws)
-    table = scene_table(scene)
+    table = scene_table(scene, shape)
     structure = np.array([len(scene.azimuths), int(scene.vertical_beam), n_gates,
                           CORRECTION_MODELS.index(scene.correction)]
-                         + [int(q in outputs) for q in ("wind_speed", "wind_direction",
-                                                        "vertical_wind", "radial_velocity",
-                                                        "gate_height")], dtype=np.int64)
+                         + [int(q in outputs) for q in OUTPUTS], dtype=np.int64)
     out = {q: np.empty((n, scenes) + ((n_beams,) if q == "radial_velocity" else ())
-                       + (n_gates,), dtype=dtype) if q in outputs else np.empty(
-                           (1, 1, 1) + ((1,) if q == "radial_velocity" else ()), dtype=dtype)
-           for q in FUSED_OUTPUTS}
+                       + (n_gates,), dtype=dtype) if q in outputs else _UNUSED[dtype][q]
+           for q in OUTPUTS}
     from_east = np.empty_like(out["wind_direction"])
-    per_trial = any(np.shape(g)[0] > 1 for g in geo)        # geometry errors: truth per trial
+    per_trial = any(g.shape[0] > 1 for g in geo)          # geometry errors: truth per trial
     block = FUSED_BLOCK_TRIALS
     trials = min(n, block)
     group = max(1, block // trials) if (scene_draws or per_trial) else scenes
@@ -111,38 +111,52 @@ def measurement_model(scene, outputs, scene_draws=False, **errors):
     beams = np.empty((truth_rows, n_beams, 3), dtype=dtype)
     profile = np.empty((truth_rows, n_beams, n_gates), dtype=dtype)
     exponent = np.empty(truth_rows)
+    compiled = kernels.compiled(dtype)
+    pointwise = any(error.shape[2] > 1 for error in ins)   # a reading per beam
+    wind = compiled["wind_pointwise" if pointwise else "wind_scan"]
     if not per_trial:                        # the truth of every scene, common to its trials
-        _truth(table, structure, geo, 0, scenes, 0, 1, False, beams, profile, exponent)
+        _truth(compiled, table, structure, geo, 0, scenes, 0, 1, False, beams, profile,
+               exponent)
     for t0 in range(0, n, trials):
         t1 = min(n, t0 + trials)
         if not scene_draws:                 # the draws' trigonometry, shared by the scenes
-            kernels.ins_trig(ins, table, 0, 1, t0, t1, False, cos_trig, sin_trig, scratch)
+            compiled["ins_trig"](ins, table, 0, 1, t0, t1, False, cos_trig, sin_trig, scratch)
         for s0 in range(0, scenes, group):
             s1 = min(scenes, s0 + group)
             if scene_draws:
-                kernels.ins_trig(ins, table, s0, s1, t0, t1, True, cos_trig, sin_trig,
-                                 scratch)
+                compiled["ins_trig"](ins, table, s0, s1, t0, t1, True, cos_trig, sin_trig,
+                                     scratch)
             if per_trial:
-                _truth(table, structure, geo, s0, s1, t0, t1, True, beams, profile, exponent)
-            kernels.wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile,
-                         geo[2], s0, s1, t0, t1, scene_draws, per_trial,
-                         out["wind_speed"], out["vertical_wind"], out["wind_direction"],
-                         from_east, out["radial_velocity"], out["gate_height"])
+                _truth(compiled, table, structure, geo, s0, s1, t0, t1, True, beams, profile,
+                       exponent)
+            wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, geo[2],
+                 s0, s1, t0, t1, scene_draws, per_trial, out["wind_speed"],
+                 out["vertical_wind"], out["wind_direction"], from_east,
+                 out["radial_velocity"], out["gate_height"])
     if "wind_direction" in outputs:
         _direction(out["wind_direction"], from_east, out["wind_direction"])
     return {q: out[q].reshape((n,) + shape + out[q].shape[2:]) for q in outputs}
 
 
-def _truth(table, structure, geo, s0, s1, t0, t1, per_trial, beams, profile, exponent):
+#: Placeholders of the outputs not requested, per dtype (the kernels write nothing there).
+_UNUSED = {dtype: {q: np.empty((1, 1, 1) + ((1,) if q == "radial_velocity" else ()), dtype)
+                   for q in OUTPUTS} for dtype in (float, complex)}
+
+
+def _truth(compiled, table, structure, geo, s0, s1, t0, t1, per_trial, beams, profile,
+           exponent):
     """True beams and the power-law profile U(z) / U_ref (z / z_ref)^alpha of the rows
     of a rectangle (:func:`uq.physics.fusedkernels.geometry`); numpy's SIMD log and exp,
     NaN stays NaN (1 where there is no shear: exp(0 log 1) is exactly 1)."""
-    kernels.geometry(table, structure, geo, s0, s1, t0, t1, per_trial, beams, profile,
-                     exponent)
+    compiled["geometry"](table, structure, geo, s0, s1, t0, t1, per_trial, beams, profile,
+                         exponent)
     rows = (s1 - s0) * ((t1 - t0) if per_trial else 1)
     ratio = profile[:rows]
     np.log(ratio, out=ratio)
-    ratio *= exponent[:rows, None, None]
+    if np.all(exponent[:rows] == exponent[0]):           # one scene's: a scalar product
+        ratio *= exponent[0]
+    else:
+        ratio *= exponent[:rows, None, None]
     np.exp(ratio, out=ratio)
 
 
@@ -158,47 +172,72 @@ def _direction(from_north, from_east, out):
     np.subtract(out, FULL_CIRCLE_DEG, out=out, where=out >= FULL_CIRCLE_DEG)   # -1e-17 + 360
 
 
-def _shaped(scene, errors, scene_draws):
-    """The errors as 3-D arrays (trials, scenes, k) for the kernels, any axis of length
-    1 broadcasting: INS (k = 1 or beams), geometry (k = 1), noise (k = beams x gates);
-    and their common dtype (complex128 if any is complex, else float64)."""
-    scenes = math.prod(scene.shape)
-    s_axis = scene.shape if scene_draws else ()
-    values = {name: np.asarray(errors[name]) for name in (*_INS, *_GEOMETRY, _NOISE)
-              if errors.get(name) is not None}
-    unknown = set(errors) - set(_INS) - set(_GEOMETRY) - {_NOISE}
-    if unknown:
-        raise _Unsupported(f"unknown errors {sorted(unknown)}")
-    dtype = complex if any(np.iscomplexobj(v) for v in values.values()) else float
+def _prepared(scene, outputs, errors, scene_draws):
+    """(scene shape, trials, INS, geometry, noise, dtype) of a call the fused loop
+    takes, else None. The errors as 3-D arrays (trials, scenes, k) for the kernels, any
+    axis of length 1 broadcasting: INS (k = 1 or beams), geometry (k = 1), noise
+    (k = beams x gates); complex128 if any error is complex, else float64."""
+    if scene.time_resolved is not None or not set(outputs) <= _OUTPUT_SET or \
+            not set(errors) <= _ERROR_SET:
+        return None
+    shape = scene.shape
+    scenes = math.prod(shape)
+    s_axis = shape if scene_draws else ()
+    values = {name: np.asarray(value) for name, value in errors.items() if value is not None}
+    dtype = complex if any(v.dtype.kind == "c" for v in values.values()) else float
     beams, gates = scene.n_beams, len(scene.ranges)
-
-    def laid(name, trailing, k):
-        value = values.get(name)
-        if value is None:
-            return np.zeros((1, 1, 1), dtype=dtype)
+    n = max([v.shape[0] for v in values.values() if v.ndim], default=1)
+    laid = {}
+    for name, value in values.items():
         if value.ndim == 0:
-            return np.full((1, 1, 1), value, dtype=dtype)
-        n = value.shape[0]
+            laid[name] = np.full((1, 1, 1), value, dtype=dtype)
+            continue
         if value.shape[1:1 + len(s_axis)] != s_axis:
-            raise _Unsupported(name)
+            return None
         rest = value.shape[1 + len(s_axis):]
-        if rest not in trailing:
-            raise _Unsupported(name)
-        array = value.reshape((n, scenes if scene_draws else 1, k if rest else 1))
-        return np.require(array, dtype=dtype, requirements="W")
+        if name.startswith("ins_"):
+            allowed = ((), (1,), (beams,))
+        elif name == _NOISE:
+            allowed = ((beams, gates),)
+        else:
+            allowed = ((),)
+        if rest not in allowed:
+            return None
+        k = math.prod(rest)
+        array = value.reshape((value.shape[0], scenes if scene_draws else 1, k))
+        if array.dtype != dtype or not array.flags.writeable:
+            array = array.astype(dtype)
+        laid[name] = array
+    zero = _ZERO[dtype]
+    return (shape, n, tuple(laid.get(name, zero) for name in _INS),
+            tuple(laid.get(name, zero) for name in _GEOMETRY), laid.get(_NOISE, zero), dtype)
 
-    ins = tuple(laid(name, ((), (1,), (beams,)), beams if _per_beam(values.get(name), len(
-        s_axis)) else 1) for name in _INS)
-    geo = tuple(laid(name, ((),), 1) for name in _GEOMETRY)
-    noise = laid(_NOISE, ((beams, gates),), beams * gates)
-    return ins, geo, noise, dtype
+
+_OUTPUT_SET, _ERROR_SET = set(FUSED_OUTPUTS), {*_INS, *_GEOMETRY, _NOISE}
+#: An absent error: zero, a (1, 1, 1) placeholder per dtype (the kernels only read it).
+_ZERO = {float: np.zeros((1, 1, 1)), complex: np.zeros((1, 1, 1), dtype=complex)}
 
 
-def _per_beam(value, scene_axes):
-    return value is not None and value.ndim == 2 + scene_axes and value.shape[-1] > 1
+#: Tables of the scenes last evaluated: id -> (weak reference, table). The engine calls
+#: the model once per slice of trials with the same scene object (64 times for 2^19
+#: trials); a table costs ~0.3 ms.
+_TABLES = {}
+_TABLES_KEPT = 8
 
 
-def scene_table(scene):
+def scene_table(scene, shape=None):
+    """:func:`make_scene_table`, kept while `scene` (a frozen dataclass) lives."""
+    kept = _TABLES.get(id(scene))
+    if kept is not None and kept[0]() is scene:
+        return kept[1]
+    table = make_scene_table(scene, shape)
+    if len(_TABLES) >= _TABLES_KEPT:
+        _TABLES.pop(next(iter(_TABLES)))
+    _TABLES[id(scene)] = (weakref.ref(scene), table)
+    return table
+
+
+def make_scene_table(scene, shape=None):
     """The scenes of a batch as rows of one float table (numba takes no dataclass),
     laid out as :data:`uq.physics.fusedkernels.TABLE` says: the scalars, the slanted
     beams' azimuths' cos and sin, the true attitude, the least-squares operator, the
@@ -206,9 +245,10 @@ def scene_table(scene):
 
     The least-squares operator (a pseudo-inverse, ~20 us) is computed once per distinct
     (half-cone, misalignment): a GUM grid of 518,400 scenes has 360 of them."""
-    scenes = math.prod(scene.shape)
+    shape = scene.shape if shape is None else shape
+    scenes = math.prod(shape)
     field = {name: np.broadcast_to(np.asarray(getattr(scene, name), dtype=float),
-                                   scene.shape).reshape(scenes) for name in SCENE_FIELDS}
+                                   shape).reshape(scenes) for name in SCENE_FIELDS}
     azimuths = np.asarray(scene.azimuths, dtype=float)
     n_slanted, n_gates = len(azimuths), len(scene.ranges)
     geometry = np.stack([field["half_cone"], field["misalignment"]], axis=-1)

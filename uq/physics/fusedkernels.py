@@ -33,6 +33,7 @@ References
 .. [2] Matavar, A. (2024). Wind field reconstruction from floating lidars. MSc thesis,
    TU Delft (point-wise correction, Sec. 3.2).
 """
+import functools
 import math
 
 import numpy as np
@@ -65,26 +66,23 @@ _INS_ANGLES = (0, 1, 2, 4)          # heading, pitch, roll, cog in INS_ORDER
 GEO_ORDER = ("half_cone", "misalignment", "height")
 
 
-def _signatures(kind):
-    """Explicit signatures, float64 and complex128, any-layout arrays: one compilation
-    each (cached on disk) for strided views and length-1 placeholders alike."""
-    out = []
-    for dtype in (types.float64, types.complex128):
-        a1, a2, a3, a4 = (types.Array(dtype, d, "A") for d in (1, 2, 3, 4))
-        c1 = types.Array(dtype, 1, "C")
-        table = types.Array(types.float64, 2, "C")
-        ints = types.Array(types.int64, 1, "C")
-        ins, geo = types.UniTuple(a3, 6), types.UniTuple(a3, 3)
-        i8, b1 = types.int64, types.boolean
-        if kind == "trig":
-            out.append(types.void(ins, table, i8, i8, i8, i8, b1, a3, a3, c1))
-        elif kind == "geometry":
-            out.append(types.void(table, ints, geo, i8, i8, i8, i8, b1, a3, a3,
-                                  types.Array(types.float64, 1, "C")))
-        else:
-            out.append(types.void(table, ints, ins, a3, a3, a3, a3, a3, a3, i8, i8, i8, i8,
-                                  b1, b1, a3, a3, a3, a3, a4, a3))
-    return out
+def _signature(kind, dtype):
+    """The explicit signature of a kernel for float64 or complex128 numbers, any-layout
+    arrays: one compilation (cached on disk) for strided views and length-1
+    placeholders alike."""
+    a3, a4 = types.Array(dtype, 3, "A"), types.Array(dtype, 4, "A")
+    c1, c3 = types.Array(dtype, 1, "C"), types.Array(dtype, 3, "C")
+    table = types.Array(types.float64, 2, "C")
+    ints = types.Array(types.int64, 1, "C")
+    ins, geo = types.UniTuple(a3, 6), types.UniTuple(a3, 3)
+    i8, b1 = types.int64, types.boolean
+    if kind == "trig":
+        return types.void(ins, table, i8, i8, i8, i8, b1, c3, c3, c1)
+    if kind == "geometry":
+        return types.void(table, ints, geo, i8, i8, i8, i8, b1, a3, a3,
+                          types.Array(types.float64, 1, "C"))
+    return types.void(table, ints, ins, a3, c3, c3, a3, a3, a3, i8, i8, i8, i8, b1, b1, a3,
+                      a3, a3, a3, a4, a3)
 
 
 @njit(inline="always")
@@ -114,7 +112,32 @@ def _pick(array, i, s, k):
                  k if array.shape[2] > 1 else 0]
 
 
-@njit(_signatures("trig"), cache=True)
+@njit(inline="always")
+def _scene_readings(ins, s, t0, count, tr0, base, cos_trig, sin_trig, cos_out, sin_out):
+    """cos and sin of the INS angles (base + error) of one scene for trials
+    [t0, t0 + count) into out[a, k, j]: the addition theorem on the errors' Taylor terms
+    (rows tr0 + j of :func:`ins_trig`, shared by the scenes that share the draws) in a
+    loop without calls (SIMD), then libm for errors beyond SMALL_ANGLE (and NaN); an
+    error constant over trials takes libm once."""
+    for a in range(4):
+        error = ins[_INS_ANGLES[a]]
+        cos_base, sin_base = math.cos(base[a]), math.sin(base[a])
+        for k in range(error.shape[2]):
+            cos_a, sin_a = cos_out[a, k], sin_out[a, k]
+            if error.shape[0] == 1:
+                angle = base[a] + _pick(error, 0, s, k) * _DEG
+                cos_a[:count], sin_a[:count] = np.cos(angle), np.sin(angle)
+                continue
+            cos_x, sin_x = cos_trig[a, k, tr0:tr0 + count], sin_trig[a, k, tr0:tr0 + count]
+            for j in range(count):                 # no calls, unit stride: SIMD
+                cos_a[j] = cos_base * cos_x[j] - sin_base * sin_x[j]      # cos(b + x)
+                sin_a[j] = sin_base * cos_x[j] + cos_base * sin_x[j]      # sin(b + x)
+            for j in range(count):                 # large errors (and NaN): libm
+                x = _pick(error, t0 + j, s, k) * _DEG
+                if not abs(x) <= SMALL_ANGLE:
+                    cos_a[j], sin_a[j] = np.cos(base[a] + x), np.sin(base[a] + x)
+
+
 def ins_trig(ins, table, s0, s1, t0, t1, per_scene, cos_out, sin_out, scratch):
     """cos and sin of the INS angle errors (heading, pitch, roll, course) of trials
     [t0, t1) into out[a, k, row] (a in that order, k the reading); the row is the
@@ -156,39 +179,51 @@ def table_width(n_slanted, n_beams, n_gates):
     return _offsets.py_func(n_slanted, n_beams, n_gates)[-1]
 
 
-@njit(_signatures("geometry"), cache=True)
+@njit(inline="always")
+def _angle_block(error, s, t0, count, base, cos_out, sin_out):
+    """cos and sin of base + error [deg] of trials [t0, t0 + count) of scene s into
+    out[:count]: the errors' Taylor polynomials and the addition theorem in loops
+    without calls (SIMD), libm beyond SMALL_ANGLE (and for NaN); an error constant over
+    trials takes libm once."""
+    if error.shape[0] == 1:
+        angle = base + _pick(error, 0, s, 0) * _DEG
+        cos_out[:count], sin_out[:count] = np.cos(angle), np.sin(angle)
+        return
+    cos_base, sin_base = np.cos(base), np.sin(base)
+    for j in range(count):                        # gather the (strided) column first:
+        cos_out[j] = _pick(error, t0 + j, s, 0) * _DEG     # unit stride: SIMD next
+    for j in range(count):                        # no calls, unit stride: SIMD
+        cos_x, sin_x = _taylor(cos_out[j])
+        cos_out[j] = cos_base * cos_x - sin_base * sin_x          # cos(b + x)
+        sin_out[j] = sin_base * cos_x + cos_base * sin_x          # sin(b + x)
+    for j in range(count):                        # large errors (and NaN): libm
+        x = _pick(error, t0 + j, s, 0) * _DEG
+        if not abs(x) <= SMALL_ANGLE:
+            cos_out[j], sin_out[j] = np.cos(base + x), np.sin(base + x)
+
+
 def geometry(table, structure, geo, s0, s1, t0, t1, per_trial, beams, ratio, shear):
     """True earth-frame beams into beams[row] (b, 3), z / z_ref of their gates into
     ratio[row] (b, g) and the scene's shear exponent into shear[row]; NaN at a height
     <= 0 (outside the power law). Rows: with `per_trial`, (s - s0) (t1 - t0) + (i - t0)
     for the trials of the rectangle; else one row per scene, s - s0, with the errors of
     trial t0 (constant over trials). Without shear the ratio is not needed: 1 (or NaN).
-    Geometry errors constant over trials take libm's cos and sin (as one reading does).
     """
     n_slanted, n_gates = structure[0], structure[2]
     n_beams = n_slanted + structure[1]
     azimuths, attitude, _, slant, _, _ = _offsets(n_slanted, n_beams, n_gates)
+    count = t1 - t0 if per_trial else 1
+    zero = beams[0, 0, 0] * 0.0
+    trig = np.full((4, count), zero)              # cos, sin of half-cone, misalignment
     row = 0
     for s in range(s0, s1):
         scene = table[s]
-        cone, misalignment = scene[_HALF_CONE], scene[_MISALIGNMENT]
-        cos_cone, sin_cone = math.cos(cone), math.sin(cone)
-        cos_mis, sin_mis = math.cos(misalignment), math.sin(misalignment)
+        _angle_block(geo[0], s, t0, count, scene[_HALF_CONE], trig[0], trig[1])
+        _angle_block(geo[1], s, t0, count, scene[_MISALIGNMENT], trig[2], trig[3])
         reference, exponent = scene[_REFERENCE], scene[_SHEAR]
-        for i in range(t0, t1 if per_trial else t0 + 1):
-            x_cone = _pick(geo[0], i, s, 0) * _DEG
-            x_mis = _pick(geo[1], i, s, 0) * _DEG
-            if geo[0].shape[0] == 1:
-                cos_t, sin_t = np.cos(cone + x_cone), np.sin(cone + x_cone)
-            else:
-                cos_x, sin_x = _taylor(x_cone)
-                cos_t, sin_t = _angle(cone, cos_cone, sin_cone, x_cone, cos_x, sin_x)
-            if geo[1].shape[0] == 1:
-                cos_m, sin_m = np.cos(misalignment + x_mis), np.sin(misalignment + x_mis)
-            else:
-                cos_x, sin_x = _taylor(x_mis)
-                cos_m, sin_m = _angle(misalignment, cos_mis, sin_mis, x_mis, cos_x, sin_x)
-            base = scene[_LIDAR_HEIGHT] + _pick(geo[2], i, s, 0)
+        for j in range(count):
+            cos_t, sin_t, cos_m, sin_m = trig[0, j], trig[1, j], trig[2, j], trig[3, j]
+            base = scene[_LIDAR_HEIGHT] + _pick(geo[2], t0 + j, s, 0)
             for b in range(n_beams):
                 if b < n_slanted:
                     cos_a, sin_a = scene[azimuths + b], scene[azimuths + n_slanted + b]
@@ -196,7 +231,7 @@ def geometry(table, structure, geo, s0, s1, t0, t1, per_trial, beams, ratio, she
                     y = sin_t * (sin_m * cos_a + cos_m * sin_a)       # sin t sin(m + a)
                     z = cos_t
                 else:
-                    x, y, z = 0.0, 0.0, 1.0
+                    x, y, z = zero, zero, zero + 1.0
                 for k in range(3):
                     beams[row, b, k] = scene[attitude + 3 * k] * x + \
                         scene[attitude + 3 * k + 1] * y + scene[attitude + 3 * k + 2] * z
@@ -271,10 +306,10 @@ def _gate_heights(scene, beams, r, height_error, n_slanted, n_gates, at_slant, o
         out[g] = total / n_slanted
 
 
-@njit(_signatures("wind"), cache=True)
-def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
-         s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
-         radial, gate_height):
+@njit(inline="always")
+def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
+          s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
+          radial, gate_height, pointwise):
     """The outputs of scenes [s0, s1) x trials [t0, t1), into arrays (n, S, ...).
 
     ``beams`` and ``profile`` (U(z) / U_ref of each beam's gates) are rows of
@@ -288,6 +323,9 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
     reading. ``from_north``, ``from_east`` get the "from" vector (the direction is then
     taken by numpy's SIMD arctan2). Model: 0 none, 1 yaw, 2 tilt2d, 3 full.
 
+    `pointwise` is a constant of each of the two kernels (:func:`wind_scan`,
+    :func:`wind_pointwise`), so each compiles only its own branch.
+
     One long loop on purpose: split into helper functions for the per-trial truth and
     least squares it ran 1.5x slower (57 -> 87 ns per trial on floating_lidar_full),
     as the values then go through memory instead of registers.
@@ -298,19 +336,15 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
     want_radial, want_height = structure[7], structure[8]
     n_beams = n_slanted + vertical_beam
     _, _, at_operator, at_slant, at_units, _ = _offsets(n_slanted, n_beams, n_gates)
-    pointwise = False
-    for a in range(6):
-        pointwise = pointwise or ins[a].shape[2] > 1
     has_noise = noise.shape[2] > 1                  # (absent: a (1, 1, 1) placeholder)
     zero = beams[0, 0, 0] * 0.0                      # 0 of the kernel's number type
     truth = np.full((n_beams, n_gates), zero)        # true radial velocities of a trial
     lidar_frame = np.full((3, n_gates), zero)        # A^+ truth: the noise-free wind
     heights = np.full(n_gates, zero)                 # mean true gate heights
-    cos_read = np.full((4, n_beams), zero)           # (cos, sin) of each reading's angles
-    sin_read = np.full((4, n_beams), zero)
-    cos_fixed = np.full((4, n_beams), zero)          # ... of readings constant over trials
-    sin_fixed = np.full((4, n_beams), zero)
-    cos_base, sin_base, base = np.empty(4), np.empty(4), np.empty(4)
+    count = t1 - t0
+    cos_read = np.full((4, n_beams, count), zero)    # (cos, sin) of the readings' angles
+    sin_read = np.full((4, n_beams, count), zero)
+    base = np.empty(4)
     normal = np.full((n_beams, 3), zero)             # point-wise: believed earth beams
     along = np.full(n_beams, zero)                   # ... the ship velocity along them
     mean = np.full(6, zero)                          # ... and the mean reading (tilt2d)
@@ -319,7 +353,6 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
     one = zero + 1.0
     mean_rot = _rotation(3, one, zero, one, zero, one, zero, 1.0, 0.0)
     mean_ship = (zero, zero)
-    count = t1 - t0
     for s in range(s0, s1):
         scene = table[s]
         speed_ref, w = scene[_SPEED], scene[_VERTICAL]
@@ -327,16 +360,11 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
         sog0, cog0, heave0, heading0 = scene[_SOG], scene[_COG], scene[_HEAVE], scene[_HEADING]
         true_ship = (sog0 * math.cos(cog0), sog0 * math.sin(cog0), heave0)
         cos_nominal, sin_nominal = math.cos(heading0), math.sin(heading0)
-        base[0], base[1], base[2], base[3] = heading0, scene[_PITCH], scene[_ROLL], cog0
         operator = scene[at_operator:at_operator + 3 * n_beams].reshape(3, n_beams)
         units = scene[at_units:at_units + 3 * n_beams].reshape(n_beams, 3)
-        for a in range(4):
-            cos_base[a], sin_base[a] = math.cos(base[a]), math.sin(base[a])
-            error = ins[_INS_ANGLES[a]]
-            if error.shape[0] == 1:          # a reading constant over trials: libm
-                for k in range(error.shape[2]):
-                    angle = base[a] + _pick(error, 0, s, k) * _DEG
-                    cos_fixed[a, k], sin_fixed[a, k] = np.cos(angle), np.sin(angle)
+        base[0], base[1], base[2], base[3] = heading0, scene[_PITCH], scene[_ROLL], cog0
+        _scene_readings(ins, s, t0, count, (s - s0) * count if per_scene else 0, base,
+                        cos_trig, sin_trig, cos_read, sin_read)
         if not per_trial:                    # one truth for all trials: A^+ truth once
             r = s
             for b in range(n_beams):
@@ -355,9 +383,10 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
             if want_height:
                 _gate_heights(scene, beams, r, _pick(height_error, t0, s, 0), n_slanted,
                               n_gates, at_slant, heights)
+        noise_s = s if noise.shape[1] > 1 else 0
         for i in range(t0, t1):
             j = i - t0
-            tr = (s - s0) * count + j if per_scene else j
+            noise_i = i if noise.shape[0] > 1 else 0
             if per_trial:                           # this trial's true radial velocities
                 r = (s - s0) * count + j
                 for b in range(n_beams):
@@ -373,34 +402,27 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
             if want_height:
                 for g in range(n_gates):
                     gate_height[i, s, g] = heights[g]
-            for a in range(4):                       # the readings' cos and sin
-                error = ins[_INS_ANGLES[a]]
-                for k in range(error.shape[2]):
-                    if error.shape[0] == 1:
-                        cos_read[a, k], sin_read[a, k] = cos_fixed[a, k], sin_fixed[a, k]
-                    else:
-                        cos_read[a, k], sin_read[a, k] = _angle(
-                            base[a], cos_base[a], sin_base[a], _pick(error, i, s, k) * _DEG,
-                            cos_trig[a, k, tr], sin_trig[a, k, tr])
             if not pointwise:
                 # ---- one reading per scan: Eq. 13 [1]
                 if model == 0:                       # none: the configured heading, fixed
-                    rot = _rotation(0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, cos_nominal, sin_nominal)
+                    rot = _rotation(0, one, zero, one, zero, one, zero, cos_nominal,
+                                    sin_nominal)
+                    cc, sc = zero, zero
                 else:
-                    rot = _rotation(model, cos_read[0, 0], sin_read[0, 0], cos_read[1, 0],
-                                    sin_read[1, 0], cos_read[2, 0], sin_read[2, 0],
-                                    cos_nominal, sin_nominal)
+                    rot = _rotation(model, cos_read[0, 0, j], sin_read[0, 0, j],
+                                    cos_read[1, 0, j], sin_read[1, 0, j], cos_read[2, 0, j],
+                                    sin_read[2, 0, j], cos_nominal, sin_nominal)
+                    cc, sc = cos_read[3, 0, j], sin_read[3, 0, j]
                 sog = sog0 + _pick(ins[3], i, s, 0)
                 heave = heave0 + _pick(ins[5], i, s, 0)
                 moving = model != 0
-                ship = (sog * cos_read[3, 0] if moving else zero,
-                        sog * sin_read[3, 0] if moving else zero,
+                ship = (sog * cc if moving else zero, sog * sc if moving else zero,
                         heave if model == 3 else zero)
                 for g in range(n_gates):                 # the lidar-frame wind A^+ v
                     if per_trial:                        # v = truth + noise
                         x = y = z = zero
                         for b in range(n_beams):
-                            value = truth[b, g] + _pick(noise, i, s, b * n_gates + g) \
+                            value = truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] \
                                 if has_noise else truth[b, g]
                             x += operator[0, b] * value
                             y += operator[1, b] * value
@@ -409,7 +431,7 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
                         x, y, z = lidar_frame[0, g], lidar_frame[1, g], lidar_frame[2, g]
                         if has_noise:
                             for b in range(n_beams):
-                                value = _pick(noise, i, s, b * n_gates + g)
+                                value = noise[noise_i, noise_s, b * n_gates + g]
                                 x += operator[0, b] * value
                                 y += operator[1, b] * value
                                 z += operator[2, b] * value
@@ -433,7 +455,7 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
                         e2 = rot[6] * units[b, 0] + rot[7] * units[b, 1] + rot[8] * units[b, 2]
                         removed = e0 * ship[0] + e1 * ship[1] + e2 * ship[2]
                         for g in range(n_gates):
-                            measured = truth[b, g] + _pick(noise, i, s, b * n_gates + g) \
+                            measured = truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] \
                                 if has_noise else truth[b, g]
                             radial[i, s, b, g] = measured + removed
                 continue
@@ -445,9 +467,9 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
                     kh = b if ins[0].shape[2] > 1 else 0
                     kp = b if ins[1].shape[2] > 1 else 0
                     kr = b if ins[2].shape[2] > 1 else 0
-                    rot = _rotation(model, cos_read[0, kh], sin_read[0, kh], cos_read[1, kp],
-                                    sin_read[1, kp], cos_read[2, kr], sin_read[2, kr],
-                                    cos_nominal, sin_nominal)
+                    rot = _rotation(model, cos_read[0, kh, j], sin_read[0, kh, j],
+                                    cos_read[1, kp, j], sin_read[1, kp, j], cos_read[2, kr, j],
+                                    sin_read[2, kr, j], cos_nominal, sin_nominal)
                 for k in range(3):
                     normal[b, k] = rot[3 * k] * units[b, 0] + rot[3 * k + 1] * units[b, 1] \
                         + rot[3 * k + 2] * units[b, 2]
@@ -457,12 +479,12 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
                     kc = b if ins[4].shape[2] > 1 else 0
                     sog = sog0 + _pick(ins[3], i, s, b)
                     heave = heave0 + _pick(ins[5], i, s, b) if model == 3 else zero
-                    along[b] = normal[b, 0] * (sog * cos_read[3, kc]) + \
-                        normal[b, 1] * (sog * sin_read[3, kc]) + normal[b, 2] * heave
+                    along[b] = normal[b, 0] * (sog * cos_read[3, kc, j]) + \
+                        normal[b, 1] * (sog * sin_read[3, kc, j]) + normal[b, 2] * heave
             if want_radial:
                 for b in range(n_beams):
                     for g in range(n_gates):
-                        measured = truth[b, g] + _pick(noise, i, s, b * n_gates + g) \
+                        measured = truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] \
                             if has_noise else truth[b, g]
                         radial[i, s, b, g] = measured + along[b]
             if not (want_speed or want_direction or want_vertical):
@@ -487,7 +509,7 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
                     total = zero
                     for b in range(n_beams):
                         total += normal[b, k] * (
-                            (truth[b, g] + _pick(noise, i, s, b * n_gates + g) if has_noise
+                            (truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] if has_noise
                              else truth[b, g]) + along[b])
                     rhs[k] = total
                     for m in range(3):
@@ -510,3 +532,36 @@ def wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heigh
                     vertical[i, s, g] = up
                 if want_direction:
                     from_north[i, s, g], from_east[i, s, g] = -north, -east
+
+
+def wind_scan(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
+              s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
+              radial, gate_height):
+    """:func:`_wind` with one INS reading per scan (every INS error (n, s, 1))."""
+    _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
+          s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
+          radial, gate_height, False)
+
+
+def wind_pointwise(table, structure, ins, noise, cos_trig, sin_trig, beams, profile,
+                   height_error, s0, s1, t0, t1, per_scene, per_trial, speed, vertical,
+                   from_north, from_east, radial, gate_height):
+    """:func:`_wind` with a reading per beam for some INS error (point-wise)."""
+    _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
+          s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
+          radial, gate_height, True)
+
+
+#: The kernels, each with its kind of signature.
+_KERNELS = {"ins_trig": (ins_trig, "trig"), "geometry": (geometry, "geometry"),
+            "wind_scan": (wind_scan, "wind"), "wind_pointwise": (wind_pointwise, "wind")}
+
+
+@functools.cache
+def compiled(dtype):
+    """The kernels compiled for float64 or complex128 (the complex-step GUM), by name:
+    each number type is compiled (or loaded from numba's on-disk cache) on first use,
+    so a Monte Carlo run never compiles the complex kernels."""
+    number = types.complex128 if np.dtype(dtype).kind == "c" else types.float64
+    return {name: njit(_signature(kind, number), cache=True)(function)
+            for name, (function, kind) in _KERNELS.items()}

@@ -148,8 +148,9 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
         return timeresolved.measurement_model(scene, outputs, scene_draws, **errors)
     if compiled:
         from uq.physics import fused  # (numba: imported only where it may apply)
-        if fused.applicable(scene, outputs, errors, scene_draws):
-            return fused.measurement_model(scene, outputs, scene_draws, **errors)
+        result = fused.evaluate(scene, outputs, scene_draws, errors)
+        if result is not None:                  # None: a call the compiled loop does not take
+            return result
     n = sample_count(errors)
     scenes = scene.shape if scene_draws else (1,) * len(scene.shape)
     err = {name: _error_shape(np.asarray(errors.get(name, 0.0)), name, scenes, scene_draws)
