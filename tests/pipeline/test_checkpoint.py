@@ -100,7 +100,8 @@ def test_a_second_command_on_the_same_output_is_refused(tmp_path):
     """Two `uq run` on one output: the second is refused at once (exit 2), the first
     finishes with the uninterrupted result."""
     path = tmp_path / "s.yaml"
-    path.write_text(yaml.safe_dump({**SWEEP, "sampling": {"n": 200_000, "seed": 7}}))
+    # long enough (~2 s of sampling) that the second starts (~1 s) while the first runs
+    path.write_text(yaml.safe_dump({**SWEEP, "sampling": {"n": 1_500_000, "seed": 7}}))
     first = subprocess.Popen([sys.executable, "-m", "uq.cli", "run", str(path), "--quiet",
                               "-o", "out.nc"], cwd=tmp_path, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60

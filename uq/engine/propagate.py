@@ -23,8 +23,8 @@ from uq.constants import (ADAPTIVE_MAX_SAMPLES, BATCH_SIZE, COVERAGE_PROBABILITY
 from uq.engine.inputs import input_set
 from uq.engine.sampling import PROPAGATION_METHODS, new_seed, normal_scores
 from uq.engine.stopping import STOPPING_RULES, gum_validated, may_stop
-from uq.engine.statistics import (INTERVALS, CoMoments, Moments, StreamingStatistics, batch_statistics,
-                         tail_capacity)
+from uq.engine.statistics import (INTERVALS, CoMoments, Moments, StreamingStatistics,
+                                  tail_capacity)
 
 _BATCH_KEYS = ("mean", "u", "low", "high")
 
@@ -225,8 +225,9 @@ class _Runner:
         self.control, self.linear = None, {}
         self.covariance, self.comoments = tuple(covariance), {}
 
-    def _start(self, capacity, shapes):
-        self.stats = {q: StreamingStatistics(shape, capacity, self.references[q])
+    def _start(self, capacity, shapes, expected=None):
+        self.stats = {q: StreamingStatistics(shape, capacity, self.references[q],
+                                             expected=expected)
                       for q, shape in shapes.items()}
         self.batches = {q: {key: [] for key in _BATCH_KEYS} for q in shapes}
         self.linear = {q: Moments(shape) for q, shape in shapes.items()}
@@ -265,21 +266,21 @@ class _Runner:
         """Statistics batch by batch; chunks start on block boundaries, so the sequence of
         floating-point merges, and the result, is the same for every chunk size."""
         for q, values in outputs.items():
-            for start in range(0, len(values), self.batch_size):
-                batch = values[start:start + self.batch_size]
-                full = len(batch) == self.batch_size
-                summary = batch_statistics(batch, self.references[q], kind=self.interval) \
-                    if full else {"moments": None}
-                self.stats[q].update(batch, summary["moments"])   # moments computed once
-                if q in self.comoments:
-                    self.comoments[q].update(batch)
-                lin = None if linear is None else linear[q][start:start + self.batch_size]
-                if lin is not None:
-                    self.linear[q].update(lin, np.isfinite(batch))
-                if not full:
-                    continue
-                if lin is not None:
-                    summary.update(self._controlled(q, summary, batch, lin))
+            summaries = self.stats[q].add(values, self.batch_size, summarize=True,
+                                          kind=self.interval)
+            if q in self.comoments or linear is not None:
+                for start in range(0, len(values), self.batch_size):
+                    batch = values[start:start + self.batch_size]
+                    if q in self.comoments:
+                        self.comoments[q].update(batch)
+                    if linear is not None:
+                        self.linear[q].update(linear[q][start:start + self.batch_size],
+                                              np.isfinite(batch))
+            for start, summary in summaries:
+                if linear is not None:
+                    batch = values[start:start + self.batch_size]
+                    summary.update(self._controlled(q, summary, batch,
+                                                    linear[q][start:start + self.batch_size]))
                 for key in _BATCH_KEYS:
                     self.batches[q][key].append(summary[key])
         self.n_done += len(next(iter(outputs.values())))
@@ -325,7 +326,7 @@ class _Runner:
                                                                blocks * RNG_BLOCK_SIZE))
             if self.stats is None:
                 self._start(tail_capacity(n, kind=self.interval) + 1,
-                            {q: v.shape[1:] for q, v in outputs.items()})
+                            {q: v.shape[1:] for q, v in outputs.items()}, expected=n)
             self._accumulate(outputs, linear)
 
     def run_adaptive(self, digits, stopping="jcgm101", gum_targets=None):

@@ -25,6 +25,7 @@ References
 import numpy as np
 
 from uq.constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG, STORED_VALUES
+from uq.engine import statkernels
 from uq.engine.orderstats import order_statistics
 
 INTERVALS = ("symmetric", "shortest")
@@ -186,6 +187,12 @@ class CoMoments:
 class StreamingStatistics:
     """Mean, standard deviation and coverage intervals of an array-valued output.
 
+    Values are kept element-major (one contiguous column per element, unwrapped for a
+    circular output) until `stored_values` are held: the moments, the circular
+    resultant and the order statistics are then passes over contiguous columns in the
+    compiled loops of :mod:`uq.engine.statkernels`. Beyond the budget only the tails
+    the coverage interval needs are kept.
+
     Parameters
     ----------
     shape : tuple
@@ -195,59 +202,128 @@ class StreamingStatistics:
         largest sample count that will be seen).
     reference : ndarray or None
         For circular outputs, the unwrapping reference [deg], of `shape`.
+    stored_values : int
+        Values kept whole, over all elements.
+    expected : int, optional
+        Samples that will be added (the store is sized for them at once).
     """
 
-    def __init__(self, shape, capacity, reference=None, stored_values=STORED_VALUES):
+    def __init__(self, shape, capacity, reference=None, stored_values=STORED_VALUES,
+                 expected=None):
         self.shape = tuple(shape)
         self.capacity = int(capacity)
-        self.reference = None if reference is None else np.broadcast_to(reference, shape)
+        self.reference = None if reference is None else \
+            np.array(np.broadcast_to(reference, shape), dtype=float).reshape(-1)   # writeable
         self.moments = Moments(shape)
-        self.resultant = np.zeros(shape, dtype=complex)
-        size = int(np.prod(shape))
-        self._low = [_Tail(self.capacity) for _ in range(size)]
-        self._high = [_Tail(self.capacity) for _ in range(size)]      # holds -values
-        # every value is kept until `stored_values` are held, then the tails take over
-        self._stored, self._budget = [], int(stored_values)
+        self.size = int(np.prod(shape))
+        self._cos, self._sin = np.zeros(self.size), np.zeros(self.size)   # resultant
+        self._low = self._high = None              # the tails, once the budget is spent
+        self._budget = int(stored_values)
+        room = self._budget // max(self.size, 1)
+        self._columns = np.empty((self.size, min(int(expected), room) if expected else 0))
+        self._count = 0                            # samples held in _columns
+        self._scratch = np.empty((2, 0))
+
+    @property
+    def _stored(self):
+        """Are all values still kept (else only the tails)?"""
+        return self._low is None
 
     def update(self, values, moments=None):
-        """Add samples of shape (m, *shape); `moments`, their (count, mean, m2) after
-        unwrapping (from :func:`batch_statistics`), if already known."""
+        """Add samples of shape (m, *shape) as one batch (`moments` is ignored: they
+        are computed from the element-major copy)."""
+        self.add(values, max(len(values), 1))
+
+    def add(self, values, batch_size, summarize=False, kind="symmetric"):
+        """Add samples (m, *shape) batch by batch: each batch's moments are merged in
+        order (so the result does not depend on how the samples were chunked, when
+        chunks start on batch boundaries). With `summarize`, returns the mean, u, low
+        and high of every full batch, ``[(start, summary), ...]`` (JCGM 101, 7.9)."""
         values = np.asarray(values, dtype=float)
-        if self.reference is not None:
-            self.resultant += np.nansum(np.exp(1j * np.deg2rad(values)), axis=0)
-            values = unwrap(values, self.reference)
-        self.moments.merge(*(moments or _batch_moments(values, self.shape)))
-        flat = values.reshape(len(values), -1)
-        if self._stored is not None:
-            self._stored.append(flat.copy())
-            if len(self._stored) * flat.size > self._budget:
+        m = len(values)
+        flat = values.reshape(m, self.size)
+        if not flat.flags.writeable:                 # (a broadcast: the kernels take views
+            flat = flat.copy()                       # they could write to)
+        columns, offset = self._room(m)
+        circular = self.reference is not None
+        statkernels.transpose(flat, self.reference if circular else _NO_REFERENCE,
+                              circular, columns, offset)
+        summaries = []
+        count, mean, m2 = (np.empty(self.size, dtype=np.int64), np.empty(self.size),
+                           np.empty(self.size))
+        for start in range(0, m, batch_size):
+            stop = min(m, start + batch_size)
+            statkernels.moments(columns, offset + start, offset + stop, count, mean, m2)
+            self.moments.merge(count.reshape(self.shape), mean.reshape(self.shape),
+                               m2.reshape(self.shape))
+            if circular:
+                statkernels.resultant(columns, offset + start, offset + stop,
+                                      self.reference, self._cos, self._sin)
+            if summarize and stop - start == batch_size:
+                summaries.append((start, self._summary(columns, offset + start, offset + stop,
+                                                       count, mean, m2, kind)))
+        if self._stored:
+            self._count += m
+            if self._count * self.size > self._budget:
                 self._spill()
-            return
-        self._add_to_tails(flat)
+        else:
+            self._add_to_tails(columns[:, :m].T)
+        return summaries
+
+    def _room(self, m):
+        """(columns, offset) to write m more samples into: the store (grown by
+        doubling), or a scratch block once only the tails are kept."""
+        if not self._stored:
+            if self._columns.shape[1] < m:
+                self._columns = np.empty((self.size, m))
+            return self._columns, 0
+        need = self._count + m
+        if need > self._columns.shape[1]:
+            grown = np.empty((self.size, max(need, 2 * self._columns.shape[1])))
+            grown[:, :self._count] = self._columns[:, :self._count]
+            self._columns = grown
+        return self._columns, self._count
+
+    def _summary(self, columns, start, stop, count, mean, m2, kind):
+        """Mean, u, low and high of one batch, of `shape`."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            u = np.sqrt(np.where(count > 1, m2 / np.maximum(count - 1, 1), np.nan))
+        low, high = self._endpoints(columns, start, stop, count, kind)
+        return {"mean": np.where(count > 0, mean, np.nan).reshape(self.shape),
+                "u": u.reshape(self.shape), "low": low.reshape(self.shape),
+                "high": high.reshape(self.shape)}
+
+    def _endpoints(self, columns, start, stop, count, kind, probability=COVERAGE_PROBABILITY):
+        """Coverage interval of every element from columns[:, start:stop]."""
+        low, high = np.empty(self.size), np.empty(self.size)
+        if kind == "symmetric":
+            ranks = np.array([_symmetric_ranks(int(c), probability) or (-1, -1)
+                              for c in count], dtype=np.int64).reshape(-1, 2)
+            if self._scratch.shape[1] < stop - start:
+                self._scratch = np.empty((2, stop - start))
+            statkernels.select_pairs(columns, start, stop, np.ascontiguousarray(count,
+                                     dtype=np.int64), ranks[:, 0].copy(), ranks[:, 1].copy(),
+                                     low, high, self._scratch)
+            return low, high
+        for j in range(self.size):
+            column = columns[j, start:stop]
+            column = np.sort(column[np.isfinite(column)])
+            low[j], high[j] = coverage_interval(column, column, len(column), probability, kind)
+        return low, high
 
     def _spill(self):
         """Hand the stored values to the tails (the memory bound of long runs)."""
-        stored, self._stored = self._stored, None
-        for flat in stored:
-            self._add_to_tails(flat)
-
-    def _stored_column(self, j):
-        """Every stored finite value of element j."""
-        column = np.concatenate([flat[:, j] for flat in self._stored]) if self._stored \
-            else np.empty(0)
-        if len(column) == self.moments.count.reshape(-1)[j]:
-            return column                  # the moments counted every value finite
-        return column[np.isfinite(column)]
+        self._low = [_Tail(self.capacity) for _ in range(self.size)]
+        self._high = [_Tail(self.capacity) for _ in range(self.size)]      # holds -values
+        self._add_to_tails(self._columns[:, :self._count].T)
+        self._columns = np.empty((self.size, 0))
 
     def _symmetric(self, j, m, probability):
-        """JCGM 101 7.7.2 endpoints of element j: just the two order statistics
-        (:func:`uq.orderstats.order_statistics`) of the stored values or of the tails,
-        no sorting (NaN when the tails hold too few values, as in coverage_interval)."""
+        """JCGM 101 7.7.2 endpoints of element j from the tails (NaN when they hold too
+        few values, as in coverage_interval)."""
         ranks = _symmetric_ranks(m, probability)
         if not ranks:
             return np.nan, np.nan
-        if self._stored is not None:
-            return tuple(order_statistics(self._stored_column(j), ranks))
         low_values, high_values = self._low[j].values(), -self._high[j].values()
         high_index = ranks[1] - (m - len(high_values))      # the high tail's top ranks
         if ranks[0] >= len(low_values) or high_index < 0:
@@ -256,15 +332,8 @@ class StreamingStatistics:
                 order_statistics(high_values, [high_index])[0])
 
     def _extremes(self, j):
-        """(smallest, largest) kept values of element j, each ascending, and their count."""
-        if self._stored is None:
-            return np.sort(self._low[j].values()), np.sort(-self._high[j].values())
-        column = self._stored_column(j)
-        k = min(self.capacity, len(column))
-        if k == 0:
-            return column, column
-        parted = np.partition(column, [k - 1, len(column) - k])     # both ends, one pass
-        return np.sort(parted[:k]), np.sort(parted[len(column) - k:])
+        """(smallest, largest) kept values of element j from the tails, each ascending."""
+        return np.sort(self._low[j].values()), np.sort(-self._high[j].values())
 
     def _add_to_tails(self, flat):
         low_bound = np.array([tail.threshold for tail in self._low])
@@ -281,21 +350,30 @@ class StreamingStatistics:
         count = self.moments.count
         u = np.sqrt(self.moments.variance())
         mean = np.where(count > 0, self.moments.mean, np.nan)
-        low, high = np.full(self.shape, np.nan), np.full(self.shape, np.nan)
-        for j, m in enumerate(count.reshape(-1)):
-            if kind == "symmetric":
-                bounds = self._symmetric(j, int(m), probability)
-            else:
-                bounds = coverage_interval(*self._extremes(j), int(m), probability, kind)
-            low.reshape(-1)[j], high.reshape(-1)[j] = bounds
-        out = {"mean": mean, "u": u, "low": low, "high": high, "n_valid": count}
+        if self._stored:
+            low, high = self._endpoints(self._columns, 0, self._count,
+                                        count.reshape(-1), kind, probability)
+        else:
+            low, high = np.full(self.size, np.nan), np.full(self.size, np.nan)
+            for j, m in enumerate(count.reshape(-1)):
+                if kind == "symmetric":
+                    low[j], high[j] = self._symmetric(j, int(m), probability)
+                else:
+                    low[j], high[j] = coverage_interval(*self._extremes(j), int(m),
+                                                        probability, kind)
+        out = {"mean": mean, "u": u, "low": low.reshape(self.shape),
+               "high": high.reshape(self.shape), "n_valid": count}
         if self.reference is not None:
-            length = np.abs(self.resultant) / np.maximum(count, 1)
+            length = np.hypot(self._cos, self._sin).reshape(self.shape) / np.maximum(count, 1)
             with np.errstate(divide="ignore"):
                 out["circular_std"] = np.rad2deg(np.sqrt(-2 * np.log(np.minimum(length, 1.0))))
             for key in ("mean", "low", "high"):
                 out[key] = np.mod(out[key], FULL_CIRCLE_DEG)
         return out
+
+
+#: The reference of an output that is not circular (the kernels take an array).
+_NO_REFERENCE = np.zeros(0)
 
 
 class _Tail:

@@ -1,0 +1,252 @@
+"""Compiled (numba) loops of the Monte Carlo statistics (:mod:`uq.engine.statistics`).
+
+The model's outputs arrive trial-major, (trials, elements); every statistic is a pass
+over one element's values. :func:`transpose` copies a chunk once into element-major
+order (unwrapping circular outputs on the way), and everything after reads contiguous
+columns that stay in the cache:
+
+* :func:`moments`: count, mean and sum of squared deviations of the finite values of a
+  batch, two passes, each summed in :data:`LANES` interleaved partial sums (a fixed
+  order, so the same on every machine and for every chunk size, and a shorter
+  dependency chain than one running sum);
+* :func:`resultant`: sums of cos and sin of each circular value's deviation from its
+  reference (the circular standard deviation), from Taylor polynomials in a loop
+  without calls, libm beyond :data:`~uq.constants.SMALL_ANGLE`;
+* :func:`select_pairs`: the two order statistics of the probabilistically symmetric
+  interval of each element, exact, by sample-bracketed selection (Floyd and Rivest
+  1975; as :mod:`uq.engine.orderstats`): one pass counts the values below each bracket
+  and keeps those inside it, and only these are partitioned.
+
+References
+----------
+.. [1] Floyd, R. W. and Rivest, R. L. (1975). Expected time bounds for selection.
+   Communications of the ACM 18(3), 165-172.
+.. [2] Chan, T. F., Golub, G. H. and LeVeque, R. J. (1983). Algorithms for computing the
+   sample variance. The American Statistician 37(3), 242-247.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from uq.constants import FULL_CIRCLE_DEG, HALF_CIRCLE_DEG, ORDER_SAMPLE, SMALL_ANGLE
+
+#: Interleaved partial sums of :func:`moments` and :func:`resultant` [1]: four break the
+#: add-latency chain (4 cycles) of one running sum; their order is fixed.
+LANES = 4
+#: Binomial standard deviations of a sample rank by which a bracket is widened [1] (as
+#: :mod:`uq.engine.orderstats`).
+_MARGIN_SIGMAS = 4.0
+_DEG = math.pi / 180.0
+_S = tuple((-1) ** k / math.factorial(2 * k + 1) for k in range(8))
+_C = tuple((-1) ** k / math.factorial(2 * k) for k in range(9))
+
+_SIG = "float64[:, :], float64[::1], boolean, float64[:, ::1], int64"
+
+
+@njit(f"void({_SIG})", cache=True)
+def transpose(values, reference, circular, out, offset):
+    """out[e, offset + i] = values[i, e], unwrapped about reference[e] into
+    (reference - 180, reference + 180] for a circular output (as
+    :func:`uq.engine.statistics.unwrap`). Tiles of 64 trials keep the writes of all
+    elements in the cache."""
+    m, elements = values.shape
+    for start in range(0, m, 64):
+        stop = min(m, start + 64)
+        for e in range(elements):
+            ref = reference[e] if circular else 0.0
+            for i in range(start, stop):
+                value = values[i, e]
+                if circular:        # numpy.mod's sign rule is Python's float %
+                    value = ref - (ref - value + HALF_CIRCLE_DEG) % FULL_CIRCLE_DEG \
+                        + HALF_CIRCLE_DEG
+                out[e, offset + i] = value
+
+
+@njit("void(float64[:, ::1], int64, int64, int64[::1], float64[::1], float64[::1])",
+      cache=True)
+def moments(columns, start, stop, count, mean, m2):
+    """Count, mean and sum of squared deviations of the finite values of
+    columns[e, start:stop], for every element e."""
+    for e in range(columns.shape[0]):
+        column = columns[e, start:stop]
+        n = column.shape[0]
+        sums = np.zeros(LANES)
+        finite = 0
+        for j in range(n - n % LANES):
+            lane = j % LANES
+            value = column[j]
+            if math.isfinite(value):
+                sums[lane] += value
+                finite += 1
+        total = 0.0
+        for j in range(n - n % LANES, n):
+            if math.isfinite(column[j]):
+                total += column[j]
+                finite += 1
+        total += (sums[0] + sums[1]) + (sums[2] + sums[3])
+        count[e] = finite
+        centre = total / finite if finite else 0.0
+        sums[:] = 0.0
+        for j in range(n - n % LANES):
+            value = column[j]
+            if math.isfinite(value):
+                sums[j % LANES] += (value - centre) * (value - centre)
+        square = 0.0
+        for j in range(n - n % LANES, n):
+            if math.isfinite(column[j]):
+                square += (column[j] - centre) * (column[j] - centre)
+        mean[e] = centre
+        m2[e] = square + ((sums[0] + sums[1]) + (sums[2] + sums[3]))
+
+
+@njit("void(float64[:, ::1], int64, int64, float64[::1], float64[::1], float64[::1])",
+      cache=True)
+def resultant(columns, start, stop, reference, cos_sum, sin_sum):
+    """Add sum cos(d) and sum sin(d) of the finite values' deviations d = value -
+    reference [deg] of columns[e, start:stop] to cos_sum[e], sin_sum[e]: the length of
+    the mean resultant vector, invariant to the rotation by the reference."""
+    n = stop - start
+    c = np.empty(n)
+    s = np.empty(n)
+    for e in range(columns.shape[0]):
+        column = columns[e, start:stop]
+        ref = reference[e]
+        for j in range(n):                   # no calls: SIMD
+            x = (column[j] - ref) * _DEG
+            x2 = x * x
+            s[j] = x * (_S[0] + x2 * (_S[1] + x2 * (_S[2] + x2 * (_S[3] + x2 * (
+                _S[4] + x2 * (_S[5] + x2 * (_S[6] + x2 * _S[7])))))))
+            c[j] = _C[0] + x2 * (_C[1] + x2 * (_C[2] + x2 * (_C[3] + x2 * (_C[4] + x2 * (
+                _C[5] + x2 * (_C[6] + x2 * (_C[7] + x2 * _C[8])))))))
+        sums = np.zeros(2 * LANES)
+        for j in range(n):
+            x = (column[j] - ref) * _DEG
+            if not math.isfinite(x):
+                continue                     # as numpy.nansum: NaN trials add nothing
+            if abs(x) > SMALL_ANGLE:         # libm beyond the polynomials' range
+                c[j], s[j] = math.cos(x), math.sin(x)
+            lane = j % LANES
+            sums[lane] += c[j]
+            sums[LANES + lane] += s[j]
+        cos_sum[e] += (sums[0] + sums[1]) + (sums[2] + sums[3])
+        sin_sum[e] += (sums[4] + sums[5]) + (sums[6] + sums[7])
+
+
+@njit(cache=True)
+def _select(values, rank, low, high):
+    """The value of 0-based `rank` of values[low:high] (reordered in place): Hoare's
+    selection with a median-of-three pivot."""
+    while high - low > 1:
+        mid = (low + high - 1) // 2
+        a, b, c = values[low], values[mid], values[high - 1]
+        pivot = max(min(a, b), min(max(a, b), c))
+        i, j = low, high - 1
+        while i <= j:
+            while values[i] < pivot:
+                i += 1
+            while values[j] > pivot:
+                j -= 1
+            if i <= j:
+                values[i], values[j] = values[j], values[i]
+                i += 1
+                j -= 1
+        if rank <= j:
+            high = j + 1
+        elif rank >= i:
+            low = i
+        else:
+            return values[rank]
+    return values[rank]
+
+
+@njit(cache=True)
+def _bracket(rank, n, sample):
+    """Sample values (a, b) that enclose `rank` of n with a margin (+-inf at the ends)."""
+    s = sample.shape[0]
+    p = (rank + 0.5) / n
+    margin = _MARGIN_SIGMAS * math.sqrt(s * p * (1.0 - p)) + 1.0
+    first, last = math.floor(p * s - margin), math.ceil(p * s + margin)
+    return (sample[first] if first >= 0 else -np.inf), (sample[last] if last < s else np.inf)
+
+
+@njit(cache=True)
+def _select_two(column, n_finite, low_rank, high_rank, keep_low, keep_high):
+    """The values of 0-based ranks low_rank < high_rank among the finite values of
+    `column` (n_finite of them; NaN neither counts nor is kept). A strided sample
+    (~4 sqrt(n) values, at most ORDER_SAMPLE) brackets each rank; one pass counts the
+    values below each bracket (SIMD), one keeps those inside; only the kept values are
+    partitioned (the two brackets do not overlap: ranks ~2.5 % and ~97.5 %; where
+    they would, the second misses and the fallback decides). Where a bracket misses its rank (rare), the finite values are
+    partitioned whole: exact either way."""
+    n = column.shape[0]
+    size = min(ORDER_SAMPLE, max(32, int(4.0 * math.sqrt(n_finite))))
+    step = max(1, n // size)
+    sample = np.sort(column[:step * size:step])
+    s = 0
+    while s < sample.shape[0] and math.isfinite(sample[s]):
+        s += 1                                     # NaN sorts last: leave it out
+    if s == 0:
+        return np.nan, np.nan
+    low_a, low_b = _bracket(low_rank, n_finite, sample[:s])
+    high_a, high_b = _bracket(high_rank, n_finite, sample[:s])
+    below_low = below_high = 0
+    for j in range(n):                            # no branches: SIMD
+        below_low += column[j] < low_a
+        below_high += column[j] < high_a
+    kept_low = kept_high = 0
+    for j in range(n):                            # the few inside a bracket
+        value = column[j]
+        if low_a <= value <= low_b:
+            keep_low[kept_low] = value
+            kept_low += 1
+        elif high_a <= value <= high_b:
+            keep_high[kept_high] = value
+            kept_high += 1
+    if below_low <= low_rank < below_low + kept_low:
+        low = _select(keep_low, low_rank - below_low, 0, kept_low)
+    else:
+        low = _select(keep_low, low_rank, 0, _finite(column, keep_low))
+    if below_high <= high_rank < below_high + kept_high:
+        high = _select(keep_high, high_rank - below_high, 0, kept_high)
+    else:
+        high = _select(keep_high, high_rank, 0, _finite(column, keep_high))
+    return low, high
+
+
+@njit(cache=True)
+def _finite(column, out):
+    """Copy the finite values of `column` into out; their number."""
+    n = 0
+    for j in range(column.shape[0]):
+        if math.isfinite(column[j]):
+            out[n] = column[j]
+            n += 1
+    return n
+
+
+@njit("void(float64[:, ::1], int64, int64, int64[::1], int64[::1], int64[::1], "
+      "float64[::1], float64[::1], float64[:, ::1])", cache=True)
+def select_pairs(columns, start, stop, count, low_rank, high_rank, low, high, scratch):
+    """low[e], high[e]: the order statistics of 0-based ranks low_rank[e] <
+    high_rank[e] among the count[e] finite values of columns[e, start:stop] (NaN where
+    the ranks are -1: too few values); the ranks are those of the count,
+    :func:`uq.engine.statistics._symmetric_ranks`. `scratch` (2, >= stop - start) is
+    the caller's, reused (no fresh pages per call)."""
+    n = stop - start
+    keep_low, keep_high = scratch[0], scratch[1]
+    for e in range(columns.shape[0]):
+        if low_rank[e] < 0:
+            low[e], high[e] = np.nan, np.nan
+            continue
+        column = columns[e, start:stop]
+        if count[e] < 2 * ORDER_SAMPLE:            # few: partition them all
+            finite = _finite(column, keep_low)
+            low[e] = _select(keep_low, low_rank[e], 0, finite)
+            high[e] = _select(keep_low, high_rank[e], low_rank[e], finite)
+            continue
+        if count[e] < n:                           # NaN among them: the finite ones
+            finite = _finite(column, keep_high)
+            column = keep_high[:finite].copy()
+        low[e], high[e] = _select_two(column, count[e], low_rank[e], high_rank[e],
+                                      keep_low, keep_high)
