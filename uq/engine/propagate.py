@@ -43,7 +43,10 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     model : callable
         ``model(**arrays)``: every input by name as an array of shape (n, *shape);
         returns an array of shape (n, ...) or a dict of them (a single array is named
-        ``y``). Must be complex-step safe for the GUM (:mod:`uq.engine.gum`).
+        ``y``). Must be complex-step safe for the GUM (:mod:`uq.engine.gum`). It is
+        called on slices of ~MODEL_SLICE_VALUES random values (its temporaries stay in
+        the cache), or once per chunk if it has the attribute ``whole_chunks = True``
+        (a model that blocks its own trials; the results are the same).
     inputs : dict
         name -> scipy.stats frozen distribution, float (a constant) or
         :class:`uq.engine.inputs.Input` (a distribution with a shape).
@@ -191,6 +194,7 @@ def _named_outputs(model):
     def wrapped(**arrays):
         out = model(**arrays)
         return out if isinstance(out, dict) else {"y": out}
+    wrapped.whole_chunks = bool(getattr(model, "whole_chunks", False))
     return wrapped
 
 
@@ -233,15 +237,21 @@ class _Runner:
         self.linear = {q: Moments(shape) for q, shape in shapes.items()}
         self.comoments = {q: CoMoments(shapes[q]) for q in self.covariance}
 
-    def _evaluate(self, first_block, n_blocks, n_samples):
+    def _pieces(self, first_block, n_blocks, n_samples):
         """Outputs (and linear deviations, with a control variate) of n_samples trials
-        from the blocks first_block ..; inputs are made slice by slice (in the cache)."""
+        from the blocks first_block .., in pieces to accumulate: inputs are made slice by
+        slice (in the cache). A model that blocks its own trials (``whole_chunks``, e.g.
+        a compiled loop) is called once per statistics batch, and each batch is yielded
+        while its outputs are still in the cache; any other model's slices are joined
+        into one piece per chunk (batches may span its slices)."""
         scores = np.empty((n_samples, self.inputs.dimension))
         for k in range(n_blocks):               # the last block only as far as needed
             rows = min(RNG_BLOCK_SIZE, n_samples - k * RNG_BLOCK_SIZE)
             normal_scores(self.method, self.seed, first_block + k, self.inputs.dimension,
                           out=scores[k * RNG_BLOCK_SIZE:k * RNG_BLOCK_SIZE + rows], rows=rows)
-        pieces, linear, step = [], [], model_slice_size(self.inputs.dimension)
+        whole = self.model.whole_chunks
+        step = self.batch_size if whole else model_slice_size(self.inputs.dimension)
+        pieces, linear = [], []
         for start in range(0, n_samples, step):
             size = min(step, n_samples - start)
             values = self.inputs.values(scores[start:start + size], overwrite=True)
@@ -250,7 +260,10 @@ class _Runner:
                 columns = controlvariate.input_columns(values, self.inputs)
                 linear.append({q: controlvariate.linear_deviation(self.control[q][0], columns)
                                for q in pieces[-1]})
-        return _joined(pieces), (_joined(linear) if self.control else None)
+            if whole:
+                yield pieces.pop(), (linear.pop() if self.control else None)
+        if not whole:
+            yield _joined(pieces), (_joined(linear) if self.control else None)
 
     def _model(self, values, size):
         """The model on one slice of `size` trials; slices start on block boundaries, so
@@ -322,12 +335,12 @@ class _Runner:
         total_blocks = -(-n // RNG_BLOCK_SIZE)
         for first in range(0, total_blocks, self.blocks_per_chunk):
             blocks = min(self.blocks_per_chunk, total_blocks - first)
-            outputs, linear = self._evaluate(first, blocks, min(n - first * RNG_BLOCK_SIZE,
-                                                               blocks * RNG_BLOCK_SIZE))
-            if self.stats is None:
-                self._start(tail_capacity(n, kind=self.interval) + 1,
-                            {q: v.shape[1:] for q, v in outputs.items()}, expected=n)
-            self._accumulate(outputs, linear)
+            for outputs, linear in self._pieces(first, blocks, min(
+                    n - first * RNG_BLOCK_SIZE, blocks * RNG_BLOCK_SIZE)):
+                if self.stats is None:
+                    self._start(tail_capacity(n, kind=self.interval) + 1,
+                                {q: v.shape[1:] for q, v in outputs.items()}, expected=n)
+                self._accumulate(outputs, linear)
 
     def run_adaptive(self, digits, stopping="jcgm101", gum_targets=None):
         """JCGM 101:2008, 7.9.4: batches of M >= 10^4 trials, one RNG block per step, until
@@ -336,11 +349,11 @@ class _Runner:
         reached."""
         block = 0
         while True:
-            outputs, linear = self._evaluate(block, 1, RNG_BLOCK_SIZE)
-            if self.stats is None:
-                self._start(tail_capacity(ADAPTIVE_MAX_SAMPLES, kind=self.interval) + 1,
-                            {q: v.shape[1:] for q, v in outputs.items()})
-            self._accumulate(outputs, linear)
+            for outputs, linear in self._pieces(block, 1, RNG_BLOCK_SIZE):
+                if self.stats is None:
+                    self._start(tail_capacity(ADAPTIVE_MAX_SAMPLES, kind=self.interval) + 1,
+                                {q: v.shape[1:] for q, v in outputs.items()})
+                self._accumulate(outputs, linear)
             block += 1
             # validating the GUM: Monte Carlo to delta/5 (JCGM 101 8.2), unless the GUM
             # is validated beyond the noise first

@@ -162,14 +162,19 @@ class CoMoments:
         self.comoment = np.zeros(self.shape + self.shape[-1:])
 
     def update(self, values):
-        """Add the trials of `values` (m, *shape) whose g values are all finite."""
-        valid = np.all(np.isfinite(values), axis=-1, keepdims=True)
-        count = valid[..., 0].sum(axis=0)
-        safe = np.where(valid, values, 0.0)
-        mean = np.divide(safe.sum(axis=0), count[..., None], out=np.zeros(self.shape),
-                         where=count[..., None] > 0)
-        deviation = np.where(valid, values - mean, 0.0)
-        comoment = np.einsum("m...i,m...j->...ij", deviation, deviation)
+        """Add the trials of `values` (m, *shape) whose g values are all finite (the
+        batch's count, mean and co-moments by :func:`uq.engine.statkernels.comoments`)."""
+        values = np.asarray(values, dtype=float)
+        g = self.shape[-1]
+        rows = values.reshape(len(values), -1, g)
+        if not rows.flags.writeable:
+            rows = rows.copy()
+        count = np.empty(rows.shape[1], dtype=np.int64)
+        mean, comoment = np.empty(rows.shape[1:]), np.empty(rows.shape[1:] + (g,))
+        statkernels.comoments(rows, count, mean, comoment)
+        count = count.reshape(self.count.shape)
+        mean = mean.reshape(self.shape)
+        comoment = comoment.reshape(self.comoment.shape)
         total = self.count + count
         weight = np.divide(count, total, out=np.zeros(count.shape), where=total > 0)
         delta = mean - self.mean

@@ -12,6 +12,8 @@ columns that stay in the cache:
 * :func:`resultant`: sums of cos and sin of each circular value's deviation from its
   reference (the circular standard deviation), from Taylor polynomials in a loop
   without calls, libm beyond :data:`~uq.constants.SMALL_ANGLE`;
+* :func:`comoments`: count, mean and co-moment matrix of the complete trials of a batch
+  along the last axis (the gate-to-gate covariance);
 * :func:`select_pairs`: the two order statistics of the probabilistically symmetric
   interval of each element, exact, by sample-bracketed selection (Floyd and Rivest
   1975; as :mod:`uq.engine.orderstats`): one pass counts the values below each bracket
@@ -44,6 +46,20 @@ _C = tuple((-1) ** k / math.factorial(2 * k) for k in range(9))
 _SIG = "float64[:, :], float64[::1], boolean, float64[:, ::1], int64"
 
 
+@njit(inline="always")
+def _mod360(x):
+    """numpy.mod(x, 360): x, x - 360 or x + 360 where x is within a turn of [0, 360)
+    (each exact or rounded as numpy's fmod-and-add rounds it), Python's float % (the
+    same sign rule) elsewhere; fmod costs ~30 ns."""
+    if 0.0 <= x < FULL_CIRCLE_DEG:
+        return x
+    if FULL_CIRCLE_DEG <= x < 2 * FULL_CIRCLE_DEG:
+        return x - FULL_CIRCLE_DEG
+    if -FULL_CIRCLE_DEG < x < 0.0:
+        return x + FULL_CIRCLE_DEG
+    return x % FULL_CIRCLE_DEG
+
+
 @njit(f"void({_SIG})", cache=True)
 def transpose(values, reference, circular, out, offset):
     """out[e, offset + i] = values[i, e], unwrapped about reference[e] into
@@ -57,9 +73,8 @@ def transpose(values, reference, circular, out, offset):
             ref = reference[e] if circular else 0.0
             for i in range(start, stop):
                 value = values[i, e]
-                if circular:        # numpy.mod's sign rule is Python's float %
-                    value = ref - (ref - value + HALF_CIRCLE_DEG) % FULL_CIRCLE_DEG \
-                        + HALF_CIRCLE_DEG
+                if circular:
+                    value = ref - _mod360(ref - value + HALF_CIRCLE_DEG) + HALF_CIRCLE_DEG
                 out[e, offset + i] = value
 
 
@@ -250,3 +265,38 @@ def select_pairs(columns, start, stop, count, low_rank, high_rank, low, high, sc
             column = keep_high[:finite].copy()
         low[e], high[e] = _select_two(column, count[e], low_rank[e], high_rank[e],
                                       keep_low, keep_high)
+
+
+@njit("void(float64[:, :, :], int64[::1], float64[:, ::1], float64[:, :, ::1])", cache=True)
+def comoments(values, count, mean, comoment):
+    """For values (m, S, g): per s, the count of trials whose g values are all finite,
+    their mean (g) and the sum of products of their deviations (g, g), two passes."""
+    m, scenes, g = values.shape
+    for s in range(scenes):
+        n = 0
+        mean[s, :] = 0.0
+        for i in range(m):
+            complete = True
+            for a in range(g):
+                complete = complete and math.isfinite(values[i, s, a])
+            if complete:
+                n += 1
+                for a in range(g):
+                    mean[s, a] += values[i, s, a]
+        count[s] = n
+        for a in range(g):
+            mean[s, a] = mean[s, a] / n if n else 0.0
+        comoment[s, :, :] = 0.0
+        for i in range(m):
+            complete = True
+            for a in range(g):
+                complete = complete and math.isfinite(values[i, s, a])
+            if not complete:
+                continue
+            for a in range(g):
+                deviation = values[i, s, a] - mean[s, a]
+                for b in range(a, g):
+                    comoment[s, a, b] += deviation * (values[i, s, b] - mean[s, b])
+        for a in range(g):
+            for b in range(a):
+                comoment[s, a, b] = comoment[s, b, a]

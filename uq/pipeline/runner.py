@@ -235,6 +235,7 @@ def _propagate(scene, settings, outputs, inputs, seed):
 
     def model(**errors):
         return measurement_model(scene, outputs, **errors)
+    model.whole_chunks = scene.time_resolved is None      # compiled: blocks its own trials
 
     return propagate(model, inputs,
                        n=sampling.get("n"), digits=sampling.get("digits"),
