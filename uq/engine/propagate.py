@@ -271,8 +271,8 @@ class _Runner:
         with np.errstate(all="ignore"):           # out-of-domain trials become NaN, counted
             outputs = self.model(**values, **self.inputs.constants)
         # outputs that do not depend on any random input may come back with one row
-        return {q: np.broadcast_to(np.real(np.asarray(v, dtype=float)),
-                                   (size,) + np.shape(v)[1:])
+        outputs = {q: np.real(np.asarray(v, dtype=float)) for q, v in outputs.items()}
+        return {q: v if len(v) == size else np.broadcast_to(v, (size,) + v.shape[1:])
                 for q, v in outputs.items()}
 
     def _accumulate(self, outputs, linear):

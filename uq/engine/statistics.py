@@ -167,8 +167,6 @@ class CoMoments:
         values = np.asarray(values, dtype=float)
         g = self.shape[-1]
         rows = values.reshape(len(values), -1, g)
-        if not rows.flags.writeable:
-            rows = rows.copy()
         count = np.empty(rows.shape[1], dtype=np.int64)
         mean, comoment = np.empty(rows.shape[1:]), np.empty(rows.shape[1:] + (g,))
         statkernels.comoments(rows, count, mean, comoment)
@@ -246,9 +244,7 @@ class StreamingStatistics:
         and high of every full batch, ``[(start, summary), ...]`` (JCGM 101, 7.9)."""
         values = np.asarray(values, dtype=float)
         m = len(values)
-        flat = values.reshape(m, self.size)
-        if not flat.flags.writeable:                 # (a broadcast: the kernels take views
-            flat = flat.copy()                       # they could write to)
+        flat = values.reshape(m, self.size)          # (a view where the layout allows)
         columns, offset = self._room(m)
         circular = self.reference is not None
         statkernels.transpose(flat, self.reference if circular else _NO_REFERENCE,

@@ -29,7 +29,7 @@ References
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
 
 from uq.constants import FULL_CIRCLE_DEG, HALF_CIRCLE_DEG, ORDER_SAMPLE, SMALL_ANGLE
 
@@ -43,7 +43,9 @@ _DEG = math.pi / 180.0
 _S = tuple((-1) ** k / math.factorial(2 * k + 1) for k in range(8))
 _C = tuple((-1) ** k / math.factorial(2 * k) for k in range(9))
 
-_SIG = "float64[:, :], float64[::1], boolean, float64[:, ::1], int64"
+_SIG = types.void(types.Array(types.float64, 2, "A", readonly=True),
+                  types.Array(types.float64, 1, "C"), types.boolean,
+                  types.Array(types.float64, 2, "C"), types.int64)
 
 
 @njit(inline="always")
@@ -60,7 +62,7 @@ def _mod360(x):
     return x % FULL_CIRCLE_DEG
 
 
-@njit(f"void({_SIG})", cache=True)
+@njit(_SIG, cache=True)
 def transpose(values, reference, circular, out, offset):
     """out[e, offset + i] = values[i, e], unwrapped about reference[e] into
     (reference - 180, reference + 180] for a circular output (as
@@ -187,31 +189,22 @@ def _bracket(rank, n, sample):
 
 @njit(cache=True)
 def _select_two(column, n_finite, low_rank, high_rank, keep_low, keep_high):
-    """The values of 0-based ranks low_rank < high_rank among the finite values of
-    `column` (n_finite of them; NaN neither counts nor is kept). A strided sample
-    (~4 sqrt(n) values, at most ORDER_SAMPLE) brackets each rank; one pass counts the
-    values below each bracket (SIMD), one keeps those inside; only the kept values are
-    partitioned (the two brackets do not overlap: ranks ~2.5 % and ~97.5 %; where
-    they would, the second misses and the fallback decides). Where a bracket misses its rank (rare), the finite values are
-    partitioned whole: exact either way."""
+    """The values of 0-based ranks low_rank < high_rank among the n_finite (all) values
+    of `column`. The column's first ~4 sqrt(n) values (at most ORDER_SAMPLE; the trials
+    are exchangeable, so a prefix is a sample, and reading it touches few cache lines)
+    bracket each rank; one streaming pass counts the values below each bracket and keeps
+    those inside; only the kept values are partitioned. Where a bracket misses its rank
+    (rare; or an ordered column), all values are partitioned: exact either way."""
     n = column.shape[0]
-    size = min(ORDER_SAMPLE, max(32, int(4.0 * math.sqrt(n_finite))))
-    step = max(1, n // size)
-    sample = np.sort(column[:step * size:step])
-    s = 0
-    while s < sample.shape[0] and math.isfinite(sample[s]):
-        s += 1                                     # NaN sorts last: leave it out
-    if s == 0:
-        return np.nan, np.nan
-    low_a, low_b = _bracket(low_rank, n_finite, sample[:s])
-    high_a, high_b = _bracket(high_rank, n_finite, sample[:s])
-    below_low = below_high = 0
-    for j in range(n):                            # no branches: SIMD
-        below_low += column[j] < low_a
-        below_high += column[j] < high_a
-    kept_low = kept_high = 0
-    for j in range(n):                            # the few inside a bracket
+    size = min(ORDER_SAMPLE, max(32, int(4.0 * math.sqrt(n_finite))), n)
+    sample = np.sort(column[:size].copy())
+    low_a, low_b = _bracket(low_rank, n_finite, sample)
+    high_a, high_b = _bracket(high_rank, n_finite, sample)
+    below_low = below_high = kept_low = kept_high = 0
+    for j in range(n):
         value = column[j]
+        below_low += value < low_a
+        below_high += value < high_a
         if low_a <= value <= low_b:
             keep_low[kept_low] = value
             kept_low += 1
@@ -267,7 +260,8 @@ def select_pairs(columns, start, stop, count, low_rank, high_rank, low, high, sc
                                       keep_low, keep_high)
 
 
-@njit("void(float64[:, :, :], int64[::1], float64[:, ::1], float64[:, :, ::1])", cache=True)
+@njit(types.void(types.Array(types.float64, 3, "A", readonly=True), types.int64[::1],
+                 types.float64[:, ::1], types.float64[:, :, ::1]), cache=True)
 def comoments(values, count, mean, comoment):
     """For values (m, S, g): per s, the count of trials whose g values are all finite,
     their mean (g) and the sum of products of their deviations (g, g), two passes."""

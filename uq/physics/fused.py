@@ -95,9 +95,9 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype):
     structure = np.array([len(scene.azimuths), int(scene.vertical_beam), n_gates,
                           CORRECTION_MODELS.index(scene.correction)]
                          + [int(q in outputs) for q in OUTPUTS], dtype=np.int64)
-    out = {q: np.empty((n, scenes) + ((n_beams,) if q == "radial_velocity" else ())
-                       + (n_gates,), dtype=dtype) if q in outputs else _UNUSED[dtype][q]
-           for q in OUTPUTS}
+    out = {q: np.empty((scenes,) + ((n_beams,) if q == "radial_velocity" else ())
+                       + (n_gates, n), dtype=dtype) if q in outputs else _UNUSED[dtype][q]
+           for q in OUTPUTS}             # element-major: each element's trials contiguous
     from_east = np.empty_like(out["wind_direction"])
     per_trial = any(g.shape[0] > 1 for g in geo)          # geometry errors: truth per trial
     block = FUSED_BLOCK_TRIALS
@@ -135,7 +135,9 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype):
                  out["radial_velocity"], out["gate_height"])
     if "wind_direction" in outputs:
         _direction(out["wind_direction"], from_east, out["wind_direction"])
-    return {q: out[q].reshape((n,) + shape + out[q].shape[2:]) for q in outputs}
+    # (n, *S, ...) views of the element-major arrays
+    return {q: np.moveaxis(out[q], -1, 0).reshape((n,) + shape + out[q].shape[1:-1])
+            for q in outputs}
 
 
 #: Placeholders of the outputs not requested, per dtype (the kernels write nothing there).

@@ -310,7 +310,9 @@ def _gate_heights(scene, beams, r, height_error, n_slanted, n_gates, at_slant, o
 def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
           s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
           radial, gate_height, pointwise):
-    """The outputs of scenes [s0, s1) x trials [t0, t1), into arrays (n, S, ...).
+    """The outputs of scenes [s0, s1) x trials [t0, t1), into element-major arrays
+    (S, g, n) and, for the radial velocities, (S, b, g, n): each element's trials are
+    contiguous, as the statistics read them.
 
     ``beams`` and ``profile`` (U(z) / U_ref of each beam's gates) are rows of
     :func:`geometry`: one per trial of the rectangle (`per_trial`) or one per scene
@@ -401,7 +403,7 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
                                   n_gates, at_slant, heights)
             if want_height:
                 for g in range(n_gates):
-                    gate_height[i, s, g] = heights[g]
+                    gate_height[s, g, i] = heights[g]
             if not pointwise:
                 # ---- one reading per scan: Eq. 13 [1]
                 if model == 0:                       # none: the configured heading, fixed
@@ -443,11 +445,11 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
                         east += rot[5] * z
                         up = rot[6] * x + rot[7] * y + rot[8] * z + ship[2]
                     if want_speed:
-                        speed[i, s, g] = _hypot(north, east)
+                        speed[s, g, i] = _hypot(north, east)
                     if want_vertical:
-                        vertical[i, s, g] = up
+                        vertical[s, g, i] = up
                     if want_direction:
-                        from_north[i, s, g], from_east[i, s, g] = -north, -east
+                        from_north[s, g, i], from_east[s, g, i] = -north, -east
                 if want_radial:        # measured + (R n_lidar) . ship: motion-free radial
                     for b in range(n_beams):
                         e0 = rot[0] * units[b, 0] + rot[1] * units[b, 1] + rot[2] * units[b, 2]
@@ -457,7 +459,7 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
                         for g in range(n_gates):
                             measured = truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] \
                                 if has_noise else truth[b, g]
-                            radial[i, s, b, g] = measured + removed
+                            radial[s, b, g, i] = measured + removed
                 continue
             # ---- a reading per beam: point-wise correction, then least squares [2]
             for b in range(n_beams):
@@ -486,7 +488,7 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
                     for g in range(n_gates):
                         measured = truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] \
                             if has_noise else truth[b, g]
-                        radial[i, s, b, g] = measured + along[b]
+                        radial[s, b, g, i] = measured + along[b]
             if not (want_speed or want_direction or want_vertical):
                 continue
             if model == 2:                           # tilt2d: the mean reading (Eq. 13 [1])
@@ -527,11 +529,11 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
                     north = mean_rot[0] * x + mean_rot[1] * y + mean_ship[0]
                     east = mean_rot[3] * x + mean_rot[4] * y + mean_ship[1]
                 if want_speed:
-                    speed[i, s, g] = _hypot(north, east)
+                    speed[s, g, i] = _hypot(north, east)
                 if want_vertical:
-                    vertical[i, s, g] = up
+                    vertical[s, g, i] = up
                 if want_direction:
-                    from_north[i, s, g], from_east[i, s, g] = -north, -east
+                    from_north[s, g, i], from_east[s, g, i] = -north, -east
 
 
 def wind_scan(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
