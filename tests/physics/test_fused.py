@@ -299,3 +299,40 @@ def test_reading_trigonometry_equals_libm(base, rng):
     np.testing.assert_allclose(cos, np.cos(exact), rtol=0, atol=4 * 2.2e-16)
     np.testing.assert_allclose(sin, np.sin(exact), rtol=0, atol=4 * 2.2e-16)
     assert np.isnan(cos[2002]) and np.isnan(sin[2002])
+
+
+def test_a_nan_error_in_the_first_trial_stays_in_that_trial(rng):
+    """An out-of-domain first trial (NaN geometry and INS errors) is NaN alone; the
+    others equal the numpy model (the kernels once took their zero from trial 0's
+    beams, so one NaN made every output NaN)."""
+    scene = make_scene(**{"correction": "full", "wind.shear": 0.1, "lidar.vertical_beam": True,
+                          "ship.pitch": 3.0})
+    err = errors(rng, 300, scene, ALL_SOURCES)
+    err["lidar_half_cone"][0] = err["ins_heading"][0] = np.nan
+    compiled, plain = both(scene, **err)
+    for name in ("wind_speed", "radial_velocity"):
+        assert np.isnan(compiled[name][0]).all() and not np.isnan(compiled[name][1:]).any()
+    assert_same({k: v[1:] for k, v in compiled.items()}, {k: v[1:] for k, v in plain.items()})
+
+
+@pytest.mark.parametrize("sources", [("lidar_half_cone",), ALL_SOURCES])
+def test_no_output_depends_on_uninitialised_memory(sources, monkeypatch, rng):
+    """Every scratch buffer of the compiled model filled with NaN (numpy.empty gives
+    whatever memory holds): the outputs are the same. A batch of four scenes in two
+    rectangles of trials (truth per trial) and with common truth."""
+    scene = make_scene(**{"correction": "none", "lidar.vertical_beam": True, "lidar.ranges": [40]})
+    batch = dataclasses.replace(scene, wind_direction=np.deg2rad([10.0, 50.0, 90.0, 130.0]),
+                                heading=np.deg2rad([0.0, 30.0, 60.0, 90.0]))
+    err = errors(rng, 1719, scene, sources)                # 2 scenes per rectangle
+    clean = measurement_model(batch, EVERY, **err)
+    empty = np.empty
+
+    def poisoned(*args, **kwargs):
+        array = empty(*args, **kwargs)
+        if array.dtype.kind in "fc":
+            array.fill(np.nan)
+        return array
+    monkeypatch.setattr(fused.np, "empty", poisoned)
+    dirty = measurement_model(batch, EVERY, **err)
+    for name in EVERY:
+        np.testing.assert_array_equal(dirty[name], clean[name], err_msg=name)

@@ -91,7 +91,7 @@ def evaluate(scene, outputs, scene_draws, errors):
 def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype):
     n_gates, n_beams = len(scene.ranges), scene.n_beams
     scenes = math.prod(shape)
-    table = scene_table(scene, shape)
+    (table, shapes), kept = scene_table(scene, shape)
     structure = np.array([len(scene.azimuths), int(scene.vertical_beam), n_gates,
                           CORRECTION_MODELS.index(scene.correction)]
                          + [int(q in outputs) for q in OUTPUTS], dtype=np.int64)
@@ -108,15 +108,15 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype):
     sin_trig = np.empty_like(cos_trig)
     scratch = np.empty(trials, dtype=dtype)
     truth_rows = group * trials if per_trial else scenes
-    beams = np.empty((truth_rows, n_beams, 3), dtype=dtype)
-    profile = np.empty((truth_rows, n_beams, n_gates), dtype=dtype)
-    exponent = np.empty(truth_rows)
     compiled = kernels.compiled(dtype)
     pointwise = any(error.shape[2] > 1 for error in ins)   # a reading per beam
     wind = compiled["wind_pointwise" if pointwise else "wind_scan"]
-    if not per_trial:                        # the truth of every scene, common to its trials
-        _truth(compiled, table, structure, geo, 0, scenes, 0, 1, False, beams, profile,
-               exponent)
+    exponent = np.empty(truth_rows)
+    if per_trial:                           # geometry errors: the truth of each trial
+        beams = np.empty((truth_rows, n_beams, 3), dtype=dtype)
+        profile = np.empty((truth_rows, n_beams, n_gates), dtype=dtype)
+    else:                                   # every scene's truth, common to its trials
+        beams, profile = _scene_truth(table, shapes, structure, geo, scenes, dtype, kept)
     for t0 in range(0, n, trials):
         t1 = min(n, t0 + trials)
         if not scene_draws:                 # the draws' trigonometry, shared by the scenes
@@ -127,9 +127,9 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype):
                 compiled["ins_trig"](ins, table, s0, s1, t0, t1, True, cos_trig, sin_trig,
                                      scratch)
             if per_trial:
-                _truth(compiled, table, structure, geo, s0, s1, t0, t1, True, beams, profile,
-                       exponent)
-            wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, geo[2],
+                _truth(compiled, table, shapes, structure, geo, s0, s1, t0, t1, True, beams,
+                       profile, exponent)
+            wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile, geo[2],
                  s0, s1, t0, t1, scene_draws, per_trial, out["wind_speed"],
                  out["vertical_wind"], out["wind_direction"], from_east,
                  out["radial_velocity"], out["gate_height"])
@@ -145,14 +145,46 @@ _UNUSED = {dtype: {q: np.empty((1, 1, 1) + ((1,) if q == "radial_velocity" else 
                    for q in OUTPUTS} for dtype in (float, complex)}
 
 
-def _truth(compiled, table, structure, geo, s0, s1, t0, t1, per_trial, beams, profile,
-           exponent):
+def _scene_truth(table, shapes, structure, geo, scenes, dtype, kept):
+    """True beams and profile of every scene (no geometry error varies them over the
+    trials). Errors that are constants (absent, or the GUM's real means): computed once
+    in float64 and kept with the table (a GUM evaluates the same scenes three times); a
+    complex-step call gets an exact complex copy (its geometry is not perturbed, so
+    the imaginary parts are zero)."""
+    n_beams, n_gates = structure[0] + structure[1], structure[2]
+    constant = all(g.shape == (1, 1, 1) and g[0, 0, 0].imag == 0 for g in geo)
+    key = tuple(float(g[0, 0, 0].real) for g in geo)
+    if constant and key in kept:
+        beams, profile = kept[key]
+    else:
+        real = constant or np.dtype(dtype).kind != "c"
+        number = float if real else dtype
+        beams = np.empty((scenes, n_beams, 3), dtype=number)
+        profile = np.empty((scenes, n_beams, n_gates), dtype=number)
+        _truth(kernels.compiled(number), table, shapes, structure,
+               tuple(g.real.copy() for g in geo) if real else geo, 0, scenes, 0, 1, False,
+               beams, profile, np.empty(scenes))
+        if constant:
+            kept[key] = (beams, profile)
+    if np.dtype(dtype).kind == "c" and beams.dtype.kind != "c":
+        if constant and key + ("c",) in kept:
+            return kept[key + ("c",)]
+        beams, profile = beams.astype(complex), profile.astype(complex)
+        if constant:
+            kept[key + ("c",)] = (beams, profile)
+    return beams, profile
+
+
+def _truth(compiled, table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams,
+           profile, exponent):
     """True beams and the power-law profile U(z) / U_ref (z / z_ref)^alpha of the rows
     of a rectangle (:func:`uq.physics.fusedkernels.geometry`); numpy's SIMD log and exp,
     NaN stays NaN (1 where there is no shear: exp(0 log 1) is exactly 1)."""
-    compiled["geometry"](table, structure, geo, s0, s1, t0, t1, per_trial, beams, profile,
-                         exponent)
+    compiled["geometry"](table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams,
+                         profile, exponent)
     rows = (s1 - s0) * ((t1 - t0) if per_trial else 1)
+    if not np.any(exponent[:rows]):         # no shear: the kernel set 1 (or NaN) already
+        return
     ratio = profile[:rows]
     np.log(ratio, out=ratio)
     if np.all(exponent[:rows] == exponent[0]):           # one scene's: a scalar product
@@ -228,44 +260,49 @@ _TABLES_KEPT = 8
 
 
 def scene_table(scene, shape=None):
-    """:func:`make_scene_table`, kept while `scene` (a frozen dataclass) lives."""
+    """:func:`make_scene_table`, kept while `scene` (a frozen dataclass) lives; with a
+    dict to keep the batch's truth in (:func:`_run`)."""
     kept = _TABLES.get(id(scene))
     if kept is not None and kept[0]() is scene:
-        return kept[1]
-    table = make_scene_table(scene, shape)
+        return kept[1], kept[2]
+    tables = make_scene_table(scene, shape)
     if len(_TABLES) >= _TABLES_KEPT:
         _TABLES.pop(next(iter(_TABLES)))
-    _TABLES[id(scene)] = (weakref.ref(scene), table)
-    return table
+    _TABLES[id(scene)] = (weakref.ref(scene), tables, {})
+    return tables, _TABLES[id(scene)][2]
 
 
 def make_scene_table(scene, shape=None):
-    """The scenes of a batch as rows of one float table (numba takes no dataclass),
-    laid out as :data:`uq.physics.fusedkernels.TABLE` says: the scalars, the slanted
-    beams' azimuths' cos and sin, the true attitude, the least-squares operator, the
-    slant distances and the configured ship-frame beams, shape (scenes, width).
-
-    The least-squares operator (a pseudo-inverse, ~20 us) is computed once per distinct
-    (half-cone, misalignment): a GUM grid of 518,400 scenes has 360 of them."""
+    """The scenes of a batch as rows of one float table (numba takes no dataclass), and
+    the table of their distinct beam geometries, as :mod:`uq.physics.fusedkernels` lays
+    them out (``TABLE``, ``TRIG``, :func:`~uq.physics.fusedkernels.geometry_offsets`):
+    per scene the scalars, the cos and sin of its angles and the row of its geometry;
+    per distinct (half-cone, misalignment) the azimuths' cos and sin, the least-squares
+    operator (a pseudo-inverse, ~20 us), the slant distances and the configured beams
+    (a GUM grid of 518,400 scenes has 360 of them). Returns (table, geometry)."""
     shape = scene.shape if shape is None else shape
     scenes = math.prod(shape)
-    field = {name: np.broadcast_to(np.asarray(getattr(scene, name), dtype=float),
-                                   shape).reshape(scenes) for name in SCENE_FIELDS}
+    fields = np.empty((len(kernels.TABLE), scenes))
+    for row, name in enumerate(kernels.TABLE):
+        fields[row] = np.broadcast_to(np.asarray(getattr(scene, name), dtype=float), shape
+                                      ).reshape(scenes)
+    field = dict(zip(kernels.TABLE, fields))
     azimuths = np.asarray(scene.azimuths, dtype=float)
-    n_slanted, n_gates = len(azimuths), len(scene.ranges)
-    geometry = np.stack([field["half_cone"], field["misalignment"]], axis=-1)
-    distinct, index = np.unique(geometry, axis=0, return_inverse=True)
-    units = beam_unit_vectors(distinct[:, 0], azimuths, distinct[:, 1],
+    n_slanted = len(azimuths)
+    key = field["half_cone"] + 1j * field["misalignment"]
+    if np.all(key == key[0]):
+        distinct, index = key[:1], np.zeros(scenes, dtype=np.intp)
+    else:                    # complex numbers sort by real, then imaginary part
+        distinct, index = np.unique(key, return_inverse=True)
+    units = beam_unit_vectors(distinct.real, azimuths, distinct.imag,
                               scene.vertical_beam)                             # (u, b, 3)
     operator = least_squares_operator(units)                                  # (u, 3, b)
-    index = index.reshape(-1)
-    slant = slant_distances(scene.ranges, field["half_cone"], n_slanted,
-                            scene.vertical_beam)                             # (S, b, g)
-    attitude = attitude_matrix(field["heading"], field["pitch"], field["roll"])
-    scalars = np.stack([field[name] for name in kernels.TABLE], axis=-1)
-    table = np.concatenate([scalars, np.broadcast_to(np.cos(azimuths), (scenes, n_slanted)),
-                            np.broadcast_to(np.sin(azimuths), (scenes, n_slanted)),
-                            attitude.reshape(scenes, 9), operator[index].reshape(scenes, -1),
-                            slant.reshape(scenes, -1), units[index].reshape(scenes, -1)],
-                           axis=1)
-    return np.ascontiguousarray(table)
+    slant = slant_distances(scene.ranges, distinct.real, n_slanted, scene.vertical_beam)
+    u = len(distinct)
+    geometry = np.concatenate([np.broadcast_to(np.cos(azimuths), (u, n_slanted)),
+                               np.broadcast_to(np.sin(azimuths), (u, n_slanted)),
+                               operator.reshape(u, -1), slant.reshape(u, -1),
+                               units.reshape(u, -1)], axis=1)
+    table = np.empty((scenes, kernels.TABLE_WIDTH))
+    kernels.fill_table(fields, np.ascontiguousarray(index.reshape(-1), dtype=np.intp), table)
+    return table, geometry

@@ -48,20 +48,34 @@ _S = tuple((-1) ** k / math.factorial(2 * k + 1) for k in range(8))
 _C = tuple((-1) ** k / math.factorial(2 * k) for k in range(9))
 
 #: Columns of the scene table (:func:`uq.physics.fused.scene_table`), one row per scene:
-#: these scalars, then the cosines and sines of the slanted beams' azimuths, the true
-#: attitude (3 x 3, row-major), the least-squares operator A^+ (3 x b), the slant
-#: distances (b x g) and the configured ship-frame beams (b x 3) (:func:`_offsets`).
+#: these scalars, then the cosines and the sines of TRIG, then the row of the scene's
+#: (half-cone, misalignment) in the geometry table: the cosines and sines of the slanted
+#: beams' azimuths, the least-squares operator A^+ (3 x b), the slant distances (b x g)
+#: and the configured ship-frame beams (b x 3) (:func:`_geometry_offsets`).
 TABLE = ("lidar_height", "wind_speed", "reference_height", "shear", "wind_direction",
          "vertical_wind", "sog", "cog", "heave", "heading", "pitch", "roll", "half_cone",
          "misalignment")
 (_LIDAR_HEIGHT, _SPEED, _REFERENCE, _SHEAR, _DIRECTION, _VERTICAL, _SOG, _COG, _HEAVE,
  _HEADING, _PITCH, _ROLL, _HALF_CONE, _MISALIGNMENT) = range(len(TABLE))
+#: Angles whose cos and sin follow the scalars (cosines, then sines): numpy's float64
+#: cos and sin are libm's, computed once per scene for the whole batch.
+TRIG = ("heading", "pitch", "roll", "cog", "wind_direction", "half_cone", "misalignment")
+_COS = len(TABLE)
+_SIN = _COS + len(TRIG)
+(_T_HEADING, _T_PITCH, _T_ROLL, _T_COG, _T_DIRECTION, _T_HALF_CONE,
+ _T_MISALIGNMENT) = range(len(TRIG))
+#: The column of the scene's row in the geometry table, and the scene table's width.
+_GEOMETRY_ROW = _SIN + len(TRIG)
+TABLE_WIDTH = _GEOMETRY_ROW + 1
 #: The structure vector (int64): beams, gates, correction model and wanted outputs.
 STRUCTURE = ("n_slanted", "vertical_beam", "n_gates", "model", "want_speed", "want_direction",
              "want_vertical", "want_radial", "want_height")
 #: The INS errors, in the order of the ``ins`` tuple; the angles among them (degrees).
 INS_ORDER = ("heading", "pitch", "roll", "sog", "cog", "heave")
 _INS_ANGLES = (0, 1, 2, 4)          # heading, pitch, roll, cog in INS_ORDER
+#: The table columns of the INS angles' true values (heading, pitch, roll, cog: the
+#: first four of TRIG, in that order).
+_READING_BASES = tuple(TABLE.index(name) for name in TRIG[:4])
 #: The geometry errors, in the order of the ``geo`` tuple.
 GEO_ORDER = ("half_cone", "misalignment", "height")
 
@@ -79,10 +93,10 @@ def _signature(kind, dtype):
     if kind == "trig":
         return types.void(ins, table, i8, i8, i8, i8, b1, c3, c3, c1)
     if kind == "geometry":
-        return types.void(table, ints, geo, i8, i8, i8, i8, b1, a3, a3,
+        return types.void(table, table, ints, geo, i8, i8, i8, i8, b1, a3, a3,
                           types.Array(types.float64, 1, "C"))
-    return types.void(table, ints, ins, a3, c3, c3, a3, a3, a3, i8, i8, i8, i8, b1, b1, a3,
-                      a3, a3, a3, a4, a3)
+    return types.void(table, table, ints, ins, a3, c3, c3, a3, a3, a3, i8, i8, i8, i8, b1, b1,
+                      a3, a3, a3, a3, a4, a3)
 
 
 @njit(inline="always")
@@ -106,6 +120,18 @@ def _angle(base, cos_base, sin_base, x, cos_x, sin_x):
 
 
 @njit(inline="always")
+def _fixed(base, cos_base, sin_base, x):
+    """cos and sin of base + x for an error x constant over trials: where x is 0, the
+    scene's own from the table (base + 0 is base), or (1, +0) for a zero base (+-0 + 0
+    is +0: libm's cos and sin of it); else libm."""
+    if x == 0.0:
+        if base != 0.0:
+            return cos_base, sin_base
+        return 1.0, 0.0
+    return np.cos(base + x), np.sin(base + x)
+
+
+@njit(inline="always")
 def _pick(array, i, s, k):
     """Element (i, s, k) of an error array whose axes of length 1 broadcast."""
     return array[i if array.shape[0] > 1 else 0, s if array.shape[1] > 1 else 0,
@@ -113,29 +139,29 @@ def _pick(array, i, s, k):
 
 
 @njit(inline="always")
-def _scene_readings(ins, s, t0, count, tr0, base, cos_trig, sin_trig, cos_out, sin_out):
-    """cos and sin of the INS angles (base + error) of one scene for trials
-    [t0, t0 + count) into out[a, k, j]: the addition theorem on the errors' Taylor terms
-    (rows tr0 + j of :func:`ins_trig`, shared by the scenes that share the draws) in a
-    loop without calls (SIMD), then libm for errors beyond SMALL_ANGLE (and NaN); an
-    error constant over trials takes libm once."""
-    for a in range(4):
-        error = ins[_INS_ANGLES[a]]
-        cos_base, sin_base = math.cos(base[a]), math.sin(base[a])
-        for k in range(error.shape[2]):
-            cos_a, sin_a = cos_out[a, k], sin_out[a, k]
-            if error.shape[0] == 1:
-                angle = base[a] + _pick(error, 0, s, k) * _DEG
-                cos_a[:count], sin_a[:count] = np.cos(angle), np.sin(angle)
-                continue
-            cos_x, sin_x = cos_trig[a, k, tr0:tr0 + count], sin_trig[a, k, tr0:tr0 + count]
-            for j in range(count):                 # no calls, unit stride: SIMD
-                cos_a[j] = cos_base * cos_x[j] - sin_base * sin_x[j]      # cos(b + x)
-                sin_a[j] = sin_base * cos_x[j] + cos_base * sin_x[j]      # sin(b + x)
-            for j in range(count):                 # large errors (and NaN): libm
-                x = _pick(error, t0 + j, s, k) * _DEG
-                if not abs(x) <= SMALL_ANGLE:
-                    cos_a[j], sin_a[j] = np.cos(base[a] + x), np.sin(base[a] + x)
+def _readings(error, a, base, cos_base, sin_base, s, t0, count, tr0, cos_trig, sin_trig,
+              cos_out, sin_out):
+    """cos and sin of INS angle a (base + error) of scene s for trials [t0, t0 + count)
+    into out[a, k, j]: the addition theorem on the error's Taylor terms (rows tr0 + j of
+    :func:`ins_trig`, shared by the scenes that share the draws) in a loop without calls
+    (SIMD), then libm for errors beyond SMALL_ANGLE (and NaN); an error constant over
+    trials takes libm once. (Indices, not views: a view costs two atomic reference
+    counts, more than the loop for a few trials per scene.)"""
+    for k in range(error.shape[2]):
+        if error.shape[0] == 1:
+            cos_fixed, sin_fixed = _fixed(base, cos_base, sin_base,
+                                          _pick(error, 0, s, k) * _DEG)
+            for j in range(count):
+                cos_out[a, k, j], sin_out[a, k, j] = cos_fixed, sin_fixed
+            continue
+        for j in range(count):                 # no calls, unit stride: SIMD
+            cos_x, sin_x = cos_trig[a, k, tr0 + j], sin_trig[a, k, tr0 + j]
+            cos_out[a, k, j] = cos_base * cos_x - sin_base * sin_x      # cos(b + x)
+            sin_out[a, k, j] = sin_base * cos_x + cos_base * sin_x      # sin(b + x)
+        for j in range(count):                 # large errors (and NaN): libm
+            x = _pick(error, t0 + j, s, k) * _DEG
+            if not abs(x) <= SMALL_ANGLE:
+                cos_out[a, k, j], sin_out[a, k, j] = np.cos(base + x), np.sin(base + x)
 
 
 def ins_trig(ins, table, s0, s1, t0, t1, per_scene, cos_out, sin_out, scratch):
@@ -163,46 +189,72 @@ def ins_trig(ins, table, s0, s1, t0, t1, per_scene, cos_out, sin_out, scratch):
 
 
 @njit(inline="always")
-def _offsets(n_slanted, n_beams, n_gates):
-    """Columns of the azimuths, attitude, operator, slant distances and configured beams
-    in a row of the scene table, and the row's length."""
-    azimuths = len(TABLE)
-    attitude = azimuths + 2 * n_slanted
-    operator = attitude + 9
+def _geometry_offsets(n_slanted, n_beams, n_gates):
+    """Columns of the operator, slant distances and configured beams in a row of the
+    geometry table (the azimuths' cos and sin come first), and the row's length."""
+    operator = 2 * n_slanted
     slant = operator + 3 * n_beams
     units = slant + n_beams * n_gates
-    return azimuths, attitude, operator, slant, units, units + 3 * n_beams
+    return operator, slant, units, units + 3 * n_beams
 
 
-def table_width(n_slanted, n_beams, n_gates):
-    """Length of a row of the scene table."""
-    return _offsets.py_func(n_slanted, n_beams, n_gates)[-1]
+def geometry_offsets(n_slanted, n_beams, n_gates):
+    """:func:`_geometry_offsets` for Python."""
+    return _geometry_offsets.py_func(n_slanted, n_beams, n_gates)
+
+
+#: First columns of the cosines and of the sines of TRIG in the scene table.
+TRIG_COS, TRIG_SIN = _COS, _SIN
+_TRIG_FIELDS = tuple(TABLE.index(name) for name in TRIG)
+
+
+@njit("void(float64[:, ::1], intp[::1], float64[:, ::1])", cache=True)
+def fill_table(fields, index, out):
+    """The scene table row by row (sequential writes): the scalars (fields, one row per
+    TABLE name), libm's cos and sin of TRIG, and the scene's row of the geometry table."""
+    for s in range(out.shape[0]):
+        for c in range(len(TABLE)):
+            out[s, c] = fields[c, s]
+        for k in range(len(TRIG)):
+            angle = fields[_TRIG_FIELDS[k], s]
+            out[s, _COS + k] = math.cos(angle)
+            out[s, _SIN + k] = math.sin(angle)
+        out[s, _GEOMETRY_ROW] = index[s]
 
 
 @njit(inline="always")
-def _angle_block(error, s, t0, count, base, cos_out, sin_out):
+def _attitude(table, s):
+    """The scene's true body-to-earth rotation Rz(heading) Ry(pitch) Rx(roll), row-major
+    (the expressions of :func:`uq.physics.rotation.attitude_matrix`)."""
+    return _rotation(3, table[s, _COS + _T_HEADING], table[s, _SIN + _T_HEADING],
+                     table[s, _COS + _T_PITCH], table[s, _SIN + _T_PITCH],
+                     table[s, _COS + _T_ROLL], table[s, _SIN + _T_ROLL], 1.0, 0.0)
+
+
+@njit(inline="always")
+def _angle_block(error, s, t0, count, base, cos_base, sin_base, out, row):
     """cos and sin of base + error [deg] of trials [t0, t0 + count) of scene s into
-    out[:count]: the errors' Taylor polynomials and the addition theorem in loops
-    without calls (SIMD), libm beyond SMALL_ANGLE (and for NaN); an error constant over
-    trials takes libm once."""
+    out[row, :count], out[row + 1, :count]: the errors' Taylor polynomials and the
+    addition theorem in loops without calls (SIMD), libm beyond SMALL_ANGLE (and for
+    NaN); an error constant over trials takes libm once."""
     if error.shape[0] == 1:
-        angle = base + _pick(error, 0, s, 0) * _DEG
-        cos_out[:count], sin_out[:count] = np.cos(angle), np.sin(angle)
+        cos_fixed, sin_fixed = _fixed(base, cos_base, sin_base, _pick(error, 0, s, 0) * _DEG)
+        for j in range(count):
+            out[row, j], out[row + 1, j] = cos_fixed, sin_fixed
         return
-    cos_base, sin_base = np.cos(base), np.sin(base)
     for j in range(count):                        # gather the (strided) column first:
-        cos_out[j] = _pick(error, t0 + j, s, 0) * _DEG     # unit stride: SIMD next
+        out[row, j] = _pick(error, t0 + j, s, 0) * _DEG    # unit stride: SIMD next
     for j in range(count):                        # no calls, unit stride: SIMD
-        cos_x, sin_x = _taylor(cos_out[j])
-        cos_out[j] = cos_base * cos_x - sin_base * sin_x          # cos(b + x)
-        sin_out[j] = sin_base * cos_x + cos_base * sin_x          # sin(b + x)
+        cos_x, sin_x = _taylor(out[row, j])
+        out[row, j] = cos_base * cos_x - sin_base * sin_x          # cos(b + x)
+        out[row + 1, j] = sin_base * cos_x + cos_base * sin_x      # sin(b + x)
     for j in range(count):                        # large errors (and NaN): libm
         x = _pick(error, t0 + j, s, 0) * _DEG
         if not abs(x) <= SMALL_ANGLE:
-            cos_out[j], sin_out[j] = np.cos(base + x), np.sin(base + x)
+            out[row, j], out[row + 1, j] = np.cos(base + x), np.sin(base + x)
 
 
-def geometry(table, structure, geo, s0, s1, t0, t1, per_trial, beams, ratio, shear):
+def geometry(table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams, ratio, shear):
     """True earth-frame beams into beams[row] (b, 3), z / z_ref of their gates into
     ratio[row] (b, g) and the scene's shear exponent into shear[row]; NaN at a height
     <= 0 (outside the power law). Rows: with `per_trial`, (s - s0) (t1 - t0) + (i - t0)
@@ -211,32 +263,37 @@ def geometry(table, structure, geo, s0, s1, t0, t1, per_trial, beams, ratio, she
     """
     n_slanted, n_gates = structure[0], structure[2]
     n_beams = n_slanted + structure[1]
-    azimuths, attitude, _, slant, _, _ = _offsets(n_slanted, n_beams, n_gates)
+    _, slant, _, _ = _geometry_offsets(n_slanted, n_beams, n_gates)
     count = t1 - t0 if per_trial else 1
-    zero = beams[0, 0, 0] * 0.0
+    zero = np.zeros(1, beams.dtype)[0]            # 0 of the number type (not 0 x data)
     trig = np.full((4, count), zero)              # cos, sin of half-cone, misalignment
+    cone_error, misalignment_error, height_error = geo[0], geo[1], geo[2]
     row = 0
     for s in range(s0, s1):
-        scene = table[s]
-        _angle_block(geo[0], s, t0, count, scene[_HALF_CONE], trig[0], trig[1])
-        _angle_block(geo[1], s, t0, count, scene[_MISALIGNMENT], trig[2], trig[3])
-        reference, exponent = scene[_REFERENCE], scene[_SHEAR]
+        _angle_block(cone_error, s, t0, count, table[s, _HALF_CONE],
+                     table[s, _COS + _T_HALF_CONE], table[s, _SIN + _T_HALF_CONE], trig, 0)
+        _angle_block(misalignment_error, s, t0, count, table[s, _MISALIGNMENT],
+                     table[s, _COS + _T_MISALIGNMENT], table[s, _SIN + _T_MISALIGNMENT],
+                     trig, 2)
+        reference, exponent = table[s, _REFERENCE], table[s, _SHEAR]
+        shape = int(table[s, _GEOMETRY_ROW])
+        attitude = _attitude(table, s)
         for j in range(count):
             cos_t, sin_t, cos_m, sin_m = trig[0, j], trig[1, j], trig[2, j], trig[3, j]
-            base = scene[_LIDAR_HEIGHT] + _pick(geo[2], t0 + j, s, 0)
+            base = table[s, _LIDAR_HEIGHT] + _pick(height_error, t0 + j, s, 0)
             for b in range(n_beams):
                 if b < n_slanted:
-                    cos_a, sin_a = scene[azimuths + b], scene[azimuths + n_slanted + b]
+                    cos_a, sin_a = shapes[shape, b], shapes[shape, n_slanted + b]
                     x = sin_t * (cos_m * cos_a - sin_m * sin_a)       # sin t cos(m + a)
                     y = sin_t * (sin_m * cos_a + cos_m * sin_a)       # sin t sin(m + a)
                     z = cos_t
                 else:
                     x, y, z = zero, zero, zero + 1.0
                 for k in range(3):
-                    beams[row, b, k] = scene[attitude + 3 * k] * x + \
-                        scene[attitude + 3 * k + 1] * y + scene[attitude + 3 * k + 2] * z
+                    beams[row, b, k] = attitude[3 * k] * x + attitude[3 * k + 1] * y + \
+                        attitude[3 * k + 2] * z
                 for g in range(n_gates):
-                    height = base + scene[slant + b * n_gates + g] * beams[row, b, 2]
+                    height = base + shapes[shape, slant + b * n_gates + g] * beams[row, b, 2]
                     if not height.real > 0:      # outside the model (also a NaN height)
                         ratio[row, b, g] = np.nan
                     elif exponent != 0.0:
@@ -295,19 +352,29 @@ def _solve3(m, rhs):
 
 
 @njit(inline="always")
-def _gate_heights(scene, beams, r, height_error, n_slanted, n_gates, at_slant, out):
+def _mean_reading(error, base, i, s, zero):
+    """The mean over the beams' readings of an INS angle, base + error [rad]."""
+    total = zero
+    for k in range(error.shape[2]):
+        total += base + _pick(error, i, s, k) * _DEG
+    return total / error.shape[2]
+
+
+@njit(inline="always")
+def _gate_heights(table, s, shapes, shape, beams, r, height_error, n_slanted, n_gates,
+                  at_slant, out):
     """Mean true height of the slanted beams at each gate [m] (as the numpy model:
     lidar height + error, plus slant distance x the true beam's up component)."""
-    base = scene[_LIDAR_HEIGHT] + height_error
+    base = table[s, _LIDAR_HEIGHT] + height_error
     for g in range(n_gates):
-        total = base + scene[at_slant + g] * beams[r, 0, 2]
+        total = base + shapes[shape, at_slant + g] * beams[r, 0, 2]
         for b in range(1, n_slanted):
-            total += base + scene[at_slant + b * n_gates + g] * beams[r, b, 2]
+            total += base + shapes[shape, at_slant + b * n_gates + g] * beams[r, b, 2]
         out[g] = total / n_slanted
 
 
 @njit(inline="always")
-def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
+def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
           s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
           radial, gate_height, pointwise):
     """The outputs of scenes [s0, s1) x trials [t0, t1), into element-major arrays
@@ -337,9 +404,13 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
     want_speed, want_direction, want_vertical = structure[4], structure[5], structure[6]
     want_radial, want_height = structure[7], structure[8]
     n_beams = n_slanted + vertical_beam
-    _, _, at_operator, at_slant, at_units, _ = _offsets(n_slanted, n_beams, n_gates)
+    at_operator, at_slant, at_units, _ = _geometry_offsets(n_slanted, n_beams, n_gates)
+    # the tuple's arrays as locals once (an array taken from a tuple in a loop is an
+    # atomic reference count each time)
+    heading_error, pitch_error, roll_error = ins[0], ins[1], ins[2]
+    sog_error, cog_error, heave_error = ins[3], ins[4], ins[5]
     has_noise = noise.shape[2] > 1                  # (absent: a (1, 1, 1) placeholder)
-    zero = beams[0, 0, 0] * 0.0                      # 0 of the kernel's number type
+    zero = np.zeros(1, beams.dtype)[0]               # 0 of the kernel's number type
     truth = np.full((n_beams, n_gates), zero)        # true radial velocities of a trial
     lidar_frame = np.full((3, n_gates), zero)        # A^+ truth: the noise-free wind
     heights = np.full(n_gates, zero)                 # mean true gate heights
@@ -347,6 +418,8 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
     cos_read = np.full((4, n_beams, count), zero)    # (cos, sin) of the readings' angles
     sin_read = np.full((4, n_beams, count), zero)
     base = np.empty(4)
+    operator = np.empty((3, n_beams))                # the scene's A^+ and configured beams
+    units = np.empty((n_beams, 3))
     normal = np.full((n_beams, 3), zero)             # point-wise: believed earth beams
     along = np.full(n_beams, zero)                   # ... the ship velocity along them
     mean = np.full(6, zero)                          # ... and the mean reading (tilt2d)
@@ -356,17 +429,30 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
     mean_rot = _rotation(3, one, zero, one, zero, one, zero, 1.0, 0.0)
     mean_ship = (zero, zero)
     for s in range(s0, s1):
-        scene = table[s]
-        speed_ref, w = scene[_SPEED], scene[_VERTICAL]
-        to_north, to_east = -math.cos(scene[_DIRECTION]), -math.sin(scene[_DIRECTION])
-        sog0, cog0, heave0, heading0 = scene[_SOG], scene[_COG], scene[_HEAVE], scene[_HEADING]
-        true_ship = (sog0 * math.cos(cog0), sog0 * math.sin(cog0), heave0)
-        cos_nominal, sin_nominal = math.cos(heading0), math.sin(heading0)
-        operator = scene[at_operator:at_operator + 3 * n_beams].reshape(3, n_beams)
-        units = scene[at_units:at_units + 3 * n_beams].reshape(n_beams, 3)
-        base[0], base[1], base[2], base[3] = heading0, scene[_PITCH], scene[_ROLL], cog0
-        _scene_readings(ins, s, t0, count, (s - s0) * count if per_scene else 0, base,
-                        cos_trig, sin_trig, cos_read, sin_read)
+        speed_ref, w = table[s, _SPEED], table[s, _VERTICAL]
+        to_north = -table[s, _COS + _T_DIRECTION]       # wind "from": it blows to -e
+        to_east = -table[s, _SIN + _T_DIRECTION]
+        sog0, cog0, heave0, heading0 = table[s, _SOG], table[s, _COG], table[s, _HEAVE], table[s, _HEADING]
+        true_ship = (sog0 * table[s, _COS + _T_COG], sog0 * table[s, _SIN + _T_COG], heave0)
+        cos_nominal, sin_nominal = table[s, _COS + _T_HEADING], table[s, _SIN + _T_HEADING]
+        shape = int(table[s, _GEOMETRY_ROW])
+        for b in range(n_beams):             # copies, not views (reference counts)
+            for k in range(3):
+                operator[k, b] = shapes[shape, at_operator + k * n_beams + b]
+                units[b, k] = shapes[shape, at_units + 3 * b + k]
+        base[0], base[1], base[2], base[3] = heading0, table[s, _PITCH], table[s, _ROLL], cog0
+        tr0 = (s - s0) * count if per_scene else 0
+        _readings(heading_error, 0, heading0, table[s, _COS + _T_HEADING],
+                  table[s, _SIN + _T_HEADING], s, t0, count, tr0, cos_trig, sin_trig,
+                  cos_read, sin_read)
+        _readings(pitch_error, 1, table[s, _PITCH], table[s, _COS + _T_PITCH],
+                  table[s, _SIN + _T_PITCH], s, t0, count, tr0, cos_trig, sin_trig,
+                  cos_read, sin_read)
+        _readings(roll_error, 2, table[s, _ROLL], table[s, _COS + _T_ROLL],
+                  table[s, _SIN + _T_ROLL], s, t0, count, tr0, cos_trig, sin_trig,
+                  cos_read, sin_read)
+        _readings(cog_error, 3, cog0, table[s, _COS + _T_COG], table[s, _SIN + _T_COG], s,
+                  t0, count, tr0, cos_trig, sin_trig, cos_read, sin_read)
         if not per_trial:                    # one truth for all trials: A^+ truth once
             r = s
             for b in range(n_beams):
@@ -383,7 +469,7 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
                         total += operator[k, b] * truth[b, g]
                     lidar_frame[k, g] = total
             if want_height:
-                _gate_heights(scene, beams, r, _pick(height_error, t0, s, 0), n_slanted,
+                _gate_heights(table, s, shapes, shape, beams, r, _pick(height_error, t0, s, 0), n_slanted,
                               n_gates, at_slant, heights)
         noise_s = s if noise.shape[1] > 1 else 0
         for i in range(t0, t1):
@@ -399,7 +485,7 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
                         truth[b, g] = speed_ref * profile[r, b, g] * along_wind + \
                             beams[r, b, 2] * w - moving
                 if want_height:
-                    _gate_heights(scene, beams, r, _pick(height_error, i, s, 0), n_slanted,
+                    _gate_heights(table, s, shapes, shape, beams, r, _pick(height_error, i, s, 0), n_slanted,
                                   n_gates, at_slant, heights)
             if want_height:
                 for g in range(n_gates):
@@ -415,8 +501,8 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
                                     cos_read[1, 0, j], sin_read[1, 0, j], cos_read[2, 0, j],
                                     sin_read[2, 0, j], cos_nominal, sin_nominal)
                     cc, sc = cos_read[3, 0, j], sin_read[3, 0, j]
-                sog = sog0 + _pick(ins[3], i, s, 0)
-                heave = heave0 + _pick(ins[5], i, s, 0)
+                sog = sog0 + _pick(sog_error, i, s, 0)
+                heave = heave0 + _pick(heave_error, i, s, 0)
                 moving = model != 0
                 ship = (sog * cc if moving else zero, sog * sc if moving else zero,
                         heave if model == 3 else zero)
@@ -466,9 +552,9 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
                 if model == 0:
                     rot = _rotation(0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, cos_nominal, sin_nominal)
                 else:
-                    kh = b if ins[0].shape[2] > 1 else 0
-                    kp = b if ins[1].shape[2] > 1 else 0
-                    kr = b if ins[2].shape[2] > 1 else 0
+                    kh = b if heading_error.shape[2] > 1 else 0
+                    kp = b if pitch_error.shape[2] > 1 else 0
+                    kr = b if roll_error.shape[2] > 1 else 0
                     rot = _rotation(model, cos_read[0, kh, j], sin_read[0, kh, j],
                                     cos_read[1, kp, j], sin_read[1, kp, j], cos_read[2, kr, j],
                                     sin_read[2, kr, j], cos_nominal, sin_nominal)
@@ -478,9 +564,9 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
                 if model == 0:
                     along[b] = zero
                 else:
-                    kc = b if ins[4].shape[2] > 1 else 0
-                    sog = sog0 + _pick(ins[3], i, s, b)
-                    heave = heave0 + _pick(ins[5], i, s, b) if model == 3 else zero
+                    kc = b if cog_error.shape[2] > 1 else 0
+                    sog = sog0 + _pick(sog_error, i, s, b)
+                    heave = heave0 + _pick(heave_error, i, s, b) if model == 3 else zero
                     along[b] = normal[b, 0] * (sog * cos_read[3, kc, j]) + \
                         normal[b, 1] * (sog * sin_read[3, kc, j]) + normal[b, 2] * heave
             if want_radial:
@@ -492,16 +578,14 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
             if not (want_speed or want_direction or want_vertical):
                 continue
             if model == 2:                           # tilt2d: the mean reading (Eq. 13 [1])
-                for a in range(4):                   # the angles, read per beam or once
-                    error = ins[_INS_ANGLES[a]]
-                    total = zero
-                    for k in range(error.shape[2]):
-                        total += base[a] + _pick(error, i, s, k) * _DEG
-                    mean[a] = total / error.shape[2]
+                mean[0] = _mean_reading(heading_error, base[0], i, s, zero)
+                mean[1] = _mean_reading(pitch_error, base[1], i, s, zero)
+                mean[2] = _mean_reading(roll_error, base[2], i, s, zero)
+                mean[3] = _mean_reading(cog_error, base[3], i, s, zero)
                 total = zero
-                for k in range(ins[3].shape[2]):
-                    total += sog0 + _pick(ins[3], i, s, k)
-                mean[4] = total / ins[3].shape[2]
+                for k in range(sog_error.shape[2]):
+                    total += sog0 + _pick(sog_error, i, s, k)
+                mean[4] = total / sog_error.shape[2]
                 mean_rot = _rotation(3, np.cos(mean[0]), np.sin(mean[0]), np.cos(mean[1]),
                                      np.sin(mean[1]), np.cos(mean[2]), np.sin(mean[2]),
                                      cos_nominal, sin_nominal)
@@ -536,20 +620,20 @@ def _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, heig
                     from_north[s, g, i], from_east[s, g, i] = -north, -east
 
 
-def wind_scan(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
-              s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
-              radial, gate_height):
+def wind_scan(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile,
+              height_error, s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north,
+              from_east, radial, gate_height):
     """:func:`_wind` with one INS reading per scan (every INS error (n, s, 1))."""
-    _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
+    _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
           s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
           radial, gate_height, False)
 
 
-def wind_pointwise(table, structure, ins, noise, cos_trig, sin_trig, beams, profile,
-                   height_error, s0, s1, t0, t1, per_scene, per_trial, speed, vertical,
-                   from_north, from_east, radial, gate_height):
+def wind_pointwise(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams,
+                   profile, height_error, s0, s1, t0, t1, per_scene, per_trial, speed,
+                   vertical, from_north, from_east, radial, gate_height):
     """:func:`_wind` with a reading per beam for some INS error (point-wise)."""
-    _wind(table, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
+    _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
           s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
           radial, gate_height, True)
 
