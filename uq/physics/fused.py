@@ -252,11 +252,13 @@ _OUTPUT_SET, _ERROR_SET = set(FUSED_OUTPUTS), {*_INS, *_GEOMETRY, _NOISE}
 _ZERO = {float: np.zeros((1, 1, 1)), complex: np.zeros((1, 1, 1), dtype=complex)}
 
 
-#: Tables of the scenes last evaluated: id -> (weak reference, table). The engine calls
-#: the model once per slice of trials with the same scene object (64 times for 2^19
-#: trials); a table costs ~0.3 ms.
+#: Tables of the scenes last evaluated: id -> (weak reference, tables, truths). The
+#: engine calls the model many times with the same scene object (per batch of trials;
+#: the GUM and the nominal three times); building a table costs ~0.3 ms for one scene.
+#: Two are kept: a sweep's chunks come one after the other, and the memory of older ones
+#: is then reused (fresh pages cost ~10 us each to fault in on this 2-core VM).
 _TABLES = {}
-_TABLES_KEPT = 8
+_TABLES_KEPT = 2
 
 
 def scene_table(scene, shape=None):

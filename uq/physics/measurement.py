@@ -251,8 +251,14 @@ def _corrected_radial(scene, measured, navigation, unit_vectors):
     return measured + np.sum(beams * ship, axis=-1)[..., None]
 
 
-def true_values(scene):
+def true_values(scene, outputs=OUTPUTS):
     """The wind the lidar should measure at each nominal gate height.
+
+    Parameters
+    ----------
+    scene : Scene
+    outputs : iterable of str
+        The quantities wanted (the radial velocities, the costly ones, only if named).
 
     Returns
     -------
@@ -263,12 +269,14 @@ def true_values(scene):
         ``lidar_height + range`` at which the true wind is given.
     """
     wind_vector = true_wind(scene, scene.gate_heights())
-    attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
-    beams_earth = scene.nominal_unit_vectors() @ np.swapaxes(attitude, -1, -2)
-    _, wind_only = true_radial_velocity(scene, beams_earth, np.zeros(scene.shape + (3,)))
     north, east = wind_vector[..., 0], wind_vector[..., 1]
-    return _full_shape({"gate_height": scene.gate_heights() + 0.0 * north,
-                        "wind_speed": wind.wind_speed(north, east),
-                        "wind_direction": wind.wind_direction(north, east),
-                        "vertical_wind": wind_vector[..., 2],
-                        "radial_velocity": wind_only}, scene.shape, scene.n_beams)
+    truth = {"gate_height": scene.gate_heights() + 0.0 * north,
+             "wind_speed": wind.wind_speed(north, east),
+             "wind_direction": wind.wind_direction(north, east),
+             "vertical_wind": wind_vector[..., 2]}
+    if "radial_velocity" in outputs:
+        attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
+        beams_earth = scene.nominal_unit_vectors() @ np.swapaxes(attitude, -1, -2)
+        _, truth["radial_velocity"] = true_radial_velocity(scene, beams_earth,
+                                                           np.zeros(scene.shape + (3,)))
+    return _full_shape(truth, scene.shape, scene.n_beams)

@@ -261,7 +261,7 @@ def _dims(quantity):
 
 
 def _scene_dataset(scene, settings, outputs, engine):
-    truth = true_values(scene)
+    truth = true_values(scene, outputs)
     nominal = measurement_model(scene, outputs)
     paper = _paper_uncertainty(scene, settings, truth["wind_speed"])
     data = {}
