@@ -161,7 +161,7 @@ def _navigation(scene, resolved, phases, err, n):
     stamps = timing.stamps(n_beams) if scene.correction == "pointwise" else \
         np.array([timing.scan_mid_time(n_beams)])
     read = stamps[None, :] + np.reshape(err["ins_clock_offset"], (-1, 1))    # (n', k)
-    state = _ins_state(scene, resolved, phases, read, err["ins_sample_offset"], ins)
+    state = ins_state(scene, resolved, phases, read, err["ins_sample_offset"], ins)
     k = np.shape(state["heading"])[-1]
     reading = {}
     for key in ("heading", "pitch", "roll"):
@@ -173,8 +173,11 @@ def _navigation(scene, resolved, phases, err, n):
     return reading
 
 
-def _ins_state(scene, resolved, phases, read, sample_offset, ins):
-    """The INS's true state at the read times (interpolated from its samples)."""
+def ins_state(scene, resolved, phases, read, sample_offset, ins):
+    """The INS's true (error-free) state read at `read` (n, k) [s]: interpolated from its
+    samples at ``sample_offset + j / rate``, or exact for a continuous INS. Keys
+    ``heading``, ``pitch``, ``roll`` [rad], their ``*_rate`` [rad s-1], ``velocity``
+    (n, k, 3) [m s-1] of the INS point."""
     if ins.rate is None:
         kin = platform_kinematics(scene, resolved.motion, phases, read)
         return _state(kin)

@@ -199,9 +199,20 @@ def assign_dotted(raw, dotted, value, source):
 def _build(raw, source):
     settings = _validate(raw, source)
     sweep, links = _validate_sweep(raw.get("sweep"), settings, source)
-    settings["sweep"] = {key: list(values) for key, values in sweep}
+    settings["sweep"] = {key: [_plain(v) for v in values] for key, values in sweep}
     settings["sweep"].update({follower: {"same_as": leader} for follower, leader in links})
     return Scenario(settings["name"], settings["description"], settings, sweep, source, links)
+
+
+def _plain(value):
+    """A numpy scalar as the Python number it holds (the scenario text is YAML)."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    return value
 
 
 def load_fit_settings(raw_fit, source):
