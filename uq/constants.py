@@ -203,3 +203,8 @@ MAX_DWELL_NODES = 32
 #: of ~1e-15, ~1e-13 after a few dozen operations; a vanishing u comes out at ~1e-29) and
 #: far below anything a lidar resolves (~1e-2 m s-1) or a report prints (4 digits of u).
 NUMERICAL_ZERO = 1e-9
+
+#: Most components of a wave spectrum [1]: each is a Monte Carlo input (a random phase)
+#: and a column of the GUM Jacobian; 256 resolve a JONSWAP peak (gamma 3.3, relative width
+#: ~0.1) with ~20 bins across it over a band of 0.5-4 fp.
+MAX_WAVE_COMPONENTS = 256

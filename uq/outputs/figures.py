@@ -35,7 +35,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 
 from uq.errors import ScenarioError  # noqa: E402
 from uq.files import check_target, output_folder, save_figure  # noqa: E402
-from uq.outputs import plots  # noqa: E402
+from uq.outputs import motionfigures, plots  # noqa: E402
 from uq.outputs.labels import model_style  # noqa: E402
 from uq.outputs.planning import VELOCITY_RATIOS, velocity_ratio_line  # noqa: E402
 from uq.outputs.planning import models as available_models  # noqa: E402
@@ -421,6 +421,8 @@ def paper_plan(dataset):
         plan += [("fig6_tilt_maps", fig6_tilt_maps)]
     if dims == {"lidar_half_cone", "wind_direction"}:
         plan += [("fig7_half_cone", fig7_half_cone)]
+    plan += motionfigures.tiana_plan(dataset, dims)
+    plan += motionfigures.comparison_plan(dataset, sweep_dimensions(dataset))
     return plan
 
 

@@ -14,7 +14,8 @@ untouched. Per trial:
    shear); with ``dwell_average`` its mean over the dwell. Radial noise is added.
 2. The INS reports the attitude (with its rates) and the velocity of its own point. It is
    read at ``t + delta`` (clock offset delta): at each beam's time stamp for ``pointwise``,
-   at the scan's mid time for the other models; from its samples by ``nearest`` or
+   at the scan's mid time for the other models (whose one reading takes the
+   error of the first beam's: its marginal is the error's distribution); from its samples by ``nearest`` or
    ``linear`` interpolation (:mod:`uq.physics.ins`), or exactly (continuous INS). The
    reading's errors are added: heading, pitch, roll to its Euler angles; ``cog`` turns
    the horizontal velocity, ``sog`` adds along the static course, ``heave`` to the
@@ -87,7 +88,11 @@ def single_scene(scene, outputs, **errors):
     resolved = scene.time_resolved
     n = sample_count(errors)
     err = {name: np.asarray(errors.get(name, 0.0)) for name in set(errors) | set(_ALL_INPUTS)}
-    phases = resolved.motion.unit_phases(_phases(err["motion_phases"], resolved, n))
+    # the motion and the INS timing vary over n_time trials (1 when none of their inputs
+    # is random): the platform's kinematics are evaluated that many times, not n
+    n_time = max([1] + [np.shape(err[k])[0] for k in TIME_RESOLVED_INPUTS if np.ndim(err[k])])
+    phases = resolved.motion.unit_phases(_phases(err["motion_phases"], resolved, n_time))
+    phases = np.broadcast_to(phases, (n_time,) + phases.shape[1:])
     measured, heights = _measure(scene, resolved, phases, err, n)
     navigation = _navigation(scene, resolved, phases, err, n)
     unit_vectors = scene.nominal_unit_vectors()                        # configured, (b, 3)
@@ -160,7 +165,9 @@ def _navigation(scene, resolved, phases, err, n):
     n_beams = scene.n_beams
     stamps = timing.stamps(n_beams) if scene.correction == "pointwise" else \
         np.array([timing.scan_mid_time(n_beams)])
+    n_time = np.shape(phases)[0]
     read = stamps[None, :] + np.reshape(err["ins_clock_offset"], (-1, 1))    # (n', k)
+    read = np.broadcast_to(read, (n_time, read.shape[1]))
     state = ins_state(scene, resolved, phases, read, err["ins_sample_offset"], ins)
     k = np.shape(state["heading"])[-1]
     reading = {}

@@ -11,6 +11,11 @@ validated settings unless given).
       roll:  {amplitude: 5.0, period: 5.0, phase: random}   # deg, s, deg or random
       pitch: {amplitude: 3.0, period: 6.0, phase: 90}
       heave: {amplitude: 1.0, period: 8.0}                  # surge, sway, heave in m
+      spectrum: {kind: jonswap, hs: 2.0, tp: 8.0, gamma: 3.3, components: 32,
+                 band: [0.0625, 0.5]}                       # m, s, 1, 1, Hz
+      response:                  # per metre of wave amplitude: deg/m or m/m; lag in deg
+        roll: {factor: 2.0, lag: 90}
+        heave: {factor: 1.0}
     lidar:
       lever_arm: [0.0, 0.0, 2.0]   # m, (bow, starboard, up) from the INS to the lidar
       scan: {beam_duration: 1.0, timestamp: mid, dwell_average: false}
@@ -29,8 +34,16 @@ from uq.physics.ins import INTERPOLATIONS, InsSampling
 from uq.physics.motion import DEGREES_OF_FREEDOM, Motion, MotionComponent
 from uq.physics.scene import TimeResolved
 from uq.physics.timing import TIMESTAMPS, ScanTiming
+from uq.physics.waves import jonswap_components
+from uq.constants import MAX_WAVE_COMPONENTS
 
 HARMONIC_KEYS = ("amplitude", "period", "phase")
+SPECTRUM_KEYS = ("kind", "hs", "tp", "gamma", "components", "band")
+SPECTRUM_KINDS = ("jonswap",)
+RESPONSE_KEYS = ("factor", "lag")
+#: Default band of a spectrum, in multiples of its peak frequency 1/tp [1]: the JONSWAP
+#: (gamma 3.3) energy outside [0.5, 4] fp is below 1e-3 of the total (the f^-5 tail).
+SPECTRUM_BAND = (0.5, 4.0)
 SCAN_KEYS = ("beam_duration", "timestamp", "dwell_average")
 SCAN_DEFAULTS = {"beam_duration": 1.0, "timestamp": "mid", "dwell_average": False}
 ANGULAR_DOFS = ("roll", "pitch", "yaw")
@@ -42,11 +55,56 @@ MAX_ANGULAR_AMPLITUDE_DEG = 45.0
 def validate_motion(check, value):
     """The validated ``motion`` section (degrees and seconds, as in the file)."""
     check.mapping(value, "motion")
-    check.keys(value, "motion", DEGREES_OF_FREEDOM)
+    check.keys(value, "motion", DEGREES_OF_FREEDOM + ("spectrum", "response"))
     out = {}
     for dof in DEGREES_OF_FREEDOM:
         if dof in value:
             out[dof] = _harmonic(check, value[dof], f"motion.{dof}", dof in ANGULAR_DOFS)
+    if ("spectrum" in value) != ("response" in value):
+        check.fail("motion.spectrum" if "response" in value else "motion.response",
+                   "a wave spectrum and the platform's response go together; allowed: "
+                   "both motion.spectrum and motion.response, or neither")
+    if "spectrum" in value:
+        out["spectrum"] = _spectrum(check, value["spectrum"])
+        out["response"] = _response(check, value["response"])
+    return out
+
+
+def _spectrum(check, value):
+    key = "motion.spectrum"
+    check.mapping(value, key)
+    check.keys(value, key, SPECTRUM_KEYS)
+    for name in ("hs", "tp"):
+        if name not in value:
+            check.fail(f"{key}.{name}", "missing; a spectrum needs hs [m] and tp [s]")
+    tp = check.number(value["tp"], f"{key}.tp", low=0.0, low_open=True)
+    band = value.get("band", [SPECTRUM_BAND[0] / tp, SPECTRUM_BAND[1] / tp])
+    band = check.number_list(band, f"{key}.band", low=0.0, low_open=True)
+    if len(band) != 2 or not band[0] < band[1]:
+        check.fail(f"{key}.band", "allowed: [lowest, highest] frequency in Hz, lowest first")
+    return {"kind": check.choice(value.get("kind", "jonswap"), f"{key}.kind", SPECTRUM_KINDS),
+            "hs": check.number(value["hs"], f"{key}.hs", low=0.0),
+            "tp": tp,
+            "gamma": check.number(value.get("gamma", 3.3), f"{key}.gamma", low=1.0, high=10.0),
+            "components": check.integer(value.get("components", 32), f"{key}.components",
+                                        low=1, high=MAX_WAVE_COMPONENTS),
+            "band": band}
+
+
+def _response(check, value):
+    check.mapping(value, "motion.response")
+    check.keys(value, "motion.response", DEGREES_OF_FREEDOM)
+    out = {}
+    for dof, spec in value.items():
+        key = f"motion.response.{dof}"
+        check.mapping(spec, key)
+        check.keys(spec, key, RESPONSE_KEYS)
+        if "factor" not in spec:
+            check.fail(f"{key}.factor", "missing; allowed: the amplitude per metre of wave "
+                       "amplitude (deg/m or m/m)")
+        out[dof] = {"factor": check.number(spec["factor"], f"{key}.factor", low=0.0),
+                    "lag": check.number(spec.get("lag", 0.0), f"{key}.lag", low=-360.0,
+                                        high=360.0)}
     return out
 
 
@@ -108,8 +166,10 @@ def time_resolved(settings):
     if not is_time_resolved(settings):
         return None
     lidar, ins = settings["lidar"], settings["ins"]
-    components = tuple(_component(dof, spec) for dof, spec in
-                       (settings.get("motion") or {}).items())
+    motion_settings = settings.get("motion") or {}
+    components = tuple(_component(dof, spec) for dof, spec in motion_settings.items()
+                       if dof in DEGREES_OF_FREEDOM)
+    components += _wave_components(motion_settings)
     motion = Motion(components, tuple(lidar.get("lever_arm", (0.0, 0.0, 0.0))))
     scan = {**SCAN_DEFAULTS, **lidar.get("scan", {})}
     return TimeResolved(motion, ScanTiming(**scan),
@@ -126,9 +186,23 @@ def _component(dof, spec):
                            (0.0,) * len(DEGREES_OF_FREEDOM), phase)
 
 
+def _wave_components(motion_settings):
+    if "spectrum" not in motion_settings:
+        return ()
+    spectrum = motion_settings["spectrum"]
+    response = {dof: (spec["factor"], math.radians(spec["lag"]))
+                for dof, spec in motion_settings["response"].items()}
+    return jonswap_components(spectrum["hs"], spectrum["tp"], spectrum["gamma"],
+                              spectrum["components"], tuple(spectrum["band"]), response)
+
+
 def random_phase_count(settings):
-    """Components of the motion with a random phase (each a Monte Carlo input)."""
-    return sum(spec["phase"] == "random" for spec in (settings.get("motion") or {}).values())
+    """Components of the motion with a random phase (each a Monte Carlo input): the
+    harmonics with ``phase: random`` and every component of a wave spectrum."""
+    motion = settings.get("motion") or {}
+    harmonics = sum(spec["phase"] == "random" for dof, spec in motion.items()
+                    if dof in DEGREES_OF_FREEDOM)
+    return harmonics + (motion["spectrum"]["components"] if "spectrum" in motion else 0)
 
 
 def beam_stamps(settings, n_beams):

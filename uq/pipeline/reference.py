@@ -29,8 +29,10 @@ EXEMPLAR_OPTIONAL = {
                          "height": {"dist": "normal", "u": 0.2}},
               "lever_arm": [0.0, 0.0, 2.0],
               "scan": {}},
-    "motion": {dof: {"amplitude": 1.0, "period": 5.0, "phase": 0.0}
-               for dof in ("roll", "pitch", "yaw", "surge", "sway", "heave")},
+    "motion": {**{dof: {"amplitude": 1.0, "period": 5.0, "phase": 0.0}
+                  for dof in ("roll", "pitch", "yaw", "surge", "sway", "heave")},
+               "spectrum": {"hs": 2.0, "tp": 7.0},
+               "response": {"roll": {"factor": 2.0, "lag": 90.0}}},
     "sampling": {"chunk_size": 65536, "seed": 1},
     "fit": {"priors": {"shear": {"dist": "uniform", "low": -0.5, "high": 1.0},
                        "reference_speed": {"dist": "normal", "mean": 9.0, "u": 2.0}},
@@ -73,7 +75,9 @@ MEANINGS = {
                        "[m s-1], height [m] (a distribution)"),
     "correction": ("", "motion correction: none, yaw (heading and ship velocity), tilt2d "
                    "(Rubio & Gottschall 2022 Eq. 13 as written), full (rotation of all "
-                   "three components and the ship velocity)"),
+                   "three components and the ship velocity), with one INS reading per scan; "
+                   "pointwise: each beam with the INS read at its own time stamp, lever "
+                   "arm included"),
     "sampling.method": ("", "mc, lhs, sobol, or none (GUM and the paper's model only)"),
     "sampling.n": ("1", "Monte Carlo trials per scene (give n or digits)"),
     "sampling.digits": ("1", "adaptive sampling to this many significant digits "
@@ -96,6 +100,17 @@ MEANINGS = {
     "motion.<dof>.phase": ("deg", "phase at the start of the scan (0: at the static "
                            "attitude, moving positive), or random: uniform over the cycle, "
                            "per trial (default)"),
+    "motion.spectrum.kind": ("", "wave spectrum: jonswap (Hasselmann et al. 1973, via "
+                             "wavespectra)"),
+    "motion.spectrum.hs": ("m", "significant wave height"),
+    "motion.spectrum.tp": ("s", "peak period"),
+    "motion.spectrum.gamma": ("1", "peak enhancement factor"),
+    "motion.spectrum.components": ("1", "wave components (equal frequency bins), each with "
+                                   "a random phase"),
+    "motion.spectrum.band": ("Hz", "[lowest, highest] frequency (default [0.5, 4] / tp)"),
+    "motion.response.<dof>.factor": ("deg m-1 or m m-1", "motion of a degree of freedom "
+                                     "per metre of wave amplitude (a flat response)"),
+    "motion.response.<dof>.lag": ("deg", "phase lag of that degree of freedom"),
     "lidar.lever_arm": ("m", "(bow, starboard, up) from the INS to the lidar"),
     "lidar.scan.beam_duration": ("s", "dwell per line of sight; beams in the order of "
                                  "azimuths, then the vertical beam"),
@@ -233,7 +248,9 @@ def documented_keys(records):
             continue
         if key.startswith("fit.priors."):     # one row per prior key, any parameter
             key, value = "fit.priors.<parameter>." + key.rpartition(".")[2], None
-        if key.startswith("motion."):         # one row per harmonic key, any dof
+        if key.startswith("motion.response."):        # one row per key, any dof
+            key = "motion.response.<dof>." + key.rpartition(".")[2]
+        elif key.startswith("motion.") and not key.startswith("motion.spectrum."):
             key = "motion.<dof>." + key.rpartition(".")[2]
         if key == "outputs":
             kind = "list of choices"

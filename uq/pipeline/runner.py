@@ -187,9 +187,17 @@ def run_scene(scenario, scene, seed):
     inputs = error_inputs(settings, scene.n_beams, n_gates)
     engine = _propagate(scene, settings, outputs, inputs, seed)
     dataset = _scene_dataset(scene, settings, outputs, engine)
-    if "wind_speed_motion_ti" in scenario.outputs:
+    if wants_motion_ti(settings):
         dataset = dataset.assign(_motion_ti(scene, settings, inputs, seed, dataset))
     return dataset
+
+
+def wants_motion_ti(settings):
+    """``wind_speed_motion_ti`` is computed for every scenario with motion whose outputs
+    include the wind speed (or that asks for it by name)."""
+    outputs = settings["outputs"]
+    return "wind_speed_motion_ti" in outputs or (bool(settings.get("motion"))
+                                                 and "wind_speed" in outputs)
 
 
 def model_outputs(outputs):
@@ -208,16 +216,21 @@ def _motion_ti(scene, settings, inputs, seed, dataset):
     """``wind_speed_motion_ti``: u of the scan's Vh from the motion alone (every other
     error at its mean), over the true Vh; Monte Carlo with the run's seed and sampling,
     and ``wind_speed_motion_ti_gum`` from the motion inputs' share of the GUM budget."""
+    truth = dataset["wind_speed_true"].values
     motion_only = {name: spec if name in MOTION_INPUTS else _mean_of(spec)
                    for name, spec in inputs.items()}
-    engine = _propagate(scene, settings, ("wind_speed",), motion_only, seed)
-    truth = dataset["wind_speed_true"].values
+    if settings["sampling"]["method"] == "none" or not any(n in inputs for n in MOTION_INPUTS):
+        u_motion = np.zeros_like(truth) if not any(n in inputs for n in MOTION_INPUTS) \
+            else np.full_like(truth, np.nan)
+    else:
+        engine = _propagate(scene, settings, ("wind_speed",), motion_only, seed)
+        u_motion = engine["wind_speed_mc_u"].values
     dims = dataset["wind_speed_true"].dims
     budget = dataset["wind_speed_budget"]
     labels = [input_label(name) for name in MOTION_INPUTS]
     motion_variance = budget.sel(input=[i for i in budget["input"].values if i in labels]
                                  ).sum("input").values
-    return {"wind_speed_motion_ti": (dims, engine["wind_speed_mc_u"].values / truth),
+    return {"wind_speed_motion_ti": (dims, u_motion / truth),
             "wind_speed_motion_ti_gum": (dims, np.sqrt(motion_variance) / truth)}
 
 

@@ -27,8 +27,8 @@ from uq.physics.beams import beam_unit_vectors
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS, validate_error
 from uq.errors import ScenarioError
 from uq.pipeline.fitconfig import validate_fit
-from uq.pipeline.motionsection import (is_time_resolved, validate_ins_timing, validate_lever_arm,
-                                       validate_motion, validate_scan)
+from uq.pipeline.motionsection import (validate_ins_timing, validate_lever_arm, validate_motion,
+                                       validate_scan)
 from uq.physics.measurement import OUTPUTS
 from uq.engine.sampling import PROPAGATION_METHODS
 from uq.engine.statistics import INTERVALS
@@ -337,13 +337,6 @@ def _check_time_resolved(check, settings):
     if "interpolation" in ins and "rate" not in ins:
         check.fail("ins.interpolation", "needs ins.rate (a continuous INS is not "
                    "interpolated); allowed: give ins.rate in Hz")
-    per_beam = ins["correlation"] == "beam" or any(
-        isinstance(spec, dict) and "correlation_time" in spec for spec in ins.values())
-    if per_beam and is_time_resolved(settings) and settings["correction"] != "pointwise":
-        check.fail("correction", f"{settings['correction']!r} reads the INS once per scan "
-                   "in a time-resolved scan, so its errors cannot differ between beams; "
-                   "allowed: pointwise (a reading per beam), or ins.correlation: scan "
-                   "without correlation_time")
     if DERIVED_OUTPUTS[0] in settings["outputs"] and not settings.get("motion"):
         check.fail("outputs", f"{DERIVED_OUTPUTS[0]} needs a motion section; allowed: the "
                    "other outputs")
