@@ -15,6 +15,7 @@ import sys
 import textwrap
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
@@ -473,6 +474,15 @@ def _(d):
 def _(d):
     path = scenario(d, "height,speed\n40,5 m/s\n60,6 m/s\n80,7 m/s\n", "table.csv")
     return [(["fit", str(path), "-o", str(d / "fit.nc")], (str(path), "speed"))]
+
+
+@case("fit of a CSV of 10^6 rows")
+def _(d):
+    rows = np.arange(1, 10**6 + 1) % 200 + 20.0
+    path = d / "table.csv"
+    np.savetxt(path, np.column_stack([rows, 8 + rows / 100]), delimiter=",", fmt="%.3f",
+               header="height,speed", comments="")
+    return [(["fit", str(path), "-o", str(d / "fit.nc")], (str(path), "1000000 rows"))]
 
 
 @case("fit of binary garbage")
