@@ -18,3 +18,17 @@ def test_columns_never_run_together_and_empty_ones_are_dropped():
         assert len(cells) == len(names), line          # every cell stands apart
     assert any("(n)" in line and "conclusive" in line for line in lines)
     assert "e-1" not in "\n".join(lines[2:5])          # rounding noise printed as 0
+
+
+def test_report_states_the_apparent_turbulence_intensity():
+    """sqrt(TI^2 + TI_motion^2): 6 % and 8 % make 10 %; the report of a motion result
+    states it for the true TI asked for."""
+    import numpy as np
+    from uq.outputs.report import apparent_ti, render_report
+    assert apparent_ti(0.06, 0.08) == np.float64(0.1)
+    ds = uq.run({"motion": {"roll": {"amplitude": 3.0, "period": 5.0}},
+                 "sampling": {"n": 500, "seed": 1}, "correction": "none"})
+    ti = float(ds["wind_speed_motion_ti"])
+    page = render_report(ds, true_ti=0.05)
+    assert "Apparent turbulence intensity" in page and "5 %" in page
+    assert f"{100 * np.hypot(0.05, ti):.2f} %" in page
