@@ -208,3 +208,7 @@ NUMERICAL_ZERO = 1e-9
 #: and a column of the GUM Jacobian; 256 resolve a JONSWAP peak (gamma 3.3, relative width
 #: ~0.1) with ~20 bins across it over a band of 0.5-4 fp.
 MAX_WAVE_COMPONENTS = 256
+
+#: Largest motion record read [bytes]: a day of 10 Hz samples of six degrees of freedom is
+#: ~50 MB of CSV; a longer record adds nothing a scan of seconds can use.
+MAX_SERIES_BYTES = 64 << 20

@@ -52,7 +52,8 @@ from uq.physics.rotation import (attitude_from_matrix_analytic, attitude_matrix,
                                  rotation_about_vertical)
 from uq.physics.scene import ANGULAR_NAVIGATION, NAVIGATION, sample_count
 
-TIME_RESOLVED_INPUTS = ("motion_phases", "ins_clock_offset", "ins_sample_offset")
+TIME_RESOLVED_INPUTS = ("motion_phases", "motion_window", "ins_clock_offset",
+                        "ins_sample_offset")
 
 
 def measurement_model(scene, outputs, scene_draws=False, **errors):
@@ -91,7 +92,8 @@ def single_scene(scene, outputs, **errors):
     # the motion and the INS timing vary over n_time trials (1 when none of their inputs
     # is random): the platform's kinematics are evaluated that many times, not n
     n_time = max([1] + [np.shape(err[k])[0] for k in TIME_RESOLVED_INPUTS if np.ndim(err[k])])
-    phases = resolved.motion.unit_phases(_phases(err["motion_phases"], resolved, n_time))
+    phases = resolved.motion.unit_phases(_phases(err["motion_phases"], err["motion_window"],
+                                                 resolved, n_time))
     phases = np.broadcast_to(phases, (n_time,) + phases.shape[1:])
     measured, heights = _measure(scene, resolved, phases, err, n)
     navigation = _navigation(scene, resolved, phases, err, n)
@@ -118,13 +120,20 @@ _ALL_INPUTS = tuple(f"ins_{key}" for key in NAVIGATION) + (
     TIME_RESOLVED_INPUTS
 
 
-def _phases(value, resolved, n):
-    """The random components' unit phases, (n, K_random, 2); zeros (their mean) when the
-    input is not given (the error-free reconstruction)."""
+def _phases(phases, window, resolved, n):
+    """The random components' unit phases, (n, K_random, 2): those of random phases (a
+    sea, harmonics), then those of a record's window (:attr:`Motion.window`); zeros
+    (their mean) for an input not given (the error-free reconstruction)."""
     k = len(resolved.motion.random_components)
-    if value.ndim == 0:
-        return np.zeros((n, k, 2)) if k else None
-    return value
+    if not k:
+        return None
+    k_window = resolved.motion.window
+
+    def part(value, size):
+        if np.ndim(value):
+            return np.broadcast_to(value, (n, size, 2))
+        return np.zeros((n, size, 2))
+    return np.concatenate([part(phases, k - k_window), part(window, k_window)], axis=-2)
 
 
 def _measure(scene, resolved, phases, err, n):

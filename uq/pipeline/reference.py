@@ -11,6 +11,9 @@ Regenerate with ``python -m uq.pipeline.reference > docs/scenario.md``.
 """
 import copy
 import math
+from pathlib import Path
+
+import numpy as np
 
 from uq.pipeline import scenario as scenario_module
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS
@@ -111,6 +114,13 @@ MEANINGS = {
     "motion.response.<dof>.factor": ("deg m-1 or m m-1", "motion of a degree of freedom "
                                      "per metre of wave amplitude (a flat response)"),
     "motion.response.<dof>.lag": ("deg", "phase lag of that degree of freedom"),
+    "motion.series.file": ("", "CSV of a measured motion record (relative to the "
+                           "scenario file); each trial reads a random window of it"),
+    "motion.series.time": ("s", "column of the sample times (equally spaced)"),
+    "motion.series.columns.<dof>": ("deg or m", "column of a degree of freedom: roll, pitch, "
+                                "yaw in deg; surge, sway, heave in m"),
+    "motion.series.components": ("1", "Fourier harmonics of the record kept (those with "
+                                 "the most motion)"),
     "lidar.lever_arm": ("m", "(bow, starboard, up) from the INS to the lidar"),
     "lidar.scan.beam_duration": ("s", "dwell per line of sight; beams in the order of "
                                  "azimuths, then the vertical beam"),
@@ -205,8 +215,18 @@ class RecordingChecker(Checker):
 def recorded_checks():
     """Dotted key -> (kind, value, limits) of every check the validator makes; the value
     is the default wherever the exemplar leaves the key unset."""
+    import tempfile
+    with tempfile.TemporaryDirectory() as folder:
+        record = Path(folder) / "record.csv"
+        times = np.arange(32) * 0.5
+        record.write_text("time,roll\n" + "".join(f"{t},{np.sin(t)}\n" for t in times))
+        series = {"motion": {"series": {"file": str(record), "columns": {"roll": "roll"}}}}
+        return _recorded(series)
+
+
+def _recorded(series):
     checker = RecordingChecker("<reference>")
-    for overlay in (EXEMPLAR_OPTIONAL, EXEMPLAR_ALTERNATIVE):
+    for overlay in (_merge(copy.deepcopy(EXEMPLAR_OPTIONAL), series), EXEMPLAR_ALTERNATIVE):
         checker.overlay = overlay
         raw = _merge(copy.deepcopy(DEFAULTS), overlay)
         raw["outputs"] = list(scenario_module.OUTPUTS)
@@ -248,9 +268,12 @@ def documented_keys(records):
             continue
         if key.startswith("fit.priors."):     # one row per prior key, any parameter
             key, value = "fit.priors.<parameter>." + key.rpartition(".")[2], None
+        if key.startswith("motion.series.columns."):
+            key = "motion.series.columns.<dof>"
         if key.startswith("motion.response."):        # one row per key, any dof
             key = "motion.response.<dof>." + key.rpartition(".")[2]
-        elif key.startswith("motion.") and not key.startswith("motion.spectrum."):
+        elif key.startswith("motion.") and not key.startswith(("motion.spectrum.",
+                                                                "motion.series.")):
             key = "motion.<dof>." + key.rpartition(".")[2]
         if key == "outputs":
             kind = "list of choices"

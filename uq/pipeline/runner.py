@@ -157,6 +157,9 @@ def _motion_inputs(settings):
     random = motionsection.random_phase_count(settings)
     if random:
         inputs["motion_phases"] = Input(UniformCircle(1.0), (random, 2))
+    series, window = motionsection.series_motion(settings.get("motion") or {})
+    if series:
+        inputs["motion_window"] = Input(window, (len(series), 2))
     ins = settings["ins"]
     if "clock_offset" in ins:
         inputs["ins_clock_offset"] = error_distribution(ins["clock_offset"])
@@ -168,7 +171,8 @@ def _motion_inputs(settings):
 
 
 #: Budget labels of the inputs that are not scenario keys of their own.
-INPUT_LABELS = {"motion_phases": "motion (phases)", "ins_sample_offset": "ins.rate (sampling)"}
+INPUT_LABELS = {"motion_phases": "motion (phases)", "motion_window": "motion.series (window)",
+                "ins_sample_offset": "ins.rate (sampling)"}
 
 
 def input_label(name):
@@ -209,7 +213,7 @@ def model_outputs(outputs):
 
 
 #: Inputs that are the motion itself (random phases and when the INS samples it).
-MOTION_INPUTS = ("motion_phases", "ins_sample_offset")
+MOTION_INPUTS = ("motion_phases", "motion_window", "ins_sample_offset")
 
 
 def _motion_ti(scene, settings, inputs, seed, dataset):
