@@ -393,15 +393,18 @@ def plot_probe_bias(dataset):
                                 constrained_layout=True, squeeze=False, sharex=True,
                                 sharey="row")
     gates = dataset["range"].values
-    kinds = list(dataset[PROBE_KIND_DIM].values) if PROBE_KIND_DIM in dataset.dims else [None]
+    if PROBE_KIND_DIM in dataset.dims:
+        kinds = list(dataset[PROBE_KIND_DIM].values)
+    else:                       # one kind: a selected value of the sweep, or the scenario's
+        kinds = [str(dataset[PROBE_KIND_DIM].values) if PROBE_KIND_DIM in dataset.coords
+                 else dataset.attrs.get("probe", "probe").split(":")[0]]
     for j, value in enumerate(columns):
         at = dataset if column_dim is None else dataset.sel({column_dim: value})
         for kind in kinds:
-            one = at if kind is None else at.sel({PROBE_KIND_DIM: kind})
+            one = at.sel({PROBE_KIND_DIM: kind}) if PROBE_KIND_DIM in at.dims else at
             bias = one["wind_speed_probe_bias"].values
             relative = 100 * bias / one["wind_speed_true"].values
-            label = kind or dataset.attrs.get("probe", "probe").split(":")[0]
-            style = {"color": PROBE_COLOURS.get(label, "k"), "marker": ".", "label": label}
+            style = {"color": PROBE_COLOURS.get(kind, "k"), "marker": ".", "label": kind}
             axes[0, j].plot(gates, bias, **style)
             axes[1, j].plot(gates, relative, **style)
         if column_dim is not None:
