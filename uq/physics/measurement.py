@@ -15,6 +15,10 @@ input                        shape            meaning
 ``lidar_radial_velocity``    (n, beams, gates) radial-velocity noise [m s-1]
 ``lidar_height``             (n,)             true minus configured height of the lidar
                                               above sea level [m] (draft, ballast, tide)
+``lidar_gate_length``,       (n,)             true minus configured parameters of the
+``lidar_pulse_fwhm``                          probe volume (:mod:`uq.physics.probe`):
+``lidar_wavelength``,                         [m], [m], [um], [mm]
+``lidar_beam_radius``
 ===========================  ===============  ========================================
 
 k = 1 when INS errors are shared by the beams of a scan (``scan``) and k = n_beams when
@@ -41,6 +45,10 @@ structure: beams, gates, correction). Outputs then have shape (n, *S, ...), and 
 scene sees the same error draws (common random numbers). Quantities that do not depend
 on the errors (nominal beam vectors, least-squares operator, slant distances) are
 computed once per scene, not per sample.
+
+With a probe volume (``scene.probe``, :mod:`uq.physics.probe`) the horizontal wind
+speed in each true radial velocity is its weighted mean along the true beam (a
+quadrature; a probe never runs the compiled model).
 
 The output ``gate_height`` is the mean true height of the slanted beams at each range
 gate [m]: the height the reconstructed horizontal wind belongs to, which a tilted lidar

@@ -11,7 +11,9 @@ untouched. Per trial:
    :func:`uq.physics.motion.platform_kinematics` (static ship + harmonic motion + lever
    arm). The true radial velocity at gate g is ``b(t) . (u(z) - v_lidar(t))`` with the
    true beam ``b(t) = R(t) b_ship`` and the true height z of the gate point (power-law
-   shear); with ``dwell_average`` its mean over the dwell. Radial noise is added.
+   shear; with a probe volume, :mod:`uq.physics.probe`, the horizontal speed weighted
+   along ``b(t)`` at its points' heights); with ``dwell_average`` its mean over the
+   dwell. Radial noise is added.
 2. The INS reports the attitude (with its rates) and the velocity of its own point. It is
    read at ``t + delta`` (clock offset delta): at each beam's time stamp for ``pointwise``,
    at the scan's mid time for the other models; from its samples by ``nearest`` or
