@@ -427,3 +427,33 @@ def test_readme_table_is_the_model():
             row = f"| {shear:.2f} | " + " | ".join(
                 f"{value:.3f} %".replace("-", "\u2212") for value in relative[shown]) + " |"
             assert row in readme, row
+
+
+def test_the_probe_moves_with_the_beam_in_a_time_resolved_scan():
+    """Roll and heave during the scan: each beam at its time stamp t_k = k + 1/2 s has
+    the attitude (roll + 5 deg sin(2 pi t / 6 + 30 deg)) and the height (+ 1 m sin(2 pi t
+    / 8)) written out here; the pointwise-corrected radial velocity (no errors: the
+    lidar's own velocity removed exactly) is the brute-force weighted speed along that
+    beam, projected, plus the vertical wind."""
+    roll = {"amplitude": 5.0, "period": 6.0, "phase": 30.0}
+    heave = {"amplitude": 1.0, "period": 8.0, "phase": 0.0}
+    for probe, physics in ((PULSED, windcube()), (CW, zephir())):
+        s = scene(probe, **{"motion.roll": roll, "motion.heave": heave, "ship.pitch": 3.0,
+                            "correction": "pointwise", "wind.shear": 0.2,
+                            "wind.vertical": 0.3, "lidar.ranges": [40.0, 150.0]})
+        out = measurement_model(s, ("radial_velocity",))["radial_velocity"][0]
+        slant = slant_distances(s.ranges, s.half_cone, 4, False)
+        to_wind = -np.array([np.cos(s.wind_direction), np.sin(s.wind_direction)])
+        for k in range(4):
+            t = k + 0.5
+            rolled = s.roll + math.radians(5.0) * math.sin(2 * math.pi * t / 6 + math.radians(30))
+            beam = attitude_matrix(s.heading, s.pitch, rolled) @ s.nominal_unit_vectors()[k]
+            lidar = s.lidar_height + math.sin(2 * math.pi * t / 8)
+            for g in range(2):
+                centre = lidar + slant[k, g] * beam[2]
+                u_c = s.wind_speed * (centre / s.reference_height) ** s.shear
+                speed = u_c * brute_force_speed(physics, centre, beam[2], slant[k, g], s.shear)
+                expected = speed * beam[:2] @ to_wind + beam[2] * 0.3
+                # the quadrature's tolerance, relative to the speed (~10 m/s)
+                assert out[k, g] == pytest.approx(expected, abs=2 * PROBE_QUADRATURE_TOLERANCE
+                                                  * s.wind_speed)
