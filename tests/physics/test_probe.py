@@ -277,8 +277,9 @@ def test_power_law_bias_is_the_second_order_expansion_where_small_and_the_integr
         assert bias[gate] == pytest.approx(exact, abs=PROBE_QUADRATURE_TOLERANCE)
         second, fourth = second_and_fourth_order(physics, shear, vertical, centre, focus)
         small = abs(fourth) < 0.05 * abs(second)    # the series converges fast here
-        cut = kind == "pulsed" and physics.half_length(focus) < focus  # no cut at the lens
-        if small and (kind == "cw" or cut):
+        # the pulsed moments above are those of the uncut weighting: not where the lens cuts
+        whole = kind == "pulsed" and physics.half_length(focus) < focus
+        if small and (kind == "cw" or whole):
             # the remainder after the second order is the fourth-order term plus terms
             # smaller by (probe extent / height)^2; 2x the fourth order bounds it, plus
             # the quadrature's tolerance
@@ -294,8 +295,9 @@ def test_expansion_is_checked_at_several_gates():
         for rng_ in (10.0, 40.0, 100.0, 200.0, 300.0):
             second, fourth = second_and_fourth_order(physics, 0.14, vertical, 2 + rng_,
                                                      rng_ / vertical)
-            cut = physics.kind == "pulsed" and physics.half_length(rng_ / vertical) >= rng_ / vertical
-            small += abs(fourth) < 0.05 * abs(second) and not cut
+            focus = rng_ / vertical
+            at_lens = physics.kind == "pulsed" and physics.half_length(focus) >= focus
+            small += abs(fourth) < 0.05 * abs(second) and not at_lens
         assert small == expected
 
 

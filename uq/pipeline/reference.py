@@ -80,8 +80,8 @@ MEANINGS = {
                        "[m], wavelength [um], beam_radius [mm] (one draw per scan; needs "
                        "the parameter in lidar.probe) (a distribution)"),
     "lidar.probe.kind": ("", "range weighting of each radial velocity along its beam: "
-                         "point (at the gate centre; the default), pulsed (the range gate convolved with "
-                         "a Gaussian pulse), cw (a focused continuous wave: a Lorentzian "
+                         "point (at the gate centre; the default), pulsed (the range "
+                         "gate convolved with a Gaussian pulse), cw (a focused continuous wave: a Lorentzian "
                          "with truncated tails); cut at the lens; see uq/physics/probe.py. "
                          "The parameters of every kind may be given (kind can be swept)"),
     "lidar.probe.gate_length": ("m", "range-gate length of a pulsed lidar"),
