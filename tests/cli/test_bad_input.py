@@ -328,6 +328,20 @@ def _(d):
                          "lidar.ranges[0]")
 
 
+@case("a probe of an unknown kind")
+def _(d):
+    return check_and_run(scenario(d, with_good(lidar={"probe": {"kind": "flash"}})),
+                         "lidar.probe.kind", "point, pulsed, cw")
+
+
+@case("an error of a probe parameter the probe does not give")
+def _(d):
+    return check_and_run(scenario(d, with_good(lidar={
+        "probe": {"kind": "pulsed", "gate_length": 30, "pulse_fwhm": 22.5},
+        "errors": {"beam_radius": {"dist": "normal", "u": 1.0}}})),
+        "lidar.errors.beam_radius", "lidar.probe.beam_radius")
+
+
 @case("outputs as text")
 def _(d):
     return check_and_run(scenario(d, with_good(outputs="wind_speed")), "outputs")

@@ -213,13 +213,15 @@ def _bias(dataset, quantity):
     answer = planning.bias_answer(dataset, quantity)
     unit = QUANTITY_UNITS[quantity]
     correction = answer["correction"]
+    probe = answer.get("probe")
     text = f"<h4>Bias: {quantity.replace('_', ' ')}</h4><p>Systematic error of the correction " \
-        "(reconstruction with zero errors minus truth): "
-    if correction["zero"]:
-        text += (f"none (at most {abs(correction['value']):.1g} {unit}, within the "
-                 f"{_ZERO} {unit} of rounding).")
-    else:
-        text += f"largest {correction['value']:+.3g} {unit} at {_e(_where(correction, dataset))}."
+        "(reconstruction with zero errors minus truth" + (
+            ", less the probe volume's" if probe else "") + "): "
+    text += _systematic(correction, unit, dataset)
+    if probe:
+        text += (" Systematic error of the probe volume (the radial velocities weighted "
+                 "along the beams minus the same at the gate centres): "
+                 + _systematic(probe, unit, dataset))
     if "mc" in answer:
         variable = f"{quantity}_mc_bias"
         if answer["mc_significant"] is None:
@@ -233,6 +235,14 @@ def _bias(dataset, quantity):
                      f"{_share(answer['significant_count'], answer['compared'], dataset, variable)}"
                      f"; largest {largest['value']:+.3g} {unit} at {_e(_where(largest, dataset))}.")
     return text + "</p>"
+
+
+def _systematic(item, unit, dataset):
+    """``none (...)`` or ``largest +x unit at ...`` of a systematic error."""
+    if item["zero"]:
+        return (f"none (at most {abs(item['value']):.1g} {unit}, within the {_ZERO} {unit} "
+                "of rounding).")
+    return f"largest {item['value']:+.3g} {unit} at {_e(_where(item, dataset))}."
 
 
 def _where(item, dataset=None):

@@ -11,7 +11,9 @@ untouched. Per trial:
    :func:`uq.physics.motion.platform_kinematics` (static ship + harmonic motion + lever
    arm). The true radial velocity at gate g is ``b(t) . (u(z) - v_lidar(t))`` with the
    true beam ``b(t) = R(t) b_ship`` and the true height z of the gate point (power-law
-   shear); with ``dwell_average`` its mean over the dwell. Radial noise is added.
+   shear; with a probe volume, :mod:`uq.physics.probe`, the horizontal speed weighted
+   along ``b(t)`` at its points' heights); with ``dwell_average`` its mean over the
+   dwell. Radial noise is added.
 2. The INS reports the attitude (with its rates) and the velocity of its own point. It is
    read at ``t + delta`` (clock offset delta): at each beam's time stamp for ``pointwise``,
    at the scan's mid time for the other models (whose one reading takes the
@@ -47,6 +49,7 @@ from uq.physics.correction import (correction_rotation, pointwise_wind, removed_
                                    scan_wind)
 from uq.physics.ins import bracket
 from uq.physics.motion import platform_kinematics
+from uq.physics.probe import PARAMETER_SCALE
 from uq.physics.rotation import (attitude_from_matrix_analytic, attitude_matrix,
                                  attitude_matrix_rate, interpolate_rotation,
                                  rotation_about_vertical)
@@ -54,6 +57,8 @@ from uq.physics.scene import ANGULAR_NAVIGATION, NAVIGATION, sample_count
 
 TIME_RESOLVED_INPUTS = ("motion_phases", "motion_window", "ins_clock_offset",
                         "ins_sample_offset")
+#: Probe parameters with errors (inputs ``lidar_<parameter>``, :mod:`uq.physics.probe`).
+PROBE_ERRORS = tuple(PARAMETER_SCALE)
 
 
 def measurement_model(scene, outputs, scene_draws=False, **errors):
@@ -155,7 +160,8 @@ def _measure(scene, resolved, phases, err, n):
         + kin["lidar_offset"][..., 2]                                   # (n, b, q)
     heights = lidar_z[..., None] + slant[:, None, :] * beams[..., 2:3]  # (n, b, q, g)
     speed = wind.power_law_speed(scene.wind_speed, heights, scene.reference_height,
-                                 scene.shear)
+                                 scene.shear) if scene.probe is None else \
+        _probe_speed(scene, heights, beams[..., 2:3], slant[:, None, :], err)
     to_north, to_east = wind.wind_components(1.0, complexstep.degrees(scene.wind_direction))
     along_wind = beams[..., 0] * to_north + beams[..., 1] * to_east     # (n, b, q)
     own = np.sum(beams * kin["lidar_velocity"], axis=-1)                # (n, b, q)
@@ -164,6 +170,19 @@ def _measure(scene, resolved, phases, err, n):
     mean_radial = np.einsum("...q,q->...", np.moveaxis(radial, -2, -1), weights)  # (n, b, g)
     mean_height = np.einsum("...q,q->...", np.moveaxis(heights, -2, -1), weights)
     return mean_radial + err["lidar_radial_velocity"], mean_height
+
+
+def _probe_speed(scene, heights, vertical, focus, err):
+    """The probe-weighted horizontal speed at the probe's points on the true beams at
+    their own times (:mod:`uq.physics.probe`); heights (n, b, q, g), vertical (n, b, q, 1),
+    focus (b, 1, g); a probe parameter's error (n,) is one per scan."""
+    errors = {}
+    for key in PROBE_ERRORS:
+        value = np.asarray(err.get(f"lidar_{key}", 0.0))
+        errors[key] = value.reshape(-1, 1, 1, 1) if value.ndim else value
+    return scene.probe.average(lambda z: wind.power_law_speed(
+        scene.wind_speed, z, scene.reference_height, scene.shear), heights, vertical, focus,
+        errors)
 
 
 def _navigation(scene, resolved, phases, err, n):

@@ -29,9 +29,15 @@ EXEMPLAR_OPTIONAL = {
     "lidar": {"errors": {"half_cone": {"dist": "normal", "u": 0.1},
                          "misalignment": {"dist": "normal", "u": 0.3},
                          "radial_velocity": {"dist": "normal", "u": 0.05},
-                         "height": {"dist": "normal", "u": 0.2}},
+                         "height": {"dist": "normal", "u": 0.2},
+                         "gate_length": {"dist": "normal", "u": 1.0},
+                         "pulse_fwhm": {"dist": "normal", "u": 1.0},
+                         "wavelength": {"dist": "normal", "u": 0.001},
+                         "beam_radius": {"dist": "normal", "u": 1.0}},
               "lever_arm": [0.0, 0.0, 2.0],
-              "scan": {}},
+              "scan": {},
+              "probe": {"kind": "cw", "gate_length": 30.0, "pulse_fwhm": 22.5,
+                        "wavelength": 1.565, "beam_radius": 28.0, "truncation": 0.02}},
     "motion": {**{dof: {"amplitude": 1.0, "period": 5.0, "phase": 0.0}
                   for dof in ("roll", "pitch", "yaw", "surge", "sway", "heave")},
                "spectrum": {"hs": 2.0, "tp": 7.0},
@@ -75,7 +81,25 @@ MEANINGS = {
     "lidar.misalignment": ("deg", "angle from the bow to the reference beam, clockwise"),
     "lidar.errors.*": ("as the quantity", "true minus configured half_cone [deg], "
                        "misalignment [deg], radial_velocity noise per beam and gate "
-                       "[m s-1], height [m] (a distribution)"),
+                       "[m s-1], height [m], and of the probe's gate_length, pulse_fwhm "
+                       "[m], wavelength [um], beam_radius [mm] (one draw per scan; needs "
+                       "the parameter in lidar.probe) (a distribution)"),
+    "lidar.probe.kind": ("", "range weighting of each radial velocity along its beam: "
+                         "point (at the gate centre; the default), pulsed (the range "
+                         "gate convolved with a Gaussian pulse), cw (a focused continuous wave: a Lorentzian "
+                         "with truncated tails); cut at the lens; see uq/physics/probe.py. "
+                         "The parameters of every kind may be given (kind can be swept)"),
+    "lidar.probe.gate_length": ("m", "range-gate length of a pulsed lidar"),
+    "lidar.probe.pulse_fwhm": ("m", "full width at half maximum of a pulsed lidar's pulse "
+                               "in range (c tau / 2 for a pulse of duration tau)"),
+    "lidar.probe.wavelength": ("um", "laser wavelength of a CW lidar"),
+    "lidar.probe.beam_radius": ("mm", "1/e^2 intensity radius of a CW lidar's beam at the "
+                                "lens; the Rayleigh length at the focus F (the gate's slant "
+                                "distance) is lambda F^2 / (pi a^2)"),
+    "lidar.probe.truncation": ("1", "a CW weighting's tails are cut where it falls below "
+                               "this fraction of its peak (abs(s) <= sqrt(1/t - 1) z_R); "
+                               "part of the model (the Lorentzian's variance is infinite), stated "
+                               "in the results' probe attribute"),
     "correction": ("", "motion correction: none, yaw (heading and ship velocity), tilt2d "
                    "(Rubio & Gottschall 2022 Eq. 13 as written), full (rotation of all "
                    "three components and the ship velocity), with one INS reading per scan; "

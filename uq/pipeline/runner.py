@@ -9,6 +9,7 @@ Chunks can run on a dask cluster and be kept on disk for ``--resume``; neither c
 a number.
 """
 import contextlib
+import dataclasses
 import time
 
 import numpy as np
@@ -18,7 +19,8 @@ from uq._version import __version__
 from uq.pipeline.distributions import error_distribution
 from uq.engine.inputs import Input, UniformCircle
 from uq.physics.ins import gauss_markov_correlation
-from uq.pipeline import motionsection
+from uq.pipeline import motionsection, probesection
+from uq.physics import probe as probe_volume
 from uq.physics.measurement import ANGULAR_NAVIGATION, OUTPUTS, Scene, measurement_model, true_values
 from uq.pipeline.metadata import (COORDINATES, QUANTITIES, ancillary_variables, cf_encode,
                                   history, swept_key_attributes, variable_attributes)
@@ -112,7 +114,8 @@ def scene_from_settings(settings):
         lidar_height=lid["height"], ranges=tuple(lid["ranges"]), half_cone=rad(lid["half_cone"]),
         misalignment=rad(lid["misalignment"]), azimuths=tuple(rad(lid["azimuths"])),
         vertical_beam=lid["vertical_beam"], correction=settings["correction"],
-        time_resolved=motionsection.time_resolved(settings))
+        time_resolved=motionsection.time_resolved(settings),
+        probe=probe_volume.make_probe(lid.get("probe")))
 
 
 def error_inputs(settings, n_beams, n_gates):
@@ -123,7 +126,10 @@ def error_inputs(settings, n_beams, n_gates):
     (correlation ``exp(-|t_k - t_l| / tau)``; tau = inf is one per scan). Time-resolved
     scans add the unit phases of the random-phase motion components
     (:class:`uq.engine.inputs.UniformCircle`), the clock offset and, for a sampled INS,
-    the offset of its samples (uniform over one period).
+    the offset of its samples (uniform over one period). Errors of the probe's parameters
+    (``lidar.errors.gate_length`` ...) are one draw per scan, in scenario units; those of
+    a parameter the probe's kind does not use stay inputs without effect (so that every
+    value of a swept ``lidar.probe.kind`` has the same inputs).
     """
     inputs = {}
     beam_mode = settings["ins"]["correlation"] == "beam"
@@ -188,6 +194,7 @@ def run_scene(scenario, scene, seed):
     settings = scenario.settings
     outputs = model_outputs(scenario.outputs)
     n_gates = len(scene.ranges)
+    scene = probe_volume.resolve(scene)       # the probe's node count, once per batch
     inputs = error_inputs(settings, scene.n_beams, n_gates)
     engine = _propagate(scene, settings, outputs, inputs, seed)
     dataset = _scene_dataset(scene, settings, outputs, engine)
@@ -291,6 +298,8 @@ def _scene_dataset(scene, settings, outputs, engine):
             if q == "wind_direction":
                 bias = unwrap(bias, 0.0)
             data[f"{q}_mc_bias"] = (dims, bias)
+    if "probe" in settings["lidar"]:
+        data.update(_probe_variables(scene, outputs, nominal))
     data["mc_n_samples"] = ("scene", np.full(scene.shape, engine.attrs["n_samples"]))
     data["mc_stopped_by"] = ("scene", np.full(scene.shape, STOPPED_BY.index(
         engine.attrs["stopped_by"]), dtype=np.int8))
@@ -301,6 +310,33 @@ def _scene_dataset(scene, settings, outputs, engine):
     if "beam" in engine.dims:
         coords.update(_beam_coordinates(scene))
     return engine.assign(data).assign_coords(coords)      # one merge each (xarray's cost)
+
+
+#: Outputs whose systematic error from the probe volume is reported (``{q}_probe_bias``).
+PROBE_BIAS_OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity")
+
+
+def _probe_variables(scene, outputs, nominal):
+    """``{q}_probe_bias``: the error-free reconstruction with the probe volume minus the
+    same at the gate centre (zero for a point probe), so that ``q_nominal - q_true`` is
+    this plus the correction's own systematic error; ``probe_nodes`` and
+    ``probe_quadrature_error``: the quadrature along the beams (:mod:`uq.physics.probe`)."""
+    point = nominal if scene.probe is None else measurement_model(
+        dataclasses.replace(scene, probe=None), outputs, compiled=False)
+    data = {}
+    for q in outputs:
+        if q not in PROBE_BIAS_OUTPUTS:
+            continue
+        bias = np.real(nominal[q][0]) - np.real(point[q][0])
+        if q == "wind_direction":
+            bias = unwrap(bias, 0.0)
+        data[f"{q}_probe_bias"] = (_dims(q), bias)
+    probe = scene.probe
+    data["probe_nodes"] = ("scene", np.full(scene.shape, probe.nodes if probe else 1,
+                                            dtype=np.int32))
+    data["probe_quadrature_error"] = ("scene", np.full(
+        scene.shape, probe.quadrature_error if probe else 0.0))
+    return data
 
 
 def _beam_coordinates(scene):
@@ -367,6 +403,15 @@ DERIVED_ATTRIBUTES = {
 }
 
 
+#: Attributes of the probe's quadrature variables.
+PROBE_ATTRIBUTES = {
+    "probe_nodes": {"units": "1", "long_name": "Gauss-Legendre nodes per beam and range gate "
+                    "of the probe-volume quadrature (1: a point probe)"},
+    "probe_quadrature_error": {"units": "1", "long_name": "relative error of the probe "
+                               "quadrature at the nominal geometry, against a 128-node rule"},
+}
+
+
 def _annotate(ds, scenario):
     # attributes set on the Variables in place (ds[name] would build a DataArray each)
     for name in ds.data_vars:
@@ -377,6 +422,9 @@ def _annotate(ds, scenario):
             ds.variables[name].attrs.update(
                 variable_attributes(quantity, name[len(quantity) + 1:]))
     ds.variables["mc_n_samples"].attrs.update(units="1", long_name="Monte Carlo trials used")
+    for name, attrs in PROBE_ATTRIBUTES.items():
+        if name in ds.variables:
+            ds.variables[name].attrs.update(attrs)
     ds.variables["mc_stopped_by"].attrs.update(  # a CF flag variable (CF 1.10, 3.5)
         units="1", long_name="what stopped Monte Carlo sampling",
         flag_values=np.arange(len(STOPPED_BY), dtype=np.int8),
@@ -395,9 +443,10 @@ def _annotate(ds, scenario):
     return cf_encode(ds)
 
 
-def skipped_work(settings, outputs):
+def skipped_work(settings, outputs, probe_kinds=()):
     """What the model did not compute for this scenario, in words (the ``skipped``
-    attribute): each line names a shortcut the measurement model took."""
+    attribute): each line names a shortcut the measurement model took. `probe_kinds`: the
+    values of a swept ``lidar.probe.kind`` (default: the scenario's kind)."""
     lidar, ins = settings["lidar"], settings["ins"]
     lines = [f"input not sampled (no error declared): {key}" for key in
              [f"ins.{k}" for k in INS_KEYS if k not in ins]
@@ -409,12 +458,20 @@ def skipped_work(settings, outputs):
     if settings["correction"] in ("none", "yaw"):
         lines.append(f"correction '{settings['correction']}': no pitch/roll rotation")
     lines += [f"output not requested, not computed: {q}" for q in OUTPUTS if q not in outputs]
+    if "probe" in lidar:
+        for kind in probe_kinds or (lidar["probe"]["kind"],):
+            lines += [f"probe parameter error without effect where lidar.probe.kind is "
+                      f"{kind} (it does not use it): lidar.errors.{key}"
+                      for key in probesection.unused_errors(settings, kind)]
+        lines.append("probe volume: evaluated by the numpy model (the compiled model is "
+                     "point-wise)")
     return "; ".join(lines) or "nothing"
 
 
 def _global_attributes(scenario, seed, dataset, started):
     return {"title": f"uq results: {scenario.name}",
-            "skipped": skipped_work(scenario.settings, scenario.outputs),
+            "skipped": skipped_work(scenario.settings, scenario.outputs,
+                                    dict(scenario.sweep).get("lidar.probe.kind", ())),
             "Conventions": "CF-1.10",
             "history": history(f"uq run, scenario {scenario.name}"),
             "scenario": scenario.text,
@@ -425,4 +482,19 @@ def _global_attributes(scenario, seed, dataset, started):
             "seed": seed,
             "correction": scenario.settings["correction"],
             "ins_correlation": scenario.settings["ins"]["correlation"],
-            "runtime_s": time.perf_counter() - started}
+            "runtime_s": time.perf_counter() - started, **_probe_attributes(scenario)}
+
+
+def _probe_attributes(scenario):
+    """``probe``: the probe model in words, with the truncation of the CW Lorentzian
+    (part of the model: its variance is infinite); ``probe_truncation`` [1] when a CW
+    probe runs; nothing for a scenario without ``lidar.probe``."""
+    lidar = scenario.settings["lidar"]
+    if "probe" not in lidar:
+        return {}
+    swept = dict(scenario.sweep).get("lidar.probe.kind", ())
+    attributes = {"probe": probesection.describe(scenario.settings, swept)}
+    kinds = set(swept) or {lidar["probe"]["kind"]}
+    if "cw" in kinds:
+        attributes["probe_truncation"] = lidar["probe"]["truncation"]
+    return attributes

@@ -29,6 +29,7 @@ from uq.errors import ScenarioError
 from uq.pipeline.fitconfig import validate_fit
 from uq.pipeline.motionsection import (validate_ins_timing, validate_lever_arm, validate_motion,
                                        validate_scan)
+from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
 from uq.physics.measurement import OUTPUTS
 from uq.engine.sampling import PROPAGATION_METHODS
 from uq.engine.statistics import INTERVALS
@@ -71,7 +72,7 @@ DEFAULTS = {
 }
 #: Optional keys of a section that enter the settings only when given (so a scenario
 #: without them is today's, to the text of its ``scenario`` attribute).
-OPTIONAL_LIDAR_KEYS = ("lever_arm", "scan")
+OPTIONAL_LIDAR_KEYS = ("lever_arm", "scan", "probe")
 OPTIONAL_INS_KEYS = ("rate", "interpolation", "clock_offset")
 #: Outputs derived from the results rather than evaluated per trial.
 DERIVED_OUTPUTS = ("wind_speed_motion_ti",)
@@ -321,13 +322,16 @@ def _lidar(check, value):
     _check_beams_determine_wind(check, out)
     errors = lid["errors"] if lid["errors"] is not None else {}
     check.mapping(errors, "lidar.errors")
-    check.keys(errors, "lidar.errors", LIDAR_ERROR_KEYS)
+    check.keys(errors, "lidar.errors", LIDAR_ERROR_KEYS + PROBE_ERROR_KEYS)
     out["errors"] = {key: validate_error(errors[key], f"lidar.errors.{key}", check)
-                     for key in LIDAR_ERROR_KEYS if key in errors}
+                     for key in LIDAR_ERROR_KEYS + PROBE_ERROR_KEYS if key in errors}
     if "lever_arm" in lid:
         out["lever_arm"] = validate_lever_arm(check, lid["lever_arm"])
     if "scan" in lid:
         out["scan"] = validate_scan(check, lid["scan"])
+    if "probe" in lid:
+        out["probe"] = validate_probe(check, lid["probe"])
+    check_probe(check, out)
     return out
 
 
