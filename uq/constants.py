@@ -199,3 +199,55 @@ MAX_DWELL_NODES = 32
 #: of ~1e-15, ~1e-13 after a few dozen operations; a vanishing u comes out at ~1e-29) and
 #: far below anything a lidar resolves (~1e-2 m s-1) or a report prints (4 digits of u).
 NUMERICAL_ZERO = 1e-9
+
+#: Most components of a wave spectrum [1]: each is a Monte Carlo input (a random phase)
+#: and a column of the GUM Jacobian; 256 resolve a JONSWAP peak (gamma 3.3, relative width
+#: ~0.1) with ~20 bins across it over a band of 0.5-4 fp.
+MAX_WAVE_COMPONENTS = 256
+
+#: Largest motion record read [bytes]: a day of 10 Hz samples of six degrees of freedom is
+#: ~50 MB of CSV; a longer record adds nothing a scan of seconds can use.
+MAX_SERIES_BYTES = 64 << 20
+
+# --- probe volume (issue 19) -------------------------------------------------------------
+
+#: Relative error allowed in a probe-weighted wind speed by the quadrature along the beam
+#: [1] (:func:`uq.physics.probe.node_count`): 1e-6 of 10 m s-1 is 1e-5 m s-1, four orders
+#: below a lidar's radial-velocity noise (~0.1 m s-1) and two below the smallest probe
+#: bias of the typical configurations (~1e-4 relative, a pulsed lidar at 200 m).
+PROBE_QUADRATURE_TOLERANCE = 1e-6
+
+#: Most Gauss-Legendre nodes per beam and gate of a probe volume [1]. The typical
+#: configurations need 10-20 (a pulsed lidar) and up to ~50 (a CW lidar whose truncated
+#: tails reach the lens at 200-300 m from a lidar 2 m above the sea: the power law's branch
+#: point at the sea surface then lies just beyond the end of the probe, which slows the
+#: rule's convergence); a negative shear there needs ~100.
+MAX_PROBE_NODES = 128
+
+#: Nodes of the reference rule against which :func:`uq.physics.probe.node_count`
+#: measures the error of every smaller rule [1]: twice MAX_PROBE_NODES, so that the
+#: reference converges at twice the rate (in the number of nodes) of the largest rule
+#: it judges; its own relative error is below 1e-12 in the hardest cases tested (a CW
+#: probe focused 200-300 m out from 2-3 m above the sea).
+PROBE_REFERENCE_NODES = 2 * MAX_PROBE_NODES
+
+#: Two-sided Gaussian tail mass of the pulse beyond which the pulsed weighting is cut
+#: for the quadrature [1]: the cut is numerical, not part of the model (its effect on a
+#: weighted speed is below this mass times the relative spread of the speed, < 1e-10).
+PULSE_TAIL_MASS = 1e-10
+
+#: A typical pulsed lidar (WindCube-like) [m]: range-gate length 30 m (the "functional
+#: probed length" of the WindCube user manual) and pulse FWHM 22.5 m (a 150 ns pulse,
+#: Delta r = sqrt(ln 2) c sigma_p, Eq. 2.20), both as quoted by Matavar (2024), Sec. 2.2.3
+#: (refs. [44], [86] there); OpenFAST's InflowWind lidar module also uses 30 m for the
+#: WindCube.
+WINDCUBE_GATE_LENGTH = 30.0
+WINDCUBE_PULSE_FWHM = 22.5
+
+#: A typical continuous-wave lidar (ZephIR-like) as modelled by OpenFAST's InflowWind
+#: lidar module (modules/inflowwind/src/Lidar.f90: LsrWavLen = 1.565e-6 m, BeamRad =
+#: 0.028 m, weighting truncated where it falls below 0.02 of its peak, WtFnTrunc):
+#: wavelength [um], 1/e^2 beam radius at the lens [mm], truncation [1].
+ZEPHIR_WAVELENGTH_UM = 1.565
+ZEPHIR_BEAM_RADIUS_MM = 28.0
+ZEPHIR_TRUNCATION = 0.02

@@ -55,7 +55,9 @@ def test_bench_file_passes_the_cf_checker(monkeypatch, tmp_path, cf_compliance):
     monkeypatch.setattr(bench, "SCENES", {"rubio2022_case_i": bench.SCENES["rubio2022_case_i"]})
     monkeypatch.setattr(bench, "scan_throughput", lambda: 0.1)
     path = tmp_path / "bench.nc"
+    (tmp_path / "bench.txt").write_text("not uq's")          # beside the outputs
     run_bench(path, quick=True, sizes=[2**10, 2**11], repeats=2)
+    assert (tmp_path / "bench.txt").read_text() == "not uq's"
     cf_compliance(path)
     with xr.open_dataset(path) as ds:
         assert all(re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", name) for name in ds.attrs), \

@@ -15,6 +15,7 @@ import sys
 import textwrap
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
@@ -327,6 +328,20 @@ def _(d):
                          "lidar.ranges[0]")
 
 
+@case("a probe of an unknown kind")
+def _(d):
+    return check_and_run(scenario(d, with_good(lidar={"probe": {"kind": "flash"}})),
+                         "lidar.probe.kind", "point, pulsed, cw")
+
+
+@case("an error of a probe parameter the probe does not give")
+def _(d):
+    return check_and_run(scenario(d, with_good(lidar={
+        "probe": {"kind": "pulsed", "gate_length": 30, "pulse_fwhm": 22.5},
+        "errors": {"beam_radius": {"dist": "normal", "u": 1.0}}})),
+        "lidar.errors.beam_radius", "lidar.probe.beam_radius")
+
+
 @case("outputs as text")
 def _(d):
     return check_and_run(scenario(d, with_good(outputs="wind_speed")), "outputs")
@@ -473,6 +488,15 @@ def _(d):
 def _(d):
     path = scenario(d, "height,speed\n40,5 m/s\n60,6 m/s\n80,7 m/s\n", "table.csv")
     return [(["fit", str(path), "-o", str(d / "fit.nc")], (str(path), "speed"))]
+
+
+@case("fit of a CSV of 10^6 rows")
+def _(d):
+    rows = np.arange(1, 10**6 + 1) % 200 + 20.0
+    path = d / "table.csv"
+    np.savetxt(path, np.column_stack([rows, 8 + rows / 100]), delimiter=",", fmt="%.3f",
+               header="height,speed", comments="")
+    return [(["fit", str(path), "-o", str(d / "fit.nc")], (str(path), "1000000 rows"))]
 
 
 @case("fit of binary garbage")

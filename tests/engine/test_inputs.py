@@ -35,3 +35,32 @@ def test_values_follow_each_distribution(rng):
                                rtol=0, atol=1e-15)
     np.testing.assert_allclose(values["d"], st.expon.ppf(st.norm.cdf(scores[:, column["d"]])),
                                rtol=1e-12)
+
+
+def test_uniform_circle_is_uniform_in_angle_and_has_the_gum_moments():
+    """r z / |z| of two normal scores: angle uniform (Kolmogorov-Smirnov against U(0, 2 pi)
+    at 1e4 draws, p > 1e-3), radius exactly r, and the GUM's mean 0 and u = r / sqrt(2)."""
+    import scipy.stats as st
+    from uq.engine.inputs import UniformCircle
+    circle = UniformCircle(2.0)
+    points = circle.transform(np.random.default_rng(5).standard_normal((10_000, 2)))
+    np.testing.assert_allclose(np.hypot(points[:, 0], points[:, 1]), 2.0, rtol=1e-15)
+    angle = np.mod(np.arctan2(points[:, 1], points[:, 0]), 2 * np.pi)
+    assert st.kstest(angle, st.uniform(0, 2 * np.pi).cdf).pvalue > 1e-3
+    assert circle.mean() == 0.0 and circle.std() == pytest.approx(np.sqrt(2.0))
+    s = input_set({"c": Input(circle, (3, 2))})
+    np.testing.assert_allclose(s.standard_uncertainties(), np.sqrt(2.0))
+    np.testing.assert_array_equal(s.correlation_matrix(), np.eye(6))
+
+
+def test_an_input_with_a_correlation_between_its_elements():
+    """Input(normal, (3,), correlation=R): the draws have correlation R (3 sigma of a
+    correlation at 2e5 draws: 3 (1 - rho^2) / sqrt(N) < 0.007) and the GUM sees R."""
+    import scipy.stats as st
+    rho = np.array([[1.0, 0.8, 0.5], [0.8, 1.0, 0.8], [0.5, 0.8, 1.0]])
+    s = input_set({"e": Input(st.norm(0, 2.0), (3,), correlation=rho)})
+    np.testing.assert_allclose(s.correlation_matrix(), rho, atol=1e-15)
+    values = s.values(np.random.default_rng(1).standard_normal((200_000, 3)))["e"]
+    np.testing.assert_allclose(np.corrcoef(values.T), rho, atol=0.007)
+    with pytest.raises(ValueError, match="unit diagonal"):
+        input_set({"e": Input(st.norm(), (2,), correlation=np.array([[1, 2], [2, 1.0]]) * 0.5)})

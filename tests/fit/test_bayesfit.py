@@ -235,3 +235,27 @@ def test_least_squares_interval_of_z0_is_the_delta_method_on_ln_z0():
     # the friction velocity keeps the symmetric interval
     np.testing.assert_allclose(fit["parameter_high"][0] - fit["parameters"][0],
                                fit["parameters"][0] - fit["parameter_low"][0], rtol=1e-12)
+
+
+def test_independent_errors_need_no_dense_matrix():
+    """10^5 points with standard deviations: variances kept as a vector (a dense matrix
+    would be 80 GB), the O(n) likelihood evaluates, and equals the dense formula on a
+    small case."""
+    from uq.fit.bayesfit import as_matrix
+    n = 100_000
+    heights = np.linspace(20, 200, n)
+    data = profile_data(heights, 8 * (heights / 100) ** 0.12, np.full(n, 0.1))
+    assert data.speed_covariance.shape == (n,) and data.height_covariance.shape == (n,)
+    posterior = ProfilePosterior("power_law", data, fixed={"reference_height": 100.0},
+                                 scatter=False)
+    assert posterior.diagonal and np.isfinite(posterior.log_likelihood([8.0, 0.12]))
+    small = profile_data(heights[:5], data.speeds[:5] + 0.05, np.full(5, 0.1))
+    sparse = ProfilePosterior("power_law", small, fixed={"reference_height": 100.0},
+                              scatter=False)
+    dense = ProfilePosterior("power_law", profile_data(
+        heights[:5], small.speeds, as_matrix(small.speed_covariance)),
+        fixed={"reference_height": 100.0}, scatter=False, relative=False)
+    dense.diagonal = False                          # force the factorised path
+    theta = np.array([[8.0, 0.12], [8.1, 0.1]])
+    np.testing.assert_allclose(sparse.log_likelihood(theta), dense.log_likelihood(theta),
+                               rtol=1e-12)

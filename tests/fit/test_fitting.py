@@ -34,6 +34,7 @@ def results(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def fitted(results):
+    results.with_name("my_notes.txt").write_text("not uq's")     # beside the outputs
     assert main(["fit", str(results), "--set", "fit.ensembles=2"]) == 0
     return xr.open_dataset(results.with_name("profile_fit.nc")).load()
 
@@ -46,6 +47,7 @@ def test_fit_of_the_shipped_scenario_writes_everything(fitted, results):
         assert name in fitted
     assert results.with_name("profile_fit_profile.png").stat().st_size > 10_000
     assert results.with_name("profile_fit_corner.png").stat().st_size > 10_000
+    assert results.with_name("my_notes.txt").read_text() == "not uq's"
     assert np.all(fitted["rhat"] < 1.01)
     # the predictive band holds the credible band of the mean profile
     assert np.all(fitted.predictive_low95 <= fitted.profile_low95)

@@ -15,6 +15,9 @@ def add_parser(commands):
     report.add_argument("--target", type=float, action="append", metavar="U",
                         help="target u(wind speed) [m s-1] for the largest velocity ratio; "
                         "repeatable (default 0.05, 0.06 and 0.07)")
+    report.add_argument("--true-ti", type=float, default=6.0, metavar="PERCENT",
+                        help="true turbulence intensity [%%] for the apparent TI of results "
+                        "with motion (default 6)")
     add_select(report)
     report.set_defaults(handler=command)
     return report
@@ -31,7 +34,10 @@ def command(args):
     for target in args.target or []:
         if not target > 0:
             raise ScenarioError("--target", str(target), "allowed: a positive number [m s-1]")
+    if not 0 <= args.true_ti < 100:
+        raise ScenarioError("--true-ti", str(args.true_ti), "allowed: a percentage in [0, 100)")
     write_report(dataset, output, source=path, select=parse_select(args.select),
+                 true_ti=args.true_ti / 100,
                  **({"targets": tuple(args.target)} if args.target else {}))
     say(args, f"wrote {output}")
     return EXIT_OK

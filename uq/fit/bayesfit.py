@@ -83,12 +83,26 @@ class NotConverged(RuntimeError):
 
 @dataclass(frozen=True)
 class ProfileData:
-    """What is fitted: heights [m], speeds [m s-1] and their covariances."""
+    """What is fitted: heights [m], speeds [m s-1] and their covariances: a full matrix
+    (n, n) [m2 s-2, m2] where errors are correlated between gates, or the variances (n,)
+    of independent ones (no dense matrix: a table of 10^4 rows would need 800 MB)."""
 
     heights: np.ndarray
     speeds: np.ndarray
-    speed_covariance: np.ndarray       # (n, n) [m2 s-2]
-    height_covariance: np.ndarray      # (n, n) [m2]
+    speed_covariance: np.ndarray       # (n, n) or (n,) variances [m2 s-2]
+    height_covariance: np.ndarray      # (n, n) or (n,) variances [m2]
+
+
+def variances(covariance):
+    """The diagonal of a covariance given as a matrix or as its variances."""
+    covariance = np.asarray(covariance)
+    return covariance if covariance.ndim == 1 else np.diag(covariance)
+
+
+def as_matrix(covariance):
+    """A covariance given as a matrix or as its variances, as a matrix."""
+    covariance = np.asarray(covariance)
+    return np.diag(covariance) if covariance.ndim == 1 else covariance
 
 
 def profile_data(heights, speeds, speed_covariance=None, height_covariance=None):
@@ -99,10 +113,11 @@ def profile_data(heights, speeds, speed_covariance=None, height_covariance=None)
 
 
 def _covariance(value, n):
+    """Variances (n,) for none or standard deviations (1-D); a matrix as given."""
     if value is None:
-        return np.zeros((n, n))
+        return np.zeros(n)
     value = np.asarray(value, float)
-    return np.diag(value**2) if value.ndim == 1 else value
+    return value**2 if value.ndim == 1 else value
 
 
 class ProfilePosterior:
@@ -118,7 +133,7 @@ class ProfilePosterior:
         # profile at theta: Sigma = diag(f) R diag(f); an absolute covariance estimated
         # from data with multiplicative errors biases the fit low (Peelle's puzzle [3])
         self.relative = relative
-        self.diagonal = all(np.count_nonzero(c - np.diag(np.diag(c))) == 0
+        self.diagonal = all(np.ndim(c) == 1 or np.count_nonzero(c - np.diag(np.diag(c))) == 0
                             for c in (data.speed_covariance, data.height_covariance))
 
     def model(self, heights, *parameters):
@@ -137,11 +152,12 @@ class ProfilePosterior:
         theta = np.asarray(theta, float)
         k = len(self.names)
         slope = self._slope(theta[..., :k])
-        speed = self.data.speed_covariance
+        speed = as_matrix(self.data.speed_covariance)
         if self.relative:
             profile = self._profile(self.data.heights, theta[..., :k])
             speed = profile[..., :, None] * speed * profile[..., None, :]
-        total = speed + slope[..., :, None] * self.data.height_covariance * slope[..., None, :]
+        total = speed + slope[..., :, None] * as_matrix(self.data.height_covariance) \
+            * slope[..., None, :]
         if self.scatter:
             total = total + np.exp(2 * theta[..., k])[..., None, None] * np.eye(
                 len(self.data.heights))
@@ -184,10 +200,10 @@ class ProfilePosterior:
     def gate_variances(self, parameters):
         """Variances of the speeds at the gates without the scatter [m2 s-2]: the diagonal
         of :meth:`covariance` for profile parameters (..., k), shape (..., n)."""
-        speed = np.diag(self.data.speed_covariance)
+        speed = variances(self.data.speed_covariance)
         if self.relative:
             speed = speed * self._profile(self.data.heights, parameters) ** 2
-        return speed + self._slope(parameters) ** 2 * np.diag(self.data.height_covariance)
+        return speed + self._slope(parameters) ** 2 * variances(self.data.height_covariance)
 
     def _independent_log_likelihood(self, theta, residual):
         """The same for diagonal covariances: no factorisation, O(n) per walker."""

@@ -30,7 +30,8 @@ import pandas as pd
 import xarray as xr
 
 from uq.errors import DataFileError
-from uq.fit.bayesfit import ProfilePosterior, posterior_summary, profile_data, sample_posterior
+from uq.fit.bayesfit import (ProfilePosterior, posterior_summary, profile_data, sample_posterior,
+                             variances)
 from uq.fit.profilefit import least_squares_profile
 from uq.physics.profiles import PROFILES
 from uq.pipeline.metadata import cf_encode, history
@@ -44,6 +45,9 @@ SUMMARY_KEYS = ("low95", "low68", "median", "high68", "high95")
 
 #: Fewest profile points a fit needs [1]: two parameters and a residual.
 MIN_FIT_POINTS = 3
+#: Most profile points of a fit [1]: the likelihood is O(n) per walker and step; with
+#: 32 walkers, 4 ensembles and ~10^4 steps, 10^4 points take ~10 min on one core.
+MAX_FIT_POINTS = 10_000
 
 
 def profile_from_results(dataset, kind="propagated", source="results"):
@@ -85,6 +89,11 @@ def profile_from_table(table, columns, source="table"):
     values = {k: v[finite] for k, v in values.items()}
     if np.any(values["height"] <= 0):
         raise DataFileError(source, columns["height"], "heights must be > 0 m")
+    if len(values["height"]) > MAX_FIT_POINTS:
+        raise DataFileError(source, "", f"{len(values['height'])} rows; allowed: at most "
+                            f"{MAX_FIT_POINTS} (average the records per height first: a "
+                            "profile fit of more points costs minutes per 10^4 and adds "
+                            "nothing the means do not hold)")
     if len(values["height"]) < MIN_FIT_POINTS:
         raise DataFileError(source, "", f"{len(values['height'])} row(s) with a height and a "
                             f"speed; allowed: at least {MIN_FIT_POINTS} to fit a profile "
@@ -120,10 +129,13 @@ def fit_profile(data, config, seed=None):
                               walkers=config.walkers, ensembles=config.ensembles,
                               max_steps=config.max_steps)
     grid = np.linspace(data.heights.min(), data.heights.max(), GRID_POINTS)
-    known = np.all(np.diag(data.speed_covariance) > 0) and not config.scatter
-    # with a free scatter the least-squares reference estimates it from the residuals
+    known = np.all(variances(data.speed_covariance) > 0) and not config.scatter
+    # with a free scatter the least-squares reference estimates it from the residuals;
+    # curve_fit takes standard deviations (1-D) or a covariance matrix (2-D)
+    sigma = data.speed_covariance if np.ndim(data.speed_covariance) == 2 else \
+        np.sqrt(data.speed_covariance)
     least = least_squares_profile(config.profile, data.heights, data.speeds,
-                                  sigma=data.speed_covariance if known else None,
+                                  sigma=sigma if known else None,
                                   fixed=config.fixed, grid=grid)
     return _fit_dataset(data, posterior, chains, least, grid)
 
@@ -153,7 +165,7 @@ def _fit_dataset(data, posterior, chains, least, grid):
         ds[key] = ("point", values)
     ds["observed_height"] = ("gate", data.heights)
     ds["observed_speed"] = ("gate", data.speeds)
-    ds["observed_speed_u"] = ("gate", np.sqrt(np.diag(data.speed_covariance)))
+    ds["observed_speed_u"] = ("gate", np.sqrt(variances(data.speed_covariance)))
     ds["chain"] = (("ensemble", "step", "walker", "parameter"), chains["chain"])
     ds["tau"] = ("parameter", chains["tau"])
     ds["rhat"] = ("parameter", chains["rhat"])

@@ -35,7 +35,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 
 from uq.errors import ScenarioError  # noqa: E402
 from uq.files import check_target, output_folder, save_figure  # noqa: E402
-from uq.outputs import plots  # noqa: E402
+from uq.outputs import motionfigures, plots  # noqa: E402
 from uq.outputs.labels import model_style  # noqa: E402
 from uq.outputs.planning import VELOCITY_RATIOS, velocity_ratio_line  # noqa: E402
 from uq.outputs.planning import models as available_models  # noqa: E402
@@ -334,6 +334,12 @@ CAPTIONS = {
     "histogram": "The Monte Carlo trials against the GUM's Gaussian, with both 95 % "
     "intervals (JCGM 101, clause 8): where the dashed and solid lines part by more than "
     "delta, the GUM interval is not validated.",
+    "probe_bias_against_range": "The systematic error of the horizontal wind speed from "
+    "the probe volume (the radial velocities weighted along the beams, minus the same at "
+    "the gate centres) against the range gate, a line per probe kind. Under a power-law "
+    "shear it is about alpha (alpha - 1) Var(W) cos^2(half-cone) / (2 z^2): a pulsed "
+    "lidar's probe has a fixed length, so its bias falls with height; a CW lidar's probe "
+    "grows as the square of the focus distance, so its bias grows.",
 }
 
 
@@ -421,6 +427,8 @@ def paper_plan(dataset):
         plan += [("fig6_tilt_maps", fig6_tilt_maps)]
     if dims == {"lidar_half_cone", "wind_direction"}:
         plan += [("fig7_half_cone", fig7_half_cone)]
+    plan += motionfigures.tiana_plan(dataset, dims)
+    plan += motionfigures.comparison_plan(dataset, sweep_dimensions(dataset))
     return plan
 
 
@@ -431,6 +439,11 @@ def figure_plan(dataset, select=None):
     does). Empty only for a sweep of more dimensions than a figure shows, or a run
     without any uncertainty (:func:`no_figure_reason`)."""
     dataset = select_scenes(dataset, select)
+    return uncertainty_plan(dataset) + probe_plan(dataset)
+
+
+def uncertainty_plan(dataset):
+    """The figures of the uncertainties (:func:`figure_plan` without the probe's)."""
     plan = paper_plan(dataset)
     if plan or not plots.sweep_quantities(dataset):
         return plan
@@ -443,6 +456,14 @@ def figure_plan(dataset, select=None):
     if len(dims) == 1:
         return [("uncertainty_against_sweep", plot_against_sweep)]
     return map_plan(dataset)
+
+
+def probe_plan(dataset):
+    """A probe volume and several range gates: its systematic error against the range
+    gate (:func:`uq.outputs.plots.plot_probe_bias`)."""
+    if plots.probe_panels(dataset) is False:
+        return []
+    return [("probe_bias_against_range", plots.plot_probe_bias)]
 
 
 def single_scene_plan(dataset):

@@ -137,13 +137,15 @@ def disagreement_answer(dataset, quantity="wind_speed", reference="mc_u"):
 
 
 def bias_answer(dataset, quantity="wind_speed"):
-    """Systematic error of the correction (nominal - true) and the Monte Carlo bias.
+    """Systematic errors (the correction's, the probe volume's) and the Monte Carlo bias.
 
     Returns
     -------
     dict
         {"correction": largest |nominal - true| and where, with "zero" when it is within
-        NUMERICAL_ZERO (rounding, not a systematic error), "mc": largest |mc_bias| and
+        NUMERICAL_ZERO (rounding, not a systematic error); with a probe volume
+        (``{quantity}_probe_bias``) the probe's share is taken out of it and reported as
+        "probe" (largest |probe_bias| and where, with "zero"), "mc": largest |mc_bias| and
         where, "significant": share of the compared values (scenes x gates) where
         |mc_bias| > 3 standard errors (u / sqrt(N)) and > NUMERICAL_ZERO (a scene without
         uncertainty has a standard error of zero), "significant_count" and "compared"
@@ -154,9 +156,15 @@ def bias_answer(dataset, quantity="wind_speed"):
     difference = nominal - truth
     if quantity == "wind_direction":
         difference = (difference + FULL_CIRCLE_DEG / 2) % FULL_CIRCLE_DEG - FULL_CIRCLE_DEG / 2
-    answer = {"correction": _largest(difference)}
-    answer["correction"]["zero"] = bool(abs(answer["correction"]["value"]) <= NUMERICAL_ZERO) \
-        if np.isfinite(answer["correction"]["value"]) else False
+    systematic = {"correction": difference}
+    if f"{quantity}_probe_bias" in dataset:         # nominal - true = probe + correction
+        probe = dataset[f"{quantity}_probe_bias"]
+        systematic = {"correction": difference - probe, "probe": probe}
+    answer = {}
+    for source, values in systematic.items():
+        answer[source] = _largest(values)
+        answer[source]["zero"] = bool(abs(answer[source]["value"]) <= NUMERICAL_ZERO) \
+            if np.isfinite(answer[source]["value"]) else False
     if f"{quantity}_mc_bias" in dataset:
         bias = dataset[f"{quantity}_mc_bias"]
         error = dataset[f"{quantity}_mc_u"] / np.sqrt(dataset["mc_n_samples"])

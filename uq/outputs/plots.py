@@ -8,7 +8,10 @@ trials of a single scene, drawn again by :mod:`uq.outputs.samples`).
 * a 1-D sweep: u of each model against the swept value (:func:`plot_against_sweep`);
 * a 2-D sweep, or a 3-D one with a short third dimension: maps per model
   (:func:`plot_maps`), on one colour scale where every panel's variation shows on it,
-  else one scale per panel (:func:`shared_scale`).
+  else one scale per panel (:func:`shared_scale`);
+* a probe volume (``lidar.probe``) and several range gates: the systematic error of the
+  wind speed from the probe against the range gate, a line per probe kind and a panel per
+  value of one other swept key (:func:`plot_probe_bias`).
 
 Each takes a Dataset and returns a matplotlib Figure; :mod:`uq.outputs.figures` decides
 which a result gets.
@@ -359,3 +362,65 @@ def _name_ticks(axis, coordinate):
     if values.dtype.kind not in "iuf":
         axis.set_ticks(np.arange(values.size), [str(v).lower() if values.dtype == bool
                                                else str(v) for v in values])
+
+
+#: Colours of the probe kinds (:func:`plot_probe_bias`).
+PROBE_COLOURS = {"point": "0.5", "pulsed": "tab:blue", "cw": "tab:red"}
+#: The coordinate of a swept probe kind.
+PROBE_KIND_DIM = "lidar_probe_kind"
+
+
+def probe_panels(dataset):
+    """The sweep dimension whose values get a panel each in :func:`plot_probe_bias`
+    (None: one panel), or False when the result has no such figure (no probe bias, fewer
+    than two gates, or more than one swept key beside the probe kind)."""
+    if "wind_speed_probe_bias" not in dataset or dataset.sizes.get("range", 1) < 2 \
+            or "range" not in dataset.dims:
+        return False
+    others = [d for d in dataset["mc_n_samples"].dims if d != PROBE_KIND_DIM]
+    if len(others) > 1:
+        return False
+    return others[0] if others else None
+
+
+def plot_probe_bias(dataset):
+    """Systematic error of the horizontal wind speed from the probe volume against the
+    range gate, in m s-1 (top) and relative to the true speed (bottom): a line per probe
+    kind (when ``lidar.probe.kind`` is swept), a column per value of the other swept key."""
+    column_dim = probe_panels(dataset)
+    columns = [None] if column_dim is None else list(dataset[column_dim].values)
+    figure, axes = plt.subplots(2, len(columns), figsize=(4.2 * len(columns) + 0.6, 6.2),
+                                constrained_layout=True, squeeze=False, sharex=True,
+                                sharey="row")
+    gates = dataset["range"].values
+    if PROBE_KIND_DIM in dataset.dims:
+        kinds = list(dataset[PROBE_KIND_DIM].values)
+    else:                       # one kind: a selected value of the sweep, or the scenario's
+        kinds = [str(dataset[PROBE_KIND_DIM].values) if PROBE_KIND_DIM in dataset.coords
+                 else dataset.attrs.get("probe", "probe").split(":")[0]]
+    for j, value in enumerate(columns):
+        at = dataset if column_dim is None else dataset.sel({column_dim: value})
+        for kind in kinds:
+            one = at.sel({PROBE_KIND_DIM: kind}) if PROBE_KIND_DIM in at.dims else at
+            bias = one["wind_speed_probe_bias"].values
+            relative = 100 * bias / one["wind_speed_true"].values
+            style = {"color": PROBE_COLOURS.get(kind, "k"), "marker": ".", "label": kind}
+            axes[0, j].plot(gates, bias, **style)
+            axes[1, j].plot(gates, relative, **style)
+        if column_dim is not None:
+            axes[0, j].set_title(f"{coordinate_label(dataset, column_dim)} = "
+                                 f"{_format(value)}", fontsize=9)
+        axes[1, j].set_xlabel(coordinate_label(dataset, "range"))
+        for ax in axes[:, j]:
+            ax.axhline(0.0, color="k", linewidth=0.6)
+            ax.grid(alpha=0.3)
+    axes[0, 0].set_ylabel("probe bias of " + QUANTITIES["wind_speed"][0] + " [m s$^{-1}$]")
+    axes[1, 0].set_ylabel("probe bias / true " + QUANTITIES["wind_speed"][0] + " [%]")
+    axes[0, 0].legend(fontsize=8, title="lidar.probe.kind", title_fontsize=8)
+    figure.suptitle("Systematic error of the wind speed from the probe volume "
+                    "(range weighting along the beams)", fontsize=10)
+    return figure
+
+
+def _format(value):
+    return f"{value:g}" if isinstance(value, (int, float, np.number)) else str(value)

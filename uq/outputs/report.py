@@ -28,6 +28,10 @@ QUANTITY_UNITS = {"wind_speed": "m/s", "wind_direction": "deg", "vertical_wind":
 _ZERO = f"{NUMERICAL_ZERO:.0e}".replace("e-0", "e-")
 #: Units as the report's text writes them.
 HTML_UNITS = {"degree": "deg", "m s-1": "m/s", "1": ""}
+#: True turbulence intensity [1] for which the report states the apparent one: 6 %, a
+#: typical offshore value at hub height in moderate wind (IEC 61400-1 class C at 15 m/s
+#: is ~14 %; measured North Sea means are 5-8 %).
+DEFAULT_TRUE_TI = 0.06
 STYLE = """body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;color:#222}
 table{border-collapse:collapse;margin:.6em 0}td,th{border:1px solid #bbb;padding:3px 8px;
 font-size:90%;text-align:left}th{background:#eee}pre{background:#f6f6f6;padding:.8em;
@@ -36,20 +40,26 @@ figure{margin:1em 0}figcaption{font-size:90%;color:#444;max-width:900px}
 summary{cursor:pointer;font-weight:bold}"""
 
 
-def write_report(dataset, path, source="", targets=planning.DEFAULT_TARGETS, select=None):
+def write_report(dataset, path, source="", targets=planning.DEFAULT_TARGETS, select=None,
+                 true_ti=DEFAULT_TRUE_TI):
     """Write the report of `dataset` to `path` (HTML); returns the path."""
-    page = render_report(dataset, source=source, targets=targets, select=select)
+    page = render_report(dataset, source=source, targets=targets, select=select,
+                         true_ti=true_ti)
     return write_text(path, page)
 
 
-def render_report(dataset, source="", targets=planning.DEFAULT_TARGETS, select=None):
+def render_report(dataset, source="", targets=planning.DEFAULT_TARGETS, select=None,
+                  true_ti=DEFAULT_TRUE_TI):
     """The report as one HTML string. `select` (``{dim: value}``) picks the scenes the
-    figures show (:func:`uq.outputs.figures.select_scenes`); the tables cover them all."""
+    figures show (:func:`uq.outputs.figures.select_scenes`); the tables cover them all.
+    `true_ti` [1]: the true turbulence intensity for which the apparent one is stated
+    (results with motion)."""
     name = dataset.attrs.get("title", "uq results")
     parts = [f"<!DOCTYPE html><!-- {SIGNATURE} --><html><head><meta charset='utf-8'>"
              f"<title>{_e(name)}</title>"
              f"<style>{STYLE}</style></head><body><h1>{_e(name)}</h1>",
-             _run_table(dataset, source), _answers(dataset, targets), _findings(dataset),
+             _run_table(dataset, source), _answers(dataset, targets),
+             _apparent_ti(dataset, true_ti), _findings(dataset),
              _summary_tables(dataset), _figures(select_scenes(dataset, select)),
              _scenario(dataset),
              "</body></html>"]
@@ -123,6 +133,41 @@ def _answers(dataset, targets):
     return "\n".join(out)
 
 
+def apparent_ti(true_ti, motion_ti):
+    """Turbulence intensity a lidar in motion reports [1]: the motion's scatter of Vh adds
+    in quadrature to the wind's own (independent: the wave phases are not the
+    turbulence), sqrt(TI^2 + TI_motion^2)."""
+    return np.sqrt(true_ti**2 + np.asarray(motion_ti) ** 2)
+
+
+def _apparent_ti(dataset, true_ti):
+    """The apparent TI per scene for a stated true TI (results with motion)."""
+    if "wind_speed_motion_ti" not in dataset:
+        return ""
+    motion = dataset["wind_speed_motion_ti"]
+    rows = []
+    if "correction" in motion.dims:
+        for correction in motion["correction"].values:
+            m = motion.sel(correction=correction)
+            rows.append((str(correction), _percent_range(m), _percent_range(apparent_ti(
+                true_ti, m.values))))
+    else:
+        rows.append(("as run", _percent_range(motion), _percent_range(apparent_ti(
+            true_ti, motion.values))))
+    return "\n".join([
+        "<h3>Apparent turbulence intensity</h3>",
+        f"<p>A true turbulence intensity of {100 * true_ti:g} % reads as sqrt(TI^2 + "
+        "TI_motion^2): the motion-induced increment (u of Vh from the motion alone, over Vh) "
+        "adds in quadrature (<code>--true-ti</code> sets the true TI).</p>",
+        _table(("model", "motion-induced TI increment", "apparent TI"), rows)])
+
+
+def _percent_range(values):
+    values = np.asarray(values, dtype=float).reshape(-1)
+    low, high = 100 * np.nanmin(values), 100 * np.nanmax(values)
+    return f"{low:.2f} %" if np.isclose(low, high) else f"{low:.2f} to {high:.2f} %"
+
+
 def _no_uncertainty(quantity):
     unit = QUANTITY_UNITS[quantity]
     return (f"<h3>{quantity.replace('_', ' ').capitalize()}</h3><p>No uncertainty in these "
@@ -168,13 +213,15 @@ def _bias(dataset, quantity):
     answer = planning.bias_answer(dataset, quantity)
     unit = QUANTITY_UNITS[quantity]
     correction = answer["correction"]
+    probe = answer.get("probe")
     text = f"<h4>Bias: {quantity.replace('_', ' ')}</h4><p>Systematic error of the correction " \
-        "(reconstruction with zero errors minus truth): "
-    if correction["zero"]:
-        text += (f"none (at most {abs(correction['value']):.1g} {unit}, within the "
-                 f"{_ZERO} {unit} of rounding).")
-    else:
-        text += f"largest {correction['value']:+.3g} {unit} at {_e(_where(correction, dataset))}."
+        "(reconstruction with zero errors minus truth" + (
+            ", less the probe volume's" if probe else "") + "): "
+    text += _systematic(correction, unit, dataset)
+    if probe:
+        text += (" Systematic error of the probe volume (the radial velocities weighted "
+                 "along the beams minus the same at the gate centres): "
+                 + _systematic(probe, unit, dataset))
     if "mc" in answer:
         variable = f"{quantity}_mc_bias"
         if answer["mc_significant"] is None:
@@ -188,6 +235,14 @@ def _bias(dataset, quantity):
                      f"{_share(answer['significant_count'], answer['compared'], dataset, variable)}"
                      f"; largest {largest['value']:+.3g} {unit} at {_e(_where(largest, dataset))}.")
     return text + "</p>"
+
+
+def _systematic(item, unit, dataset):
+    """``none (...)`` or ``largest +x unit at ...`` of a systematic error."""
+    if item["zero"]:
+        return (f"none (at most {abs(item['value']):.1g} {unit}, within the {_ZERO} {unit} "
+                "of rounding).")
+    return f"largest {item['value']:+.3g} {unit} at {_e(_where(item, dataset))}."
 
 
 def _where(item, dataset=None):

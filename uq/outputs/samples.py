@@ -42,11 +42,20 @@ def scene_trials(dataset, outputs, n_max=HISTOGRAM_TRIALS):
     dict
         output -> real array of shape (n, n_gates) (radial velocity (n, beams, gates)).
     """
-    scenario = load_scenario(yaml.safe_load(dataset.attrs["scenario"]))
+    return trials_with(dataset, {}, outputs, n_max)
+
+
+def trials_with(dataset, assignments, outputs, n_max=HISTOGRAM_TRIALS):
+    """The first min(n, n_max) trials of one scene of a result: its scenario with the
+    swept keys set to `assignments` (``{dotted key: value}``) and no sweep; the run's
+    seed and sampler (every scene of a sweep draws the same numbers)."""
+    raw = yaml.safe_load(dataset.attrs["scenario"])
+    raw.pop("sweep", None)
+    scenario = load_scenario(raw, assignments)
     settings = scenario.settings
     scene = scene_from_settings(settings)
     inputs = input_set(error_inputs(settings, scene.n_beams, len(scene.ranges)))
-    n = min(int(dataset["mc_n_samples"]), n_max)
+    n = min(int(np.max(dataset["mc_n_samples"])), n_max)
     scores = np.empty((n, inputs.dimension))
     for block, start in enumerate(range(0, n, RNG_BLOCK_SIZE)):
         rows = min(RNG_BLOCK_SIZE, n - start)

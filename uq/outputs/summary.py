@@ -1,38 +1,77 @@
 """Compact text summary of a results Dataset (printed by ``uq run``)."""
 import numpy as np
 
+from uq.constants import NUMERICAL_ZERO
 from uq.pipeline.metadata import QUANTITIES
 
 _COLUMNS = ("true", "nominal", "mc_mean", "mc_u", "gum_u", "paper_u")
 _VALUES = ("true", "nominal", "mc_mean")
+#: Space between columns [characters].
+_GAP = 3
 
 
 def summary_table(dataset):
     """A few lines: per output (and gate), each column's value or min..max over the sweep.
 
-    The last column counts the scenes whose GUM interval is validated (JCGM 101 clause 8)
-    and, in brackets, those where Monte Carlo was precise enough for the verdict to be
-    conclusive (its numerical error within the tolerance).
+    Columns with no value anywhere (the paper's model outside its domain, Monte Carlo
+    when it did not run) are left out; widths follow the content, so cells never run
+    together. The last column counts the scenes whose GUM interval Monte Carlo validates
+    (JCGM 101 clause 8) out of all scenes, and in brackets those where Monte Carlo was
+    precise enough for that verdict to be conclusive; a footnote says so.
     """
-    lines = [f"{dataset.attrs.get('title', '')}  (n = {dataset.attrs.get('n_samples')}, "
-             f"seed = {dataset.attrs.get('seed')}, {dataset.attrs.get('runtime_s', 0):.1f} s)"]
-    header = f"{'output':<22}" + "".join(f"{c:>16}" for c in _COLUMNS) + f"{'GUM valid':>14}"
-    lines.append(header)
+    title = (f"{dataset.attrs.get('title', '')}  (n = {dataset.attrs.get('n_samples')}, "
+             f"seed = {dataset.attrs.get('seed')}, {dataset.attrs.get('runtime_s', 0):.1f} s)")
+    rows, shown = [], []
     for q in QUANTITIES:
-        if f"{q}_mc_u" not in dataset or q == "radial_velocity":
+        if f"{q}_gum_u" not in dataset or q == "radial_velocity":
             continue
-        gates = dataset["range"].values.reshape(-1) if "range" in dataset[f"{q}_mc_u"].dims else [None]
+        shown.append(q)
+        gates = dataset["range"].values.reshape(-1) if "range" in dataset[f"{q}_gum_u"].dims \
+            else [None]
         for gate in gates:
             select = {} if gate is None else {"range": gate}
             label = q if gate is None else f"{q} @{gate:g} m"
-            cells = [_cell(dataset[f"{q}_{c}"].sel(select).values, c) for c in _COLUMNS]
-            valid = dataset[f"{q}_gum_valid"].sel(select).values
-            conclusive = dataset[f"{q}_gum_validation_conclusive"].sel(select).values
-            verdict = f"{int(np.sum(valid))}/{np.size(valid)} ({int(np.sum(conclusive))})"
-            lines.append(f"{label:<22}" + "".join(f"{c:>16}" for c in cells) + f"{verdict:>14}")
-    units = ", ".join(f"{q} [{attrs['units']}]" for q, attrs in QUANTITIES.items())
+            cells = {c: _cell(dataset[f"{q}_{c}"].sel(select).values, c) if f"{q}_{c}"
+                     in dataset else "nan" for c in _COLUMNS}
+            cells["GUM valid"] = _verdict(dataset, q, select)
+            rows.append((label, cells))
+    columns = [c for c in _COLUMNS if any(cells[c] != "nan" for _, cells in rows)]
+    columns.append("GUM valid")
+    lines = [title] + _table(rows, columns)
+    lines += _motion_line(dataset)
+    units = ", ".join(f"{q} [{QUANTITIES[q]['units']}]" for q in shown)
     lines.append(f"units: {units}")
+    lines.append("GUM valid: scenes whose GUM interval Monte Carlo validates (JCGM 101 "
+                 "clause 8) / scenes; (n): of those verdicts, n were conclusive")
     return "\n".join(lines)
+
+
+def _table(rows, columns):
+    width = {"output": max([len("output")] + [len(label) for label, _ in rows])}
+    for c in columns:
+        width[c] = max([len(c)] + [len(cells[c]) for _, cells in rows])
+    gap = " " * _GAP
+    header = "output".ljust(width["output"]) + "".join(gap + c.rjust(width[c]) for c in columns)
+    lines = [header]
+    for label, cells in rows:
+        lines.append(label.ljust(width["output"])
+                     + "".join(gap + cells[c].rjust(width[c]) for c in columns))
+    return lines
+
+
+def _verdict(dataset, q, select):
+    if f"{q}_gum_valid" not in dataset:
+        return "nan"
+    valid = dataset[f"{q}_gum_valid"].sel(select).values
+    conclusive = dataset[f"{q}_gum_validation_conclusive"].sel(select).values
+    return f"{int(np.sum(valid))}/{np.size(valid)} ({int(np.sum(conclusive))})"
+
+
+def _motion_line(dataset):
+    if "wind_speed_motion_ti" not in dataset:
+        return []
+    ti = _cell(100 * dataset["wind_speed_motion_ti"].values, "mc_u")
+    return [f"motion-induced turbulence-intensity increment [%]: {ti}"]
 
 
 def _cell(values, column):
@@ -40,6 +79,11 @@ def _cell(values, column):
     if np.all(np.isnan(values)):
         return "nan"
     low, high = np.nanmin(values), np.nanmax(values)
-    if np.isclose(low, high, rtol=1e-6, atol=1e-12):
-        return f"{low:.4g}"
-    return "swept" if column in _VALUES else f"{low:.3g}..{high:.3g}"
+    if np.isclose(low, high, rtol=1e-6, atol=NUMERICAL_ZERO):
+        return _number(low)
+    return "swept" if column in _VALUES else f"{_number(low)}..{_number(high)}"
+
+
+def _number(value):
+    """Four significant digits; rounding noise (below NUMERICAL_ZERO) is 0."""
+    return "0" if abs(value) < NUMERICAL_ZERO else f"{value:.4g}"

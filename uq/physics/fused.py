@@ -211,7 +211,8 @@ def _prepared(scene, outputs, errors, scene_draws):
     takes, else None. The errors as 3-D arrays (trials, scenes, k) for the kernels, any
     axis of length 1 broadcasting: INS (k = 1 or beams), geometry (k = 1), noise
     (k = beams x gates); complex128 if any error is complex, else float64."""
-    if scene.time_resolved is not None or not set(outputs) <= _OUTPUT_SET or \
+    if scene.time_resolved is not None or scene.probe is not None or \
+            not set(outputs) <= _OUTPUT_SET or \
             not set(errors) <= _ERROR_SET:
         return None
     shape = scene.shape

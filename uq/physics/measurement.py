@@ -15,6 +15,10 @@ input                        shape            meaning
 ``lidar_radial_velocity``    (n, beams, gates) radial-velocity noise [m s-1]
 ``lidar_height``             (n,)             true minus configured height of the lidar
                                               above sea level [m] (draft, ballast, tide)
+``lidar_gate_length``,       (n,)             true minus configured parameters of the
+``lidar_pulse_fwhm``                          probe volume (:mod:`uq.physics.probe`):
+``lidar_wavelength``,                         [m], [m], [um], [mm]
+``lidar_beam_radius``
 ===========================  ===============  ========================================
 
 k = 1 when INS errors are shared by the beams of a scan (``scan``) and k = n_beams when
@@ -42,6 +46,10 @@ scene sees the same error draws (common random numbers). Quantities that do not 
 on the errors (nominal beam vectors, least-squares operator, slant distances) are
 computed once per scene, not per sample.
 
+With a probe volume (``scene.probe``, :mod:`uq.physics.probe`) the horizontal wind
+speed in each true radial velocity is its weighted mean along the true beam (a
+quadrature; a probe never runs the compiled model).
+
 The output ``gate_height`` is the mean true height of the slanted beams at each range
 gate [m]: the height the reconstructed horizontal wind belongs to, which a tilted lidar
 or a half-cone error moves away from the nominal ``lidar_height + range``.
@@ -50,6 +58,7 @@ import numpy as np
 
 from uq import complexstep
 
+from uq.physics import probe as probe_volume
 from uq.physics import wind
 from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
 from uq.physics.correction import correction_rotation, correction_ship_velocity, reconstruct_wind
@@ -91,7 +100,8 @@ def beam_heights(scene, beams_earth, height_error=0.0):
     return lidar + slant * beams_earth[..., 2:3]
 
 
-def true_radial_velocity(scene, beams_earth, ship_velocity, height_error=0.0):
+def true_radial_velocity(scene, beams_earth, ship_velocity, height_error=0.0, probe=None,
+                         probe_errors=None):
     """Radial velocities of the true wind seen from the moving lidar [m s-1].
 
     Parameters
@@ -103,18 +113,30 @@ def true_radial_velocity(scene, beams_earth, ship_velocity, height_error=0.0):
         True ship velocity (north, east, up) [m s-1].
     height_error : float or ndarray
         True minus configured lidar height [m] (:func:`beam_heights`).
+    probe : uq.physics.probe.PulsedProbe or ContinuousWaveProbe, optional
+        Range weighting along the beams (with its node count); None: at the gate centre.
+    probe_errors : dict, optional
+        Errors of the probe's parameters (scenario units), each (n, *S, 1, 1) or scalar.
 
     Returns
     -------
     radial : ndarray, shape (..., n_beams, n_gates)
-        ``n . (u_wind(z) - u_ship)`` (Eq. 2 of Rubio & Gottschall 2022, point-wise).
+        ``n . (u_wind(z) - u_ship)`` (Eq. 2 of Rubio & Gottschall 2022, point-wise; with
+        a probe the horizontal speed is its weighted mean along the true beam,
+        :mod:`uq.physics.probe`).
     wind_only : ndarray, shape (..., n_beams, n_gates)
         ``n . u_wind(z)``, the motion-free radial wind.
     """
     heights = beam_heights(scene, beams_earth, height_error)            # (..., *S, b, g)
     field = lambda name, trailing: scene.field(name, trailing)          # noqa: E731
-    speed = wind.power_law_speed(field("wind_speed", 2), heights,
-                                 field("reference_height", 2), field("shear", 2))
+    profile = lambda z: wind.power_law_speed(field("wind_speed", 2), z,     # noqa: E731
+                                             field("reference_height", 2), field("shear", 2))
+    if probe is None:
+        speed = profile(heights)
+    else:                     # the weighted speed at the probe's points on the true beams
+        slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
+                                scene.vertical_beam)                    # focus, ([*S], b, g)
+        speed = probe.average(profile, heights, beams_earth[..., 2:3], slant, probe_errors)
     # n . u(z) = U(z) (n_h . e_wind) + n_up w: the direction of the horizontal wind is the
     # same at every height, so only its speed is evaluated per beam and gate (no stacked
     # (..., b, g, 3) wind vectors)
@@ -143,6 +165,8 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
         shape (n, *S, n_gates); ``radial_velocity`` [m s-1] (n, *S, n_beams, n_gates), the
         motion-corrected radial velocity along the beam the correction believes in.
     """
+    if scene.probe is not None:     # a probe volume: its quadrature; the numpy model only
+        scene = probe_volume.resolve(scene)
     if scene.time_resolved is not None:       # motion within the scan: its own model
         from uq.physics import timeresolved
         return timeresolved.measurement_model(scene, outputs, scene_draws, **errors)
@@ -186,8 +210,11 @@ def _full_shape(result, leading, n_beams):
                                + v.shape[-1:]) for q, v in result.items()}
 
 
+#: Errors of the probe's parameters (model inputs ``lidar_<parameter>``, scenario units).
+PROBE_ERRORS = tuple(probe_volume.PARAMETER_SCALE)
 _ERROR_NAMES = tuple(f"ins_{key}" for key in NAVIGATION) + (
-    "lidar_half_cone", "lidar_misalignment", "lidar_radial_velocity", "lidar_height")
+    "lidar_half_cone", "lidar_misalignment", "lidar_radial_velocity", "lidar_height") + \
+    tuple(f"lidar_{key}" for key in PROBE_ERRORS)
 
 
 def _measure(scene, err, batch):
@@ -202,8 +229,9 @@ def _measure(scene, err, batch):
                                    scene.vertical_beam)                    # ([n], *S, b, 3)
     attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)    # (*S, 3, 3)
     beams_earth = rotate_vectors(attitude, true_beams)
+    probe_errors = {key: _trailing(err[f"lidar_{key}"], 2) for key in PROBE_ERRORS}
     radial, _ = true_radial_velocity(scene, beams_earth, _ship_velocity(scene),
-                                     err["lidar_height"])
+                                     err["lidar_height"], scene.probe, probe_errors)
     measured = radial + err["lidar_radial_velocity"]
     navigation = {}
     for key in NAVIGATION:
@@ -211,6 +239,12 @@ def _measure(scene, err, batch):
         error = complexstep.radians(error) if key in ANGULAR_NAVIGATION else error
         navigation[key] = scene.field(key, 1) + error                     # (n, *S, k)
     return measured, navigation, beams_earth
+
+
+def _trailing(value, count):
+    """`value` with `count` axes of length one appended (a scalar stays a scalar)."""
+    value = np.asarray(value)
+    return value if value.ndim == 0 else value.reshape(value.shape + (1,) * count)
 
 
 def _gate_height(scene, beams_earth, height_error):

@@ -73,10 +73,15 @@ class Motion:
     components : tuple of MotionComponent
     lever_arm : tuple of float
         (bow, starboard, up) [m] from the INS to the lidar.
+    window : int
+        How many of the last random-phase components are a measured record's harmonics,
+        whose phases move together with the record's random start (input
+        ``motion_window``); the others' phases are independent (``motion_phases``).
     """
 
     components: tuple = ()
     lever_arm: tuple = (0.0, 0.0, 0.0)
+    window: int = 0
 
     @property
     def random_components(self):

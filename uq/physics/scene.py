@@ -58,6 +58,9 @@ class Scene:
     time_resolved : TimeResolved or None
         Motion during the scan, scan timing and the INS as a sampled series; None is the
         static model (every beam at the same instant and attitude).
+    probe : uq.physics.probe.PulsedProbe, ContinuousWaveProbe or None
+        The range weighting of the radial velocities along each beam; None is the
+        point-wise measurement at the gate centre.
     """
 
     wind_speed: float
@@ -79,6 +82,7 @@ class Scene:
     vertical_beam: bool
     correction: str
     time_resolved: object = None
+    probe: object = None
 
     @property
     def shape(self):

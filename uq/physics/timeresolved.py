@@ -11,10 +11,13 @@ untouched. Per trial:
    :func:`uq.physics.motion.platform_kinematics` (static ship + harmonic motion + lever
    arm). The true radial velocity at gate g is ``b(t) . (u(z) - v_lidar(t))`` with the
    true beam ``b(t) = R(t) b_ship`` and the true height z of the gate point (power-law
-   shear); with ``dwell_average`` its mean over the dwell. Radial noise is added.
+   shear; with a probe volume, :mod:`uq.physics.probe`, the horizontal speed weighted
+   along ``b(t)`` at its points' heights); with ``dwell_average`` its mean over the
+   dwell. Radial noise is added.
 2. The INS reports the attitude (with its rates) and the velocity of its own point. It is
    read at ``t + delta`` (clock offset delta): at each beam's time stamp for ``pointwise``,
-   at the scan's mid time for the other models; from its samples by ``nearest`` or
+   at the scan's mid time for the other models (whose one reading takes the
+   error of the first beam's: its marginal is the error's distribution); from its samples by ``nearest`` or
    ``linear`` interpolation (:mod:`uq.physics.ins`), or exactly (continuous INS). The
    reading's errors are added: heading, pitch, roll to its Euler angles; ``cog`` turns
    the horizontal velocity, ``sog`` adds along the static course, ``heave`` to the
@@ -46,12 +49,16 @@ from uq.physics.correction import (correction_rotation, pointwise_wind, removed_
                                    scan_wind)
 from uq.physics.ins import bracket
 from uq.physics.motion import platform_kinematics
+from uq.physics.probe import PARAMETER_SCALE
 from uq.physics.rotation import (attitude_from_matrix_analytic, attitude_matrix,
                                  attitude_matrix_rate, interpolate_rotation,
                                  rotation_about_vertical)
 from uq.physics.scene import ANGULAR_NAVIGATION, NAVIGATION, sample_count
 
-TIME_RESOLVED_INPUTS = ("motion_phases", "ins_clock_offset", "ins_sample_offset")
+TIME_RESOLVED_INPUTS = ("motion_phases", "motion_window", "ins_clock_offset",
+                        "ins_sample_offset")
+#: Probe parameters with errors (inputs ``lidar_<parameter>``, :mod:`uq.physics.probe`).
+PROBE_ERRORS = tuple(PARAMETER_SCALE)
 
 
 def measurement_model(scene, outputs, scene_draws=False, **errors):
@@ -87,7 +94,12 @@ def single_scene(scene, outputs, **errors):
     resolved = scene.time_resolved
     n = sample_count(errors)
     err = {name: np.asarray(errors.get(name, 0.0)) for name in set(errors) | set(_ALL_INPUTS)}
-    phases = resolved.motion.unit_phases(_phases(err["motion_phases"], resolved, n))
+    # the motion and the INS timing vary over n_time trials (1 when none of their inputs
+    # is random): the platform's kinematics are evaluated that many times, not n
+    n_time = max([1] + [np.shape(err[k])[0] for k in TIME_RESOLVED_INPUTS if np.ndim(err[k])])
+    phases = resolved.motion.unit_phases(_phases(err["motion_phases"], err["motion_window"],
+                                                 resolved, n_time))
+    phases = np.broadcast_to(phases, (n_time,) + phases.shape[1:])
     measured, heights = _measure(scene, resolved, phases, err, n)
     navigation = _navigation(scene, resolved, phases, err, n)
     unit_vectors = scene.nominal_unit_vectors()                        # configured, (b, 3)
@@ -113,13 +125,20 @@ _ALL_INPUTS = tuple(f"ins_{key}" for key in NAVIGATION) + (
     TIME_RESOLVED_INPUTS
 
 
-def _phases(value, resolved, n):
-    """The random components' unit phases, (n, K_random, 2); zeros (their mean) when the
-    input is not given (the error-free reconstruction)."""
+def _phases(phases, window, resolved, n):
+    """The random components' unit phases, (n, K_random, 2): those of random phases (a
+    sea, harmonics), then those of a record's window (:attr:`Motion.window`); zeros
+    (their mean) for an input not given (the error-free reconstruction)."""
     k = len(resolved.motion.random_components)
-    if value.ndim == 0:
-        return np.zeros((n, k, 2)) if k else None
-    return value
+    if not k:
+        return None
+    k_window = resolved.motion.window
+
+    def part(value, size):
+        if np.ndim(value):
+            return np.broadcast_to(value, (n, size, 2))
+        return np.zeros((n, size, 2))
+    return np.concatenate([part(phases, k - k_window), part(window, k_window)], axis=-2)
 
 
 def _measure(scene, resolved, phases, err, n):
@@ -141,7 +160,8 @@ def _measure(scene, resolved, phases, err, n):
         + kin["lidar_offset"][..., 2]                                   # (n, b, q)
     heights = lidar_z[..., None] + slant[:, None, :] * beams[..., 2:3]  # (n, b, q, g)
     speed = wind.power_law_speed(scene.wind_speed, heights, scene.reference_height,
-                                 scene.shear)
+                                 scene.shear) if scene.probe is None else \
+        _probe_speed(scene, heights, beams[..., 2:3], slant[:, None, :], err)
     to_north, to_east = wind.wind_components(1.0, complexstep.degrees(scene.wind_direction))
     along_wind = beams[..., 0] * to_north + beams[..., 1] * to_east     # (n, b, q)
     own = np.sum(beams * kin["lidar_velocity"], axis=-1)                # (n, b, q)
@@ -152,6 +172,19 @@ def _measure(scene, resolved, phases, err, n):
     return mean_radial + err["lidar_radial_velocity"], mean_height
 
 
+def _probe_speed(scene, heights, vertical, focus, err):
+    """The probe-weighted horizontal speed at the probe's points on the true beams at
+    their own times (:mod:`uq.physics.probe`); heights (n, b, q, g), vertical (n, b, q, 1),
+    focus (b, 1, g); a probe parameter's error (n,) is one per scan."""
+    errors = {}
+    for key in PROBE_ERRORS:
+        value = np.asarray(err.get(f"lidar_{key}", 0.0))
+        errors[key] = value.reshape(-1, 1, 1, 1) if value.ndim else value
+    return scene.probe.average(lambda z: wind.power_law_speed(
+        scene.wind_speed, z, scene.reference_height, scene.shear), heights, vertical, focus,
+        errors)
+
+
 def _navigation(scene, resolved, phases, err, n):
     """INS readings, each (n, k): ``heading``, ``pitch``, ``roll`` [rad] with their
     ``*_rate`` [rad s-1] and ``velocity`` (n, k, 3) [m s-1]; k = n_beams (read at the
@@ -160,8 +193,10 @@ def _navigation(scene, resolved, phases, err, n):
     n_beams = scene.n_beams
     stamps = timing.stamps(n_beams) if scene.correction == "pointwise" else \
         np.array([timing.scan_mid_time(n_beams)])
+    n_time = np.shape(phases)[0]
     read = stamps[None, :] + np.reshape(err["ins_clock_offset"], (-1, 1))    # (n', k)
-    state = _ins_state(scene, resolved, phases, read, err["ins_sample_offset"], ins)
+    read = np.broadcast_to(read, (n_time, read.shape[1]))
+    state = ins_state(scene, resolved, phases, read, err["ins_sample_offset"], ins)
     k = np.shape(state["heading"])[-1]
     reading = {}
     for key in ("heading", "pitch", "roll"):
@@ -173,8 +208,11 @@ def _navigation(scene, resolved, phases, err, n):
     return reading
 
 
-def _ins_state(scene, resolved, phases, read, sample_offset, ins):
-    """The INS's true state at the read times (interpolated from its samples)."""
+def ins_state(scene, resolved, phases, read, sample_offset, ins):
+    """The INS's true (error-free) state read at `read` (n, k) [s]: interpolated from its
+    samples at ``sample_offset + j / rate``, or exact for a continuous INS. Keys
+    ``heading``, ``pitch``, ``roll`` [rad], their ``*_rate`` [rad s-1], ``velocity``
+    (n, k, 3) [m s-1] of the INS point."""
     if ins.rate is None:
         kin = platform_kinematics(scene, resolved.motion, phases, read)
         return _state(kin)

@@ -43,6 +43,9 @@ STATISTICS = {
     "gum_value": ("GUM estimate: model at the input means", None),
     "mc_mean": ("Monte Carlo mean", None),
     "mc_bias": ("Monte Carlo mean minus true value", None),
+    "probe_bias": ("systematic error of the probe volume: reconstruction with every error "
+                   "zero, range-weighted along the beams, minus the same at the gate centres "
+                   "(a part of nominal minus true)", None),
     "mc_u": ("Monte Carlo standard uncertainty", "standard_error"),
     "mc_low": ("lower end of the 95 % coverage interval (Monte Carlo)", None),
     "mc_high": ("upper end of the 95 % coverage interval (Monte Carlo)", None),
@@ -105,11 +108,13 @@ COORDINATES = {
 FLAG_MEANINGS = {"gum_valid": "not_validated validated",
                  "gum_validation_conclusive": "inconclusive conclusive"}
 #: Units of the scenario's own unit names (docs/scenario.md) in UDUNITS, as CF wants.
-SCENARIO_UNITS = {"deg": "degree", "m s-1": "m s-1", "m": "m", "1": "1"}
+SCENARIO_UNITS = {"deg": "degree", "m s-1": "m s-1", "m": "m", "1": "1", "um": "um",
+                  "mm": "mm"}
 #: Units of an error's size (``ins.<quantity>.<parameter>``), by quantity.
 ERROR_UNITS = {"heading": "degree", "pitch": "degree", "roll": "degree", "cog": "degree",
                "sog": "m s-1", "heave": "m s-1", "half_cone": "degree",
-               "misalignment": "degree", "radial_velocity": "m s-1", "height": "m"}
+               "misalignment": "degree", "radial_velocity": "m s-1", "height": "m",
+               "gate_length": "m", "pulse_fwhm": "m", "wavelength": "um", "beam_radius": "mm"}
 #: Parameters of an error distribution that are numbers without unit.
 DIMENSIONLESS_PARAMETERS = ("dof",)
 #: Statistics linked to their quantity's Monte Carlo mean and GUM value

@@ -11,6 +11,16 @@ validated settings unless given).
       roll:  {amplitude: 5.0, period: 5.0, phase: random}   # deg, s, deg or random
       pitch: {amplitude: 3.0, period: 6.0, phase: 90}
       heave: {amplitude: 1.0, period: 8.0}                  # surge, sway, heave in m
+      spectrum: {kind: jonswap, hs: 2.0, tp: 8.0, gamma: 3.3, components: 32,
+                 band: [0.0625, 0.5]}                       # m, s, 1, 1, Hz
+      response:                  # per metre of wave amplitude: deg/m or m/m; lag in deg
+        roll: {factor: 2.0, lag: 90}
+        heave: {factor: 1.0}
+      series:                    # a measured record; each trial reads a random window
+        file: buoy.csv           # CSV, relative to the scenario file
+        time: time               # column [s], equally spaced
+        columns: {roll: roll_deg, pitch: pitch_deg, heave: heave_m}   # dof -> column
+        components: 128          # Fourier harmonics kept
     lidar:
       lever_arm: [0.0, 0.0, 2.0]   # m, (bow, starboard, up) from the INS to the lidar
       scan: {beam_duration: 1.0, timestamp: mid, dwell_average: false}
@@ -21,16 +31,35 @@ validated settings unless given).
       sog: {dist: normal, u: 0.1, correlation_time: 2.0}    # s, Gauss-Markov
     correction: pointwise
 """
+import functools
+import io
 import math
+from pathlib import Path
 
 import numpy as np
 
 from uq.physics.ins import INTERPOLATIONS, InsSampling
 from uq.physics.motion import DEGREES_OF_FREEDOM, Motion, MotionComponent
 from uq.physics.scene import TimeResolved
+from uq.errors import ScenarioError
+from uq.physics.series import WindowStart, series_components
 from uq.physics.timing import TIMESTAMPS, ScanTiming
+from uq.physics.waves import jonswap_components
+from uq.constants import MAX_SERIES_BYTES, MAX_WAVE_COMPONENTS
 
 HARMONIC_KEYS = ("amplitude", "period", "phase")
+SPECTRUM_KEYS = ("kind", "hs", "tp", "gamma", "components", "band")
+SPECTRUM_KINDS = ("jonswap",)
+RESPONSE_KEYS = ("factor", "lag")
+SERIES_KEYS = ("file", "time", "columns", "components")
+#: Fewest samples of a motion record [1]: a Fourier series of fewer says little.
+MIN_SERIES_SAMPLES = 16
+#: Largest relative spread of a record's sampling intervals [1]: the Fourier series
+#: assumes equal spacing; clock jitter of 1 % of the interval is tolerated.
+SERIES_SPACING_TOLERANCE = 0.01
+#: Default band of a spectrum, in multiples of its peak frequency 1/tp [1]: the JONSWAP
+#: (gamma 3.3) energy outside [0.5, 4] fp is below 1e-3 of the total (the f^-5 tail).
+SPECTRUM_BAND = (0.5, 4.0)
 SCAN_KEYS = ("beam_duration", "timestamp", "dwell_average")
 SCAN_DEFAULTS = {"beam_duration": 1.0, "timestamp": "mid", "dwell_average": False}
 ANGULAR_DOFS = ("roll", "pitch", "yaw")
@@ -42,11 +71,139 @@ MAX_ANGULAR_AMPLITUDE_DEG = 45.0
 def validate_motion(check, value):
     """The validated ``motion`` section (degrees and seconds, as in the file)."""
     check.mapping(value, "motion")
-    check.keys(value, "motion", DEGREES_OF_FREEDOM)
+    check.keys(value, "motion", DEGREES_OF_FREEDOM + ("spectrum", "response", "series"))
     out = {}
     for dof in DEGREES_OF_FREEDOM:
         if dof in value:
             out[dof] = _harmonic(check, value[dof], f"motion.{dof}", dof in ANGULAR_DOFS)
+    if ("spectrum" in value) != ("response" in value):
+        check.fail("motion.spectrum" if "response" in value else "motion.response",
+                   "a wave spectrum and the platform's response go together; allowed: "
+                   "both motion.spectrum and motion.response, or neither")
+    if "spectrum" in value:
+        out["spectrum"] = _spectrum(check, value["spectrum"])
+        out["response"] = _response(check, value["response"])
+    if "series" in value:
+        out["series"] = _series(check, value["series"])
+    return out
+
+
+def _series(check, value):
+    key = "motion.series"
+    check.mapping(value, key)
+    check.keys(value, key, SERIES_KEYS)
+    for name in ("file", "columns"):
+        if name not in value:
+            check.fail(f"{key}.{name}", "missing; a record needs its file and the columns of "
+                       "its degrees of freedom")
+    path = check.text(value["file"], f"{key}.file")
+    columns = value["columns"]
+    check.mapping(columns, f"{key}.columns")
+    check.keys(columns, f"{key}.columns", DEGREES_OF_FREEDOM)
+    out = {"file": str(_beside(check.source, path)),
+           "time": check.text(value.get("time", "time"), f"{key}.time"),
+           "columns": {dof: check.text(c, f"{key}.columns.{dof}") for dof, c in
+                       columns.items()},
+           "components": check.integer(value.get("components", 128), f"{key}.components",
+                                       low=1, high=MAX_WAVE_COMPONENTS)}
+    read_series(out["file"], out["time"], tuple(out["columns"].items()), check.source)
+    return out
+
+
+def _beside(source, path):
+    """`path` relative to the folder of the scenario file `source` (or as given)."""
+    from pathlib import Path
+    path = Path(path)
+    if path.is_absolute() or source.startswith("<"):
+        return path
+    return Path(source).resolve().parent / path
+
+
+def read_series(file, time, columns, source="<mapping>"):
+    """(times [s], {dof: values [rad or m]}) of a motion record; DataFileError naming the
+    file and the column for anything unreadable. Read once per file version."""
+    try:
+        version = Path(file).stat().st_mtime_ns
+    except OSError:
+        version = None
+    return _read_series(file, version, time, columns)
+
+
+@functools.lru_cache(maxsize=8)
+def _read_series(file, version, time, columns):
+    import pandas as pd
+    from uq.errors import DataFileError
+    from uq.pipeline.yamlfile import read_text
+    try:
+        text = read_text(Path(file), limit=MAX_SERIES_BYTES)
+    except ScenarioError as error:
+        raise DataFileError(str(file), "motion.series.file", error.problem) from None
+    try:
+        table = pd.read_csv(io.StringIO(text))
+    except (ValueError, pd.errors.ParserError, pd.errors.EmptyDataError) as error:
+        raise DataFileError(str(file), "motion.series.file", f"cannot read it as CSV "
+                            f"({str(error).splitlines()[0][:100]})") from None
+    wanted = [time] + [c for _, c in columns]
+    missing = [c for c in wanted if c not in table.columns]
+    if missing:
+        raise DataFileError(str(file), "motion.series.columns", f"no column "
+                            f"{', '.join(map(repr, missing))}; allowed: "
+                            f"{', '.join(map(str, table.columns[:12]))}")
+    data = {}
+    for name in wanted:
+        values = pd.to_numeric(table[name], errors="coerce").to_numpy(dtype=float)
+        if not np.all(np.isfinite(values)):
+            row = int(np.flatnonzero(~np.isfinite(values))[0])
+            raise DataFileError(str(file), name, f"row {row + 2} is not a finite number; "
+                                "allowed: a complete record of numbers")
+        data[name] = values
+    times = data[time]
+    steps = np.diff(times)
+    if len(times) < MIN_SERIES_SAMPLES or np.any(steps <= 0) or \
+            np.ptp(steps) > SERIES_SPACING_TOLERANCE * np.mean(steps):
+        raise DataFileError(str(file), time, f"{len(times)} samples; allowed: at least "
+                            f"{MIN_SERIES_SAMPLES}, increasing and equally spaced (within "
+                            f"{100 * SERIES_SPACING_TOLERANCE:g} %)")
+    values = {dof: np.radians(data[c]) if dof in ANGULAR_DOFS else data[c]
+              for dof, c in columns}
+    return times, values
+
+
+def _spectrum(check, value):
+    key = "motion.spectrum"
+    check.mapping(value, key)
+    check.keys(value, key, SPECTRUM_KEYS)
+    for name in ("hs", "tp"):
+        if name not in value:
+            check.fail(f"{key}.{name}", "missing; a spectrum needs hs [m] and tp [s]")
+    tp = check.number(value["tp"], f"{key}.tp", low=0.0, low_open=True)
+    band = value.get("band", [SPECTRUM_BAND[0] / tp, SPECTRUM_BAND[1] / tp])
+    band = check.number_list(band, f"{key}.band", low=0.0, low_open=True)
+    if len(band) != 2 or not band[0] < band[1]:
+        check.fail(f"{key}.band", "allowed: [lowest, highest] frequency in Hz, lowest first")
+    return {"kind": check.choice(value.get("kind", "jonswap"), f"{key}.kind", SPECTRUM_KINDS),
+            "hs": check.number(value["hs"], f"{key}.hs", low=0.0),
+            "tp": tp,
+            "gamma": check.number(value.get("gamma", 3.3), f"{key}.gamma", low=1.0, high=10.0),
+            "components": check.integer(value.get("components", 32), f"{key}.components",
+                                        low=1, high=MAX_WAVE_COMPONENTS),
+            "band": band}
+
+
+def _response(check, value):
+    check.mapping(value, "motion.response")
+    check.keys(value, "motion.response", DEGREES_OF_FREEDOM)
+    out = {}
+    for dof, spec in value.items():
+        key = f"motion.response.{dof}"
+        check.mapping(spec, key)
+        check.keys(spec, key, RESPONSE_KEYS)
+        if "factor" not in spec:
+            check.fail(f"{key}.factor", "missing; allowed: the amplitude per metre of wave "
+                       "amplitude (deg/m or m/m)")
+        out[dof] = {"factor": check.number(spec["factor"], f"{key}.factor", low=0.0),
+                    "lag": check.number(spec.get("lag", 0.0), f"{key}.lag", low=-360.0,
+                                        high=360.0)}
     return out
 
 
@@ -108,9 +265,13 @@ def time_resolved(settings):
     if not is_time_resolved(settings):
         return None
     lidar, ins = settings["lidar"], settings["ins"]
-    components = tuple(_component(dof, spec) for dof, spec in
-                       (settings.get("motion") or {}).items())
-    motion = Motion(components, tuple(lidar.get("lever_arm", (0.0, 0.0, 0.0))))
+    motion_settings = settings.get("motion") or {}
+    components = tuple(_component(dof, spec) for dof, spec in motion_settings.items()
+                       if dof in DEGREES_OF_FREEDOM)
+    components += _wave_components(motion_settings)
+    record = series_motion(motion_settings)[0]
+    motion = Motion(components + record, tuple(lidar.get("lever_arm", (0.0, 0.0, 0.0))),
+                    window=len(record))
     scan = {**SCAN_DEFAULTS, **lidar.get("scan", {})}
     return TimeResolved(motion, ScanTiming(**scan),
                         InsSampling(ins.get("rate"), ins.get("interpolation", "linear")))
@@ -126,9 +287,36 @@ def _component(dof, spec):
                            (0.0,) * len(DEGREES_OF_FREEDOM), phase)
 
 
+def _wave_components(motion_settings):
+    if "spectrum" not in motion_settings:
+        return ()
+    spectrum = motion_settings["spectrum"]
+    response = {dof: (spec["factor"], math.radians(spec["lag"]))
+                for dof, spec in motion_settings["response"].items()}
+    return jonswap_components(spectrum["hs"], spectrum["tp"], spectrum["gamma"],
+                              spectrum["components"], tuple(spectrum["band"]), response)
+
+
+def series_motion(motion_settings):
+    """(components with random phases, WindowStart or None) of a motion record."""
+    if "series" not in motion_settings:
+        return (), None
+    spec = motion_settings["series"]
+    times, values = read_series(spec["file"], spec["time"], tuple(spec["columns"].items()))
+    components, _ = series_components(times, values, spec["components"])
+    components = tuple(MotionComponent(c.angular_frequency, c.amplitudes, c.lags, None)
+                       for c in components)
+    length = (times[-1] - times[0]) * len(times) / (len(times) - 1)
+    return components, WindowStart([c.angular_frequency for c in components], length)
+
+
 def random_phase_count(settings):
-    """Components of the motion with a random phase (each a Monte Carlo input)."""
-    return sum(spec["phase"] == "random" for spec in (settings.get("motion") or {}).values())
+    """Components of the motion with a random phase (each a Monte Carlo input): the
+    harmonics with ``phase: random`` and every component of a wave spectrum."""
+    motion = settings.get("motion") or {}
+    harmonics = sum(spec["phase"] == "random" for dof, spec in motion.items()
+                    if dof in DEGREES_OF_FREEDOM)
+    return harmonics + (motion["spectrum"]["components"] if "spectrum" in motion else 0)
 
 
 def beam_stamps(settings, n_beams):

@@ -11,6 +11,9 @@ Regenerate with ``python -m uq.pipeline.reference > docs/scenario.md``.
 """
 import copy
 import math
+from pathlib import Path
+
+import numpy as np
 
 from uq.pipeline import scenario as scenario_module
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS
@@ -26,11 +29,19 @@ EXEMPLAR_OPTIONAL = {
     "lidar": {"errors": {"half_cone": {"dist": "normal", "u": 0.1},
                          "misalignment": {"dist": "normal", "u": 0.3},
                          "radial_velocity": {"dist": "normal", "u": 0.05},
-                         "height": {"dist": "normal", "u": 0.2}},
+                         "height": {"dist": "normal", "u": 0.2},
+                         "gate_length": {"dist": "normal", "u": 1.0},
+                         "pulse_fwhm": {"dist": "normal", "u": 1.0},
+                         "wavelength": {"dist": "normal", "u": 0.001},
+                         "beam_radius": {"dist": "normal", "u": 1.0}},
               "lever_arm": [0.0, 0.0, 2.0],
-              "scan": {}},
-    "motion": {dof: {"amplitude": 1.0, "period": 5.0, "phase": 0.0}
-               for dof in ("roll", "pitch", "yaw", "surge", "sway", "heave")},
+              "scan": {},
+              "probe": {"kind": "cw", "gate_length": 30.0, "pulse_fwhm": 22.5,
+                        "wavelength": 1.565, "beam_radius": 28.0, "truncation": 0.02}},
+    "motion": {**{dof: {"amplitude": 1.0, "period": 5.0, "phase": 0.0}
+                  for dof in ("roll", "pitch", "yaw", "surge", "sway", "heave")},
+               "spectrum": {"hs": 2.0, "tp": 7.0},
+               "response": {"roll": {"factor": 2.0, "lag": 90.0}}},
     "sampling": {"chunk_size": 65536, "seed": 1},
     "fit": {"priors": {"shear": {"dist": "uniform", "low": -0.5, "high": 1.0},
                        "reference_speed": {"dist": "normal", "mean": 9.0, "u": 2.0}},
@@ -70,10 +81,30 @@ MEANINGS = {
     "lidar.misalignment": ("deg", "angle from the bow to the reference beam, clockwise"),
     "lidar.errors.*": ("as the quantity", "true minus configured half_cone [deg], "
                        "misalignment [deg], radial_velocity noise per beam and gate "
-                       "[m s-1], height [m] (a distribution)"),
+                       "[m s-1], height [m], and of the probe's gate_length, pulse_fwhm "
+                       "[m], wavelength [um], beam_radius [mm] (one draw per scan; needs "
+                       "the parameter in lidar.probe) (a distribution)"),
+    "lidar.probe.kind": ("", "range weighting of each radial velocity along its beam: "
+                         "point (at the gate centre; the default), pulsed (the range "
+                         "gate convolved with a Gaussian pulse), cw (a focused continuous wave: a Lorentzian "
+                         "with truncated tails); cut at the lens; see uq/physics/probe.py. "
+                         "The parameters of every kind may be given (kind can be swept)"),
+    "lidar.probe.gate_length": ("m", "range-gate length of a pulsed lidar"),
+    "lidar.probe.pulse_fwhm": ("m", "full width at half maximum of a pulsed lidar's pulse "
+                               "in range (c tau / 2 for a pulse of duration tau)"),
+    "lidar.probe.wavelength": ("um", "laser wavelength of a CW lidar"),
+    "lidar.probe.beam_radius": ("mm", "1/e^2 intensity radius of a CW lidar's beam at the "
+                                "lens; the Rayleigh length at the focus F (the gate's slant "
+                                "distance) is lambda F^2 / (pi a^2)"),
+    "lidar.probe.truncation": ("1", "a CW weighting's tails are cut where it falls below "
+                               "this fraction of its peak (abs(s) <= sqrt(1/t - 1) z_R); "
+                               "part of the model (the Lorentzian's variance is infinite), stated "
+                               "in the results' probe attribute"),
     "correction": ("", "motion correction: none, yaw (heading and ship velocity), tilt2d "
                    "(Rubio & Gottschall 2022 Eq. 13 as written), full (rotation of all "
-                   "three components and the ship velocity)"),
+                   "three components and the ship velocity), with one INS reading per scan; "
+                   "pointwise: each beam with the INS read at its own time stamp, lever "
+                   "arm included"),
     "sampling.method": ("", "mc, lhs, sobol, or none (GUM and the paper's model only)"),
     "sampling.n": ("1", "Monte Carlo trials per scene (give n or digits)"),
     "sampling.digits": ("1", "adaptive sampling to this many significant digits "
@@ -96,6 +127,24 @@ MEANINGS = {
     "motion.<dof>.phase": ("deg", "phase at the start of the scan (0: at the static "
                            "attitude, moving positive), or random: uniform over the cycle, "
                            "per trial (default)"),
+    "motion.spectrum.kind": ("", "wave spectrum: jonswap (Hasselmann et al. 1973, via "
+                             "wavespectra)"),
+    "motion.spectrum.hs": ("m", "significant wave height"),
+    "motion.spectrum.tp": ("s", "peak period"),
+    "motion.spectrum.gamma": ("1", "peak enhancement factor"),
+    "motion.spectrum.components": ("1", "wave components (equal frequency bins), each with "
+                                   "a random phase"),
+    "motion.spectrum.band": ("Hz", "[lowest, highest] frequency (default [0.5, 4] / tp)"),
+    "motion.response.<dof>.factor": ("deg m-1 or m m-1", "motion of a degree of freedom "
+                                     "per metre of wave amplitude (a flat response)"),
+    "motion.response.<dof>.lag": ("deg", "phase lag of that degree of freedom"),
+    "motion.series.file": ("", "CSV of a measured motion record (relative to the "
+                           "scenario file); each trial reads a random window of it"),
+    "motion.series.time": ("s", "column of the sample times (equally spaced)"),
+    "motion.series.columns.<dof>": ("deg or m", "column of a degree of freedom: roll, pitch, "
+                                "yaw in deg; surge, sway, heave in m"),
+    "motion.series.components": ("1", "Fourier harmonics of the record kept (those with "
+                                 "the most motion)"),
     "lidar.lever_arm": ("m", "(bow, starboard, up) from the INS to the lidar"),
     "lidar.scan.beam_duration": ("s", "dwell per line of sight; beams in the order of "
                                  "azimuths, then the vertical beam"),
@@ -190,8 +239,18 @@ class RecordingChecker(Checker):
 def recorded_checks():
     """Dotted key -> (kind, value, limits) of every check the validator makes; the value
     is the default wherever the exemplar leaves the key unset."""
+    import tempfile
+    with tempfile.TemporaryDirectory() as folder:
+        record = Path(folder) / "record.csv"
+        times = np.arange(32) * 0.5
+        record.write_text("time,roll\n" + "".join(f"{t},{np.sin(t)}\n" for t in times))
+        series = {"motion": {"series": {"file": str(record), "columns": {"roll": "roll"}}}}
+        return _recorded(series)
+
+
+def _recorded(series):
     checker = RecordingChecker("<reference>")
-    for overlay in (EXEMPLAR_OPTIONAL, EXEMPLAR_ALTERNATIVE):
+    for overlay in (_merge(copy.deepcopy(EXEMPLAR_OPTIONAL), series), EXEMPLAR_ALTERNATIVE):
         checker.overlay = overlay
         raw = _merge(copy.deepcopy(DEFAULTS), overlay)
         raw["outputs"] = list(scenario_module.OUTPUTS)
@@ -233,7 +292,12 @@ def documented_keys(records):
             continue
         if key.startswith("fit.priors."):     # one row per prior key, any parameter
             key, value = "fit.priors.<parameter>." + key.rpartition(".")[2], None
-        if key.startswith("motion."):         # one row per harmonic key, any dof
+        if key.startswith("motion.series.columns."):
+            key = "motion.series.columns.<dof>"
+        if key.startswith("motion.response."):        # one row per key, any dof
+            key = "motion.response.<dof>." + key.rpartition(".")[2]
+        elif key.startswith("motion.") and not key.startswith(("motion.spectrum.",
+                                                                "motion.series.")):
             key = "motion.<dof>." + key.rpartition(".")[2]
         if key == "outputs":
             kind = "list of choices"

@@ -9,6 +9,7 @@ Chunks can run on a dask cluster and be kept on disk for ``--resume``; neither c
 a number.
 """
 import contextlib
+import dataclasses
 import time
 
 import numpy as np
@@ -18,7 +19,8 @@ from uq._version import __version__
 from uq.pipeline.distributions import error_distribution
 from uq.engine.inputs import Input, UniformCircle
 from uq.physics.ins import gauss_markov_correlation
-from uq.pipeline import motionsection
+from uq.pipeline import motionsection, probesection
+from uq.physics import probe as probe_volume
 from uq.physics.measurement import ANGULAR_NAVIGATION, OUTPUTS, Scene, measurement_model, true_values
 from uq.pipeline.metadata import (COORDINATES, QUANTITIES, ancillary_variables, cf_encode,
                                   history, swept_key_attributes, variable_attributes)
@@ -112,7 +114,8 @@ def scene_from_settings(settings):
         lidar_height=lid["height"], ranges=tuple(lid["ranges"]), half_cone=rad(lid["half_cone"]),
         misalignment=rad(lid["misalignment"]), azimuths=tuple(rad(lid["azimuths"])),
         vertical_beam=lid["vertical_beam"], correction=settings["correction"],
-        time_resolved=motionsection.time_resolved(settings))
+        time_resolved=motionsection.time_resolved(settings),
+        probe=probe_volume.make_probe(lid.get("probe")))
 
 
 def error_inputs(settings, n_beams, n_gates):
@@ -123,7 +126,10 @@ def error_inputs(settings, n_beams, n_gates):
     (correlation ``exp(-|t_k - t_l| / tau)``; tau = inf is one per scan). Time-resolved
     scans add the unit phases of the random-phase motion components
     (:class:`uq.engine.inputs.UniformCircle`), the clock offset and, for a sampled INS,
-    the offset of its samples (uniform over one period).
+    the offset of its samples (uniform over one period). Errors of the probe's parameters
+    (``lidar.errors.gate_length`` ...) are one draw per scan, in scenario units; those of
+    a parameter the probe's kind does not use stay inputs without effect (so that every
+    value of a swept ``lidar.probe.kind`` has the same inputs).
     """
     inputs = {}
     beam_mode = settings["ins"]["correlation"] == "beam"
@@ -157,6 +163,9 @@ def _motion_inputs(settings):
     random = motionsection.random_phase_count(settings)
     if random:
         inputs["motion_phases"] = Input(UniformCircle(1.0), (random, 2))
+    series, window = motionsection.series_motion(settings.get("motion") or {})
+    if series:
+        inputs["motion_window"] = Input(window, (len(series), 2))
     ins = settings["ins"]
     if "clock_offset" in ins:
         inputs["ins_clock_offset"] = error_distribution(ins["clock_offset"])
@@ -168,7 +177,8 @@ def _motion_inputs(settings):
 
 
 #: Budget labels of the inputs that are not scenario keys of their own.
-INPUT_LABELS = {"motion_phases": "motion (phases)", "ins_sample_offset": "ins.rate (sampling)"}
+INPUT_LABELS = {"motion_phases": "motion (phases)", "motion_window": "motion.series (window)",
+                "ins_sample_offset": "ins.rate (sampling)"}
 
 
 def input_label(name):
@@ -184,12 +194,21 @@ def run_scene(scenario, scene, seed):
     settings = scenario.settings
     outputs = model_outputs(scenario.outputs)
     n_gates = len(scene.ranges)
+    scene = probe_volume.resolve(scene)       # the probe's node count, once per batch
     inputs = error_inputs(settings, scene.n_beams, n_gates)
     engine = _propagate(scene, settings, outputs, inputs, seed)
     dataset = _scene_dataset(scene, settings, outputs, engine)
-    if "wind_speed_motion_ti" in scenario.outputs:
+    if wants_motion_ti(settings):
         dataset = dataset.assign(_motion_ti(scene, settings, inputs, seed, dataset))
     return dataset
+
+
+def wants_motion_ti(settings):
+    """``wind_speed_motion_ti`` is computed for every scenario with motion whose outputs
+    include the wind speed (or that asks for it by name)."""
+    outputs = settings["outputs"]
+    return "wind_speed_motion_ti" in outputs or (bool(settings.get("motion"))
+                                                 and "wind_speed" in outputs)
 
 
 def model_outputs(outputs):
@@ -201,23 +220,28 @@ def model_outputs(outputs):
 
 
 #: Inputs that are the motion itself (random phases and when the INS samples it).
-MOTION_INPUTS = ("motion_phases", "ins_sample_offset")
+MOTION_INPUTS = ("motion_phases", "motion_window", "ins_sample_offset")
 
 
 def _motion_ti(scene, settings, inputs, seed, dataset):
     """``wind_speed_motion_ti``: u of the scan's Vh from the motion alone (every other
     error at its mean), over the true Vh; Monte Carlo with the run's seed and sampling,
     and ``wind_speed_motion_ti_gum`` from the motion inputs' share of the GUM budget."""
+    truth = dataset["wind_speed_true"].values
     motion_only = {name: spec if name in MOTION_INPUTS else _mean_of(spec)
                    for name, spec in inputs.items()}
-    engine = _propagate(scene, settings, ("wind_speed",), motion_only, seed)
-    truth = dataset["wind_speed_true"].values
+    if settings["sampling"]["method"] == "none" or not any(n in inputs for n in MOTION_INPUTS):
+        u_motion = np.zeros_like(truth) if not any(n in inputs for n in MOTION_INPUTS) \
+            else np.full_like(truth, np.nan)
+    else:
+        engine = _propagate(scene, settings, ("wind_speed",), motion_only, seed)
+        u_motion = engine["wind_speed_mc_u"].values
     dims = dataset["wind_speed_true"].dims
     budget = dataset["wind_speed_budget"]
     labels = [input_label(name) for name in MOTION_INPUTS]
     motion_variance = budget.sel(input=[i for i in budget["input"].values if i in labels]
                                  ).sum("input").values
-    return {"wind_speed_motion_ti": (dims, engine["wind_speed_mc_u"].values / truth),
+    return {"wind_speed_motion_ti": (dims, u_motion / truth),
             "wind_speed_motion_ti_gum": (dims, np.sqrt(motion_variance) / truth)}
 
 
@@ -275,6 +299,8 @@ def _scene_dataset(scene, settings, outputs, engine):
             if q == "wind_direction":
                 bias = unwrap(bias, 0.0)
             data[f"{q}_mc_bias"] = (dims, bias)
+    if "probe" in settings["lidar"]:
+        data.update(_probe_variables(scene, outputs, nominal))
     data["mc_n_samples"] = ("scene", np.full(scene.shape, engine.attrs["n_samples"]))
     data["mc_stopped_by"] = ("scene", np.full(scene.shape, STOPPED_BY.index(
         engine.attrs["stopped_by"]), dtype=np.int8))
@@ -285,6 +311,33 @@ def _scene_dataset(scene, settings, outputs, engine):
     if "beam" in engine.dims:
         coords.update(_beam_coordinates(scene))
     return engine.assign(data).assign_coords(coords)      # one merge each (xarray's cost)
+
+
+#: Outputs whose systematic error from the probe volume is reported (``{q}_probe_bias``).
+PROBE_BIAS_OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity")
+
+
+def _probe_variables(scene, outputs, nominal):
+    """``{q}_probe_bias``: the error-free reconstruction with the probe volume minus the
+    same at the gate centre (zero for a point probe), so that ``q_nominal - q_true`` is
+    this plus the correction's own systematic error; ``probe_nodes`` and
+    ``probe_quadrature_error``: the quadrature along the beams (:mod:`uq.physics.probe`)."""
+    point = nominal if scene.probe is None else measurement_model(
+        dataclasses.replace(scene, probe=None), outputs, compiled=False)
+    data = {}
+    for q in outputs:
+        if q not in PROBE_BIAS_OUTPUTS:
+            continue
+        bias = np.real(nominal[q][0]) - np.real(point[q][0])
+        if q == "wind_direction":
+            bias = unwrap(bias, 0.0)
+        data[f"{q}_probe_bias"] = (_dims(q), bias)
+    probe = scene.probe
+    data["probe_nodes"] = ("scene", np.full(scene.shape, probe.nodes if probe else 1,
+                                            dtype=np.int32))
+    data["probe_quadrature_error"] = ("scene", np.full(
+        scene.shape, probe.quadrature_error if probe else 0.0))
+    return data
 
 
 def _beam_coordinates(scene):
@@ -351,6 +404,15 @@ DERIVED_ATTRIBUTES = {
 }
 
 
+#: Attributes of the probe's quadrature variables.
+PROBE_ATTRIBUTES = {
+    "probe_nodes": {"units": "1", "long_name": "Gauss-Legendre nodes per beam and range gate "
+                    "of the probe-volume quadrature (1: a point probe)"},
+    "probe_quadrature_error": {"units": "1", "long_name": "relative error of the probe "
+                               "quadrature at the nominal geometry, against a 128-node rule"},
+}
+
+
 def _annotate(ds, scenario):
     # attributes set on the Variables in place (ds[name] would build a DataArray each)
     for name in ds.data_vars:
@@ -361,6 +423,9 @@ def _annotate(ds, scenario):
             ds.variables[name].attrs.update(
                 variable_attributes(quantity, name[len(quantity) + 1:]))
     ds.variables["mc_n_samples"].attrs.update(units="1", long_name="Monte Carlo trials used")
+    for name, attrs in PROBE_ATTRIBUTES.items():
+        if name in ds.variables:
+            ds.variables[name].attrs.update(attrs)
     ds.variables["mc_stopped_by"].attrs.update(  # a CF flag variable (CF 1.10, 3.5)
         units="1", long_name="what stopped Monte Carlo sampling",
         flag_values=np.arange(len(STOPPED_BY), dtype=np.int8),
@@ -379,9 +444,10 @@ def _annotate(ds, scenario):
     return cf_encode(ds)
 
 
-def skipped_work(settings, outputs):
+def skipped_work(settings, outputs, probe_kinds=()):
     """What the model did not compute for this scenario, in words (the ``skipped``
-    attribute): each line names a shortcut the measurement model took."""
+    attribute): each line names a shortcut the measurement model took. `probe_kinds`: the
+    values of a swept ``lidar.probe.kind`` (default: the scenario's kind)."""
     lidar, ins = settings["lidar"], settings["ins"]
     lines = [f"input not sampled (no error declared): {key}" for key in
              [f"ins.{k}" for k in INS_KEYS if k not in ins]
@@ -393,12 +459,20 @@ def skipped_work(settings, outputs):
     if settings["correction"] in ("none", "yaw"):
         lines.append(f"correction '{settings['correction']}': no pitch/roll rotation")
     lines += [f"output not requested, not computed: {q}" for q in OUTPUTS if q not in outputs]
+    if "probe" in lidar:
+        for kind in probe_kinds or (lidar["probe"]["kind"],):
+            lines += [f"probe parameter error without effect where lidar.probe.kind is "
+                      f"{kind} (it does not use it): lidar.errors.{key}"
+                      for key in probesection.unused_errors(settings, kind)]
+        lines.append("probe volume: evaluated by the numpy model (the compiled model is "
+                     "point-wise)")
     return "; ".join(lines) or "nothing"
 
 
 def _global_attributes(scenario, seed, dataset, started):
     return {"title": f"uq results: {scenario.name}",
-            "skipped": skipped_work(scenario.settings, scenario.outputs),
+            "skipped": skipped_work(scenario.settings, scenario.outputs,
+                                    dict(scenario.sweep).get("lidar.probe.kind", ())),
             "Conventions": "CF-1.10",
             "history": history(f"uq run, scenario {scenario.name}"),
             "scenario": scenario.text,
@@ -409,4 +483,19 @@ def _global_attributes(scenario, seed, dataset, started):
             "seed": seed,
             "correction": scenario.settings["correction"],
             "ins_correlation": scenario.settings["ins"]["correlation"],
-            "runtime_s": time.perf_counter() - started}
+            "runtime_s": time.perf_counter() - started, **_probe_attributes(scenario)}
+
+
+def _probe_attributes(scenario):
+    """``probe``: the probe model in words, with the truncation of the CW Lorentzian
+    (part of the model: its variance is infinite); ``probe_truncation`` [1] when a CW
+    probe runs; nothing for a scenario without ``lidar.probe``."""
+    lidar = scenario.settings["lidar"]
+    if "probe" not in lidar:
+        return {}
+    swept = dict(scenario.sweep).get("lidar.probe.kind", ())
+    attributes = {"probe": probesection.describe(scenario.settings, swept)}
+    kinds = set(swept) or {lidar["probe"]["kind"]}
+    if "cw" in kinds:
+        attributes["probe_truncation"] = lidar["probe"]["truncation"]
+    return attributes

@@ -27,8 +27,9 @@ from uq.physics.beams import beam_unit_vectors
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS, validate_error
 from uq.errors import ScenarioError
 from uq.pipeline.fitconfig import validate_fit
-from uq.pipeline.motionsection import (is_time_resolved, validate_ins_timing, validate_lever_arm,
-                                       validate_motion, validate_scan)
+from uq.pipeline.motionsection import (validate_ins_timing, validate_lever_arm, validate_motion,
+                                       validate_scan)
+from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
 from uq.physics.measurement import OUTPUTS
 from uq.engine.sampling import PROPAGATION_METHODS
 from uq.engine.statistics import INTERVALS
@@ -71,7 +72,7 @@ DEFAULTS = {
 }
 #: Optional keys of a section that enter the settings only when given (so a scenario
 #: without them is today's, to the text of its ``scenario`` attribute).
-OPTIONAL_LIDAR_KEYS = ("lever_arm", "scan")
+OPTIONAL_LIDAR_KEYS = ("lever_arm", "scan", "probe")
 OPTIONAL_INS_KEYS = ("rate", "interpolation", "clock_offset")
 #: Outputs derived from the results rather than evaluated per trial.
 DERIVED_OUTPUTS = ("wind_speed_motion_ti",)
@@ -199,9 +200,20 @@ def assign_dotted(raw, dotted, value, source):
 def _build(raw, source):
     settings = _validate(raw, source)
     sweep, links = _validate_sweep(raw.get("sweep"), settings, source)
-    settings["sweep"] = {key: list(values) for key, values in sweep}
+    settings["sweep"] = {key: [_plain(v) for v in values] for key, values in sweep}
     settings["sweep"].update({follower: {"same_as": leader} for follower, leader in links})
     return Scenario(settings["name"], settings["description"], settings, sweep, source, links)
+
+
+def _plain(value):
+    """A numpy scalar as the Python number it holds (the scenario text is YAML)."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    return value
 
 
 def load_fit_settings(raw_fit, source):
@@ -310,13 +322,16 @@ def _lidar(check, value):
     _check_beams_determine_wind(check, out)
     errors = lid["errors"] if lid["errors"] is not None else {}
     check.mapping(errors, "lidar.errors")
-    check.keys(errors, "lidar.errors", LIDAR_ERROR_KEYS)
+    check.keys(errors, "lidar.errors", LIDAR_ERROR_KEYS + PROBE_ERROR_KEYS)
     out["errors"] = {key: validate_error(errors[key], f"lidar.errors.{key}", check)
-                     for key in LIDAR_ERROR_KEYS if key in errors}
+                     for key in LIDAR_ERROR_KEYS + PROBE_ERROR_KEYS if key in errors}
     if "lever_arm" in lid:
         out["lever_arm"] = validate_lever_arm(check, lid["lever_arm"])
     if "scan" in lid:
         out["scan"] = validate_scan(check, lid["scan"])
+    if "probe" in lid:
+        out["probe"] = validate_probe(check, lid["probe"])
+    check_probe(check, out)
     return out
 
 
@@ -326,13 +341,6 @@ def _check_time_resolved(check, settings):
     if "interpolation" in ins and "rate" not in ins:
         check.fail("ins.interpolation", "needs ins.rate (a continuous INS is not "
                    "interpolated); allowed: give ins.rate in Hz")
-    per_beam = ins["correlation"] == "beam" or any(
-        isinstance(spec, dict) and "correlation_time" in spec for spec in ins.values())
-    if per_beam and is_time_resolved(settings) and settings["correction"] != "pointwise":
-        check.fail("correction", f"{settings['correction']!r} reads the INS once per scan "
-                   "in a time-resolved scan, so its errors cannot differ between beams; "
-                   "allowed: pointwise (a reading per beam), or ins.correlation: scan "
-                   "without correlation_time")
     if DERIVED_OUTPUTS[0] in settings["outputs"] and not settings.get("motion"):
         check.fail("outputs", f"{DERIVED_OUTPUTS[0]} needs a motion section; allowed: the "
                    "other outputs")

@@ -1,0 +1,34 @@
+"""The summary table of uq run: readable columns, no empty ones, the verdict explained."""
+import re
+
+import uq
+from uq.outputs.summary import summary_table
+
+
+def test_columns_never_run_together_and_empty_ones_are_dropped():
+    ds = uq.run({"ins": {"heading": {"dist": "normal", "u": 0.1}}, "ship": {"sog": 2.0},
+                 "sampling": {"n": 500, "seed": 1},
+                 "sweep": {"wind.direction": [0.0, 90.0], "ship.pitch": [0.0, 5.0]}})
+    lines = summary_table(ds).splitlines()
+    header = lines[1]
+    assert "paper_u" not in header               # tilted: outside the paper's case i/ii
+    names = re.split(r"\s{3,}", header.strip())
+    for line in lines[2:5]:
+        cells = re.split(r"\s{3,}", line.strip())
+        assert len(cells) == len(names), line          # every cell stands apart
+    assert any("(n)" in line and "conclusive" in line for line in lines)
+    assert "e-1" not in "\n".join(lines[2:5])          # rounding noise printed as 0
+
+
+def test_report_states_the_apparent_turbulence_intensity():
+    """sqrt(TI^2 + TI_motion^2): 6 % and 8 % make 10 %; the report of a motion result
+    states it for the true TI asked for."""
+    import numpy as np
+    from uq.outputs.report import apparent_ti, render_report
+    assert apparent_ti(0.06, 0.08) == np.float64(0.1)
+    ds = uq.run({"motion": {"roll": {"amplitude": 3.0, "period": 5.0}},
+                 "sampling": {"n": 500, "seed": 1}, "correction": "none"})
+    ti = float(ds["wind_speed_motion_ti"])
+    page = render_report(ds, true_ti=0.05)
+    assert "Apparent turbulence intensity" in page and "5 %" in page
+    assert f"{100 * np.hypot(0.05, ti):.2f} %" in page
