@@ -133,6 +133,9 @@ class Plan:
         Slant distances of the gates [m].
     n_phases, n_window : int
         Columns the inputs ``motion_phases`` and ``motion_window`` need.
+    at_nodes : bool
+        The point-wise readings of a continuous INS are at the measurement times (no dwell
+        average): without a clock offset the reading's motion is the truth's.
     """
 
     consts: np.ndarray
@@ -150,6 +153,7 @@ class Plan:
     slant: np.ndarray
     n_phases: int
     n_window: int
+    at_nodes: bool
 
 
 def scene_plan(scene):
@@ -211,8 +215,8 @@ def _scene_plan(scene):
             "level_cos": math.cos(scene.heading), "level_sin": math.sin(scene.heading),
             "course_cos": math.cos(scene.cog), "course_sin": math.sin(scene.cog),
             "arm_bow": arm[0], "arm_starboard": arm[1], "arm_up": arm[2],
-            "static_arm_up": static[2], "moves_roll": moves[0], "moves_pitch": moves[1],
-            "moves_yaw": moves[2], "has_arm": bool(np.any(arm != 0))}
+            "static_arm_up": static[2], "moves_yaw": moves[2],
+            "has_arm": bool(np.any(arm != 0))}
     consts = np.array([head[name] if name in head else getattr(scene, name)
                        for name in kernels.HEAD], dtype=float)
     return Plan(consts=consts, pairs=np.array(pairs, dtype=np.int64).reshape(-1, 2),
@@ -225,7 +229,9 @@ def _scene_plan(scene):
                 operator=np.ascontiguousarray(least_squares_operator(beams)),
                 slant=np.ascontiguousarray(slant_distances(
                     scene.ranges, scene.half_cone, len(azimuths), scene.vertical_beam)),
-                n_phases=n_phases, n_window=n_window)
+                n_phases=n_phases, n_window=n_window,
+                at_nodes=pointwise and ins.rate is None and times.shape[1] == 1
+                and bool(np.array_equal(times[:, 0], stamps)))
 
 
 def block_trials(plan):
@@ -257,6 +263,8 @@ def _evaluate(plan, errors, n, into):
     n_components = max(1, len(plan.components))
     work = np.empty((kernels.WORK_ROWS, m))
     c, turned = np.empty((2, n_components, m)), np.empty((2, n_components, m))
+    at_nodes = plan.at_nodes and not has[kernels.INPUTS.index("ins_clock_offset")]
+    states = np.empty((n_beams if at_nodes else 1, kernels.STATE_ROWS, m))
     ship_beams = np.empty((n_beams, 3, m))
     parts = np.empty((2, n_beams * n_nodes, m))
     ratio = np.empty((n_beams * n_nodes, n_gates, m))
@@ -268,8 +276,8 @@ def _evaluate(plan, errors, n, into):
         count = min(m, n - start)
         kernels.kinematics(consts, plan.pairs, plan.amplitudes, plan.components, plan.sources,
                            phases, window, plan.node_table, plan.azimuths, plan.beams,
-                           plan.slant, *geometry, start, count, work, c, ship_beams, parts,
-                           ratio)
+                           plan.slant, *geometry, start, count, work, c, states, ship_beams,
+                           parts, ratio)
         if shear != 0.0:                            # (z / z_ref)^alpha, SIMD; NaN stays NaN
             block = ratio[:, :, :count]
             np.log(block, out=block)
@@ -278,7 +286,7 @@ def _evaluate(plan, errors, n, into):
         kernels.reconstruct(consts, plan.pairs, plan.amplitudes, plan.components,
                             plan.read_table, plan.stamps, plan.beams, plan.operator,
                             plan.weights, ins, has, noise, start, count, work, c, turned,
-                            parts, ratio, normal, out)
+                            states, parts, ratio, normal, out)
         kernels.wind_speed(out, count, speed, vertical)
         stop = start + count
         if "wind_speed" in into:

@@ -71,37 +71,52 @@ HEAD = ("n_beams", "n_gates", "n_nodes", "n_slanted", "model", "ins_mode", "rate
         "heading", "pitch", "roll", "lidar_height", "wind_speed", "reference_height", "shear",
         "to_north", "to_east", "vertical_wind", "ship_north", "ship_east", "ship_up",
         "level_cos", "level_sin", "course_cos", "course_sin", "arm_bow", "arm_starboard",
-        "arm_up", "static_arm_up", "half_cone", "misalignment", "moves_roll", "moves_pitch",
-        "moves_yaw", "has_arm")
+        "arm_up", "static_arm_up", "half_cone", "misalignment", "moves_yaw", "has_arm")
 (_N_BEAMS, _N_GATES, _N_NODES, _N_SLANTED, _MODEL, _INS_MODE, _RATE, _HEADING, _PITCH, _ROLL,
  _LIDAR_HEIGHT, _WIND_SPEED, _REFERENCE_HEIGHT, _SHEAR, _TO_NORTH, _TO_EAST, _VERTICAL_WIND,
  _SHIP_NORTH, _SHIP_EAST, _SHIP_UP, _LEVEL_COS, _LEVEL_SIN, _COURSE_COS, _COURSE_SIN,
- _ARM_BOW, _ARM_STARBOARD, _ARM_UP, _STATIC_ARM_UP, _HALF_CONE, _MISALIGNMENT, _MOVES_ROLL,
- _MOVES_PITCH, _MOVES_YAW, _HAS_ARM) = range(len(HEAD))
+ _ARM_BOW, _ARM_STARBOARD, _ARM_UP, _STATIC_ARM_UP, _HALF_CONE, _MISALIGNMENT, _MOVES_YAW,
+ _HAS_ARM) = range(len(HEAD))
 
 #: Correction models (:data:`uq.physics.correction.CORRECTION_MODELS`) and INS modes.
 NONE, YAW, TILT2D, FULL, POINTWISE = range(5)
 CONTINUOUS, NEAREST, LINEAR = range(3)
-#: Per-trial inputs of the kernels, in the order of ``has`` (which of them are given).
+#: Per-trial INS inputs of :func:`reconstruct`, in the order of ``has`` (which are given).
 INPUTS = ("ins_heading", "ins_pitch", "ins_roll", "ins_sog", "ins_cog", "ins_heave",
           "ins_clock_offset", "ins_sample_offset")
 _CLOCK, _OFFSET = 6, 7
 
-# rows of the block scratch ``work`` (rows, trials): the six degrees of freedom's values
-# and rates (roll, pitch, yaw, surge, sway, heave), the attitude's (cos, sin) of heading,
-# pitch and roll, temporaries, the two INS samples of a linear interpolation, and one
-# INS reading
-_VALUE, _RATE_ROW, _TRIG = 0, 6, 12                  # 6, 6, 6 rows
-_ANGLE, _SINE, _COSINE, _SHIFT, _LIDAR_Z = 18, 19, 20, 21, 22
-_CONE, _MIS, _BEAM, _ALONG, _MEASURED = 23, 25, 27, 30, 31
-_MATRIX1, _MATRIX2, _FRACTION = 32, 41, 50          # 9, 9, 1 rows
-_RATES1, _VELOCITY1, _S2 = 51, 54, 57
-_READ_TRIG, _READ_RATE, _READ_VELOCITY = 58, 64, 67  # 6, 3, 3 rows
-_ERROR = 70                                          # an INS error's (cos, sin)
-WORK_ROWS = 72
+#: Rows of a platform state (states[i], (rows, trials)): the six degrees of freedom's
+#: values and rates (roll, pitch, yaw, surge, sway, heave) and the attitude's (cos, sin)
+#: of heading, pitch and roll.
+_VALUE, _RATE_ROW, _TRIG = 0, 6, 12
+STATE_ROWS = 18
+# rows of the block scratch ``work`` (rows, trials): temporaries, the two INS samples of
+# a linear interpolation, one INS reading and the INS errors of one reading
+_ANGLE, _SINE, _COSINE, _SHIFT, _LIDAR_Z, _BIG = 0, 1, 2, 3, 4, 5
+_CONE, _MIS, _BEAM, _ALONG, _MEASURED = 6, 8, 10, 13, 14
+_MATRIX1, _MATRIX2, _FRACTION = 15, 24, 33           # 9, 9, 1 rows
+_RATES1, _VELOCITY1 = 34, 37                          # 3, 3 rows
+_READ_TRIG, _READ_VELOCITY = 40, 46                   # 6, 3 rows
+_ERROR, _SOG, _COG, _HEAVE = 49, 52, 53, 55           # heading, pitch, roll [rad]; m s-1;
+WORK_ROWS = 56                                        # (cos, sin); m s-1
+
+_helper = njit(cache=True, error_model="numpy")
+_inline = njit(inline="always", error_model="numpy")
 
 
-@njit(inline="always")
+def _kernel(signature):
+    return njit(signature, cache=True, error_model="numpy")
+
+
+@_inline
+def _head(consts):
+    """The scalars of :data:`HEAD` as a tuple: values, not memory, so that loops reading
+    them need no alias checks against the arrays they write."""
+    return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31])
+
+
+@_inline
 def _horner(coefficients, x):
     total = 0.0
     for k in range(len(coefficients) - 1, -1, -1):
@@ -109,7 +124,7 @@ def _horner(coefficients, x):
     return total
 
 
-@njit(inline="always")
+@_inline
 def sincos(x):
     """(sin x, cos x): x - k pi/2 in three parts (Cody-Waite [1]), the Taylor polynomials
     on [-pi/4, pi/4] and the quadrant k mod 4. Within ~1 ulp for |x| <=
@@ -127,7 +142,15 @@ def sincos(x):
     return sine, cosine
 
 
-@njit(cache=True)
+@_inline
+def _trig(x, exact):
+    """(sin x, cos x) from :func:`sincos`, or libm (`exact`: the second pass)."""
+    if exact:
+        return math.sin(x), math.cos(x)
+    return sincos(x)
+
+
+@_helper
 def sincos_rows(work, angle, sine, cosine, count):
     """work[sine], work[cosine] = sin, cos of work[angle] (rows; trials < count)."""
     for j in range(count):
@@ -138,7 +161,7 @@ def sincos_rows(work, angle, sine, cosine, count):
             work[sine, j], work[cosine, j] = math.sin(x), math.cos(x)
 
 
-@njit("void(float64[::1], float64[::1])", cache=True)
+@_kernel("void(float64[::1], float64[::1])")
 def sincos_array(x, out):
     """sin and cos of x into out[:n] and out[n:] (for the tests of :func:`sincos`)."""
     n = x.shape[0]
@@ -149,7 +172,7 @@ def sincos_array(x, out):
     out[n:] = work[2]
 
 
-@njit(inline="always")
+@_inline
 def rotate(ch, sh, cp, sp, cr, sr, x, y, z):
     """``Rz(heading) Ry(pitch) Rx(roll) (x, y, z)``: ship frame to earth frame."""
     y1 = cr * y + sr * z                 # Rx(roll) = [[1, 0, 0], [0, c, s], [0, -s, c]]
@@ -159,7 +182,7 @@ def rotate(ch, sh, cp, sp, cr, sr, x, y, z):
     return ch * x2 - sh * y1, sh * x2 + ch * y1, z2   # Rz = [[c, -s, 0], [s, c, 0], [0, 0, 1]]
 
 
-@njit(inline="always")
+@_inline
 def rotate_rate(ch, sh, cp, sp, cr, sr, dh, dp, dr, x, y, z):
     """``d/dt [Rz(h) Ry(p) Rx(r)] (x, y, z)`` for rates (dh, dp, dr) [rad s-1]: the velocity
     of a point fixed at (x, y, z) in the ship frame (the product rule on the factors)."""
@@ -174,7 +197,7 @@ def rotate_rate(ch, sh, cp, sp, cr, sr, dh, dp, dr, x, y, z):
             (ch * x2 - sh * y1) * dh + (sh * dx2 + ch * dy1), dz2)
 
 
-@njit(cache=True)
+@_helper
 def _phases(components, sources, phases, window, start, count, c):
     """c[0, k], c[1, k] (trials < count) = the unit phase vector of component k: fixed, or
     from the inputs ``motion_phases`` / ``motion_window`` (column sources[k, 1])."""
@@ -194,7 +217,7 @@ def _phases(components, sources, phases, window, start, count, c):
                 c[1, k, j] = data[start + j, column, 1]
 
 
-@njit(cache=True)
+@_helper
 def _turn_phases(components, c, work, count, turned):
     """turned = c with every component's phase advanced by w_k work[_SHIFT] (the motion at
     t + shift from the tables at t)."""
@@ -210,69 +233,27 @@ def _turn_phases(components, c, work, count, turned):
             turned[1, k, j] = c1 * sine + c2 * cosine
 
 
-@njit(cache=True)
-def _motion(pairs, amplitudes, table, column, c, work, count):
-    """Values and rates of the six degrees of freedom (rows _VALUE, _RATE_ROW) at one
-    time: table[0, p, column], table[1, p, column] = sin, cos(w t + lag) of pair p =
-    (component, dof); amplitudes[p] = (A, A w). Summed in the order of the components."""
-    for d in range(6):
-        work[_VALUE + d, :count] = 0.0
-        work[_RATE_ROW + d, :count] = 0.0
+@_helper
+def _motion(pairs, amplitudes, table, column, c, state, count):
+    """Values and rates of the moving degrees of freedom (rows _VALUE, _RATE_ROW of state;
+    the others stay 0) at one time: table[0, p, column], table[1, p, column] = sin,
+    cos(w t + lag) of pair p = (component, dof); amplitudes[p] = (A, A w). Summed in the
+    order of the components."""
+    for p in range(pairs.shape[0]):
+        d = pairs[p, 1]
+        state[_VALUE + d, :count] = 0.0
+        state[_RATE_ROW + d, :count] = 0.0
     for p in range(pairs.shape[0]):
         k, d = pairs[p, 0], pairs[p, 1]
         a, aw = amplitudes[p, 0], amplitudes[p, 1]
         s, co = table[0, p, column], table[1, p, column]
         for j in range(count):
             c1, c2 = c[0, k, j], c[1, k, j]
-            work[_VALUE + d, j] += a * (s * c1 + co * c2)
-            work[_RATE_ROW + d, j] += aw * (co * c1 - s * c2)
+            state[_VALUE + d, j] += a * (s * c1 + co * c2)
+            state[_RATE_ROW + d, j] += aw * (co * c1 - s * c2)
 
 
-@njit(cache=True)
-def _error_row(error, start, count, column, work, row):
-    """work[row] += an error [deg] -> [rad] of the trials (error (n or 1, k or 1))."""
-    col = column if error.shape[1] > 1 else 0
-    if error.shape[0] == 1:
-        for j in range(count):
-            work[row, j] += error[0, col] * _DEG
-    else:
-        for j in range(count):
-            work[row, j] += error[start + j, col] * _DEG
-
-
-@njit(cache=True)
-def _angle_trig(work, count, base, dof, moves, row):
-    """work[row], work[row + 1] = cos, sin of ``base + x_dof`` (an attitude angle)."""
-    if not moves:
-        work[row, :count] = math.cos(base)
-        work[row + 1, :count] = math.sin(base)
-        return
-    for j in range(count):
-        work[_ANGLE, j] = base + work[_VALUE + dof, j]
-    sincos_rows(work, _ANGLE, row + 1, row, count)
-
-
-@njit(cache=True)
-def _read_angle_trig(work, count, base, dof, moves, error, start, column, has_error, row):
-    """As :func:`_angle_trig`, of ``(base + x_dof) + error [deg]`` (a reading)."""
-    if not has_error:
-        _angle_trig(work, count, base, dof, moves, row)
-        return
-    for j in range(count):
-        work[_ANGLE, j] = base + work[_VALUE + dof, j] if moves else base
-    _error_row(error, start, count, column, work, _ANGLE)
-    sincos_rows(work, _ANGLE, row + 1, row, count)
-
-
-@njit(cache=True)
-def _attitude(consts, work, count, row):
-    """The attitude's (cos, sin) of heading, pitch, roll into rows row .. row + 5."""
-    _angle_trig(work, count, consts[_HEADING], 2, consts[_MOVES_YAW] > 0, row)
-    _angle_trig(work, count, consts[_PITCH], 1, consts[_MOVES_PITCH] > 0, row + 2)
-    _angle_trig(work, count, consts[_ROLL], 0, consts[_MOVES_ROLL] > 0, row + 4)
-
-
-@njit(cache=True)
+@_helper
 def _geometry_angle(base, error, start, count, work, row):
     """work[row], work[row + 1] = cos, sin of base + error [deg] (error (n or 1,))."""
     for j in range(count):
@@ -280,7 +261,7 @@ def _geometry_angle(base, error, start, count, work, row):
     sincos_rows(work, _ANGLE, row + 1, row, count)
 
 
-@njit(cache=True)
+@_helper
 def _geometry(consts, azimuths, beams, cone_error, misalignment_error, height_error, start,
               count, work, ship_beams):
     """The true beams in the ship frame, ship_beams (b, 3, trials): configured geometry +
@@ -312,60 +293,86 @@ def _geometry(consts, azimuths, beams, cone_error, misalignment_error, height_er
         work[_LIDAR_Z, j] = height + height_error[start + j if height_error.shape[0] > 1 else 0]
 
 
+@_inline
+def _truth_at(head, state, work, ship_beams, parts, b, node, j, exact, yaw):
+    """The true beam and radial-velocity parts of trial j at a node (see
+    :func:`kinematics`); the attitude's (cos, sin) into the state's rows; work[_BIG, j]
+    bounds the angles' size (for the libm pass)."""
+    heading = head[_HEADING] + state[_VALUE + 2, j]
+    pitch = head[_PITCH] + state[_VALUE + 1, j]
+    roll = head[_ROLL] + state[_VALUE, j]
+    if yaw:
+        sh, ch = _trig(heading, exact)
+    else:                                       # cos, sin of the static heading
+        ch, sh = head[_LEVEL_COS], head[_LEVEL_SIN]
+    sp, cp = _trig(pitch, exact)
+    sr, cr = _trig(roll, exact)
+    work[_BIG, j] = abs(pitch) + abs(roll) + (abs(heading) if yaw else 0.0)
+    state[_TRIG, j], state[_TRIG + 1, j], state[_TRIG + 2, j] = ch, sh, cp
+    state[_TRIG + 3, j], state[_TRIG + 4, j], state[_TRIG + 5, j] = sp, cr, sr
+    bx, by, bz = rotate(ch, sh, cp, sp, cr, sr, ship_beams[b, 0, j], ship_beams[b, 1, j],
+                        ship_beams[b, 2, j])
+    surge, sway = state[_RATE_ROW + 3, j], state[_RATE_ROW + 4, j]
+    level_c, level_s = head[_LEVEL_COS], head[_LEVEL_SIN]
+    vn = head[_SHIP_NORTH] + (level_c * surge - level_s * sway)
+    ve = head[_SHIP_EAST] + (level_s * surge + level_c * sway)
+    vu = head[_SHIP_UP] + state[_RATE_ROW + 5, j]
+    arm_up = 0.0
+    if head[_HAS_ARM] > 0:             # the lidar at R r from the INS, moving with R' r
+        arm_x, arm_y, arm_z = head[_ARM_BOW], head[_ARM_STARBOARD], head[_ARM_UP]
+        arm_up = rotate(ch, sh, cp, sp, cr, sr, arm_x, arm_y, arm_z)[2]
+        dx, dy, dz = rotate_rate(ch, sh, cp, sp, cr, sr, state[_RATE_ROW + 2, j],
+                                 state[_RATE_ROW + 1, j], state[_RATE_ROW, j],
+                                 arm_x, arm_y, arm_z)
+        vn, ve, vu = vn + dx, ve + dy, vu + dz
+    work[_MEASURED, j] = work[_LIDAR_Z, j] + ((state[_VALUE + 5, j] + arm_up)
+                                              - head[_STATIC_ARM_UP])
+    work[_BEAM + 2, j] = bz
+    parts[0, node, j] = bx * head[_TO_NORTH] + by * head[_TO_EAST]
+    parts[1, node, j] = bz * head[_VERTICAL_WIND] - (bx * vn + by * ve + bz * vu)
+
+
 _V, _CV, _M, _CM, _T, _CT = ("float64[:]", "float64[::1]", "float64[:, :]",
                              "float64[:, ::1]", "float64[:, :, :]", "float64[:, :, ::1]")
 _IM = "int64[:, ::1]"
 
 
-@njit(f"void({_CV}, {_IM}, {_CM}, {_CM}, {_IM}, {_T}, {_T}, {_CT}, {_CM}, {_CM}, {_CM}, "
-      f"{_V}, {_V}, {_V}, int64, int64, {_CM}, {_CT}, {_CT}, {_CT}, {_CT})", cache=True)
+@_kernel(f"void({_CV}, {_IM}, {_CM}, {_CM}, {_IM}, {_T}, {_T}, {_CT}, {_CM}, {_CM}, {_CM}, "
+         f"{_V}, {_V}, {_V}, int64, int64, {_CM}, {_CT}, {_CT}, {_CT}, {_CT}, {_CT})")
 def kinematics(consts, pairs, amplitudes, components, sources, phases, window, node_table,
                azimuths, beams, slant, cone_error, misalignment_error, height_error, start,
-               count, work, c, ship_beams, parts, ratio):
+               count, work, c, states, ship_beams, parts, ratio):
     """The truth of trials [start, start + count) at every measurement time.
 
     Writes ``c`` (2, K, trials), the unit phases; ``parts[0, node]`` = ``n_h . e_wind`` and
     ``parts[1, node]`` = ``n_up w - n . v_lidar`` of the true earth-frame beam n at the
     node (b * n_nodes + q), so that the radial velocity there is ``U(z) parts[0] +
     parts[1]``; ``ratio[node, g]`` = z / z_ref of the gates (1 without shear; NaN at a
-    height <= 0, outside the power law) for numpy's log and exp.
+    height <= 0, outside the power law) for numpy's log and exp. With one state per beam
+    (``states`` (b, STATE_ROWS, trials): the point-wise readings are at the nodes) the
+    platform state of beam b is kept in states[b]; else states[0] is scratch.
     """
+    head = _head(consts)
     n_beams, n_gates, n_nodes = int(consts[_N_BEAMS]), int(consts[_N_GATES]), int(consts[_N_NODES])
     _phases(components, sources, phases, window, start, count, c)
     _geometry(consts, azimuths, beams, cone_error, misalignment_error, height_error, start,
               count, work, ship_beams)
-    ship_n, ship_e, ship_u = consts[_SHIP_NORTH], consts[_SHIP_EAST], consts[_SHIP_UP]
-    level_c, level_s = consts[_LEVEL_COS], consts[_LEVEL_SIN]
-    arm_x, arm_y, arm_z = consts[_ARM_BOW], consts[_ARM_STARBOARD], consts[_ARM_UP]
-    static_z, has_arm = consts[_STATIC_ARM_UP], consts[_HAS_ARM] > 0
-    to_n, to_e, w = consts[_TO_NORTH], consts[_TO_EAST], consts[_VERTICAL_WIND]
-    reference, shear = consts[_REFERENCE_HEIGHT], consts[_SHEAR] != 0.0
+    reference, shear, yaw = consts[_REFERENCE_HEIGHT], consts[_SHEAR] != 0.0, consts[_MOVES_YAW] > 0
     for b in range(n_beams):
+        state = states[b if states.shape[0] > 1 else 0]
+        state[:_TRIG, :count] = 0.0                   # degrees of freedom that do not move
         for q in range(n_nodes):
             node = b * n_nodes + q
-            _motion(pairs, amplitudes, node_table, node, c, work, count)
-            _attitude(consts, work, count, _TRIG)
-            for j in range(count):
-                ch, sh, cp, sp = work[_TRIG, j], work[_TRIG + 1, j], work[_TRIG + 2, j], work[_TRIG + 3, j]
-                cr, sr = work[_TRIG + 4, j], work[_TRIG + 5, j]
-                bx, by, bz = rotate(ch, sh, cp, sp, cr, sr, ship_beams[b, 0, j],
-                                    ship_beams[b, 1, j], ship_beams[b, 2, j])
-                surge, sway = work[_RATE_ROW + 3, j], work[_RATE_ROW + 4, j]
-                vn = ship_n + (level_c * surge - level_s * sway)
-                ve = ship_e + (level_s * surge + level_c * sway)
-                vu = ship_u + work[_RATE_ROW + 5, j]
-                arm_up = 0.0
-                if has_arm:                   # the lidar at R r from the INS, moving with R' r
-                    arm_up = rotate(ch, sh, cp, sp, cr, sr, arm_x, arm_y, arm_z)[2]
-                    dx, dy, dz = rotate_rate(ch, sh, cp, sp, cr, sr, work[_RATE_ROW + 2, j],
-                                             work[_RATE_ROW + 1, j], work[_RATE_ROW, j],
-                                             arm_x, arm_y, arm_z)
-                    vn, ve, vu = vn + dx, ve + dy, vu + dz
-                work[_MEASURED, j] = work[_LIDAR_Z, j] + ((work[_VALUE + 5, j] + arm_up)
-                                                          - static_z)
-                work[_BEAM + 2, j] = bz
-                parts[0, node, j] = bx * to_n + by * to_e
-                parts[1, node, j] = bz * w - (bx * vn + by * ve + bz * vu)
+            _motion(pairs, amplitudes, node_table, node, c, state, count)
+            if yaw:
+                for j in range(count):
+                    _truth_at(head, state, work, ship_beams, parts, b, node, j, False, True)
+            else:
+                for j in range(count):
+                    _truth_at(head, state, work, ship_beams, parts, b, node, j, False, False)
+            for j in range(count):                    # beyond the reduction (and NaN): libm
+                if not work[_BIG, j] <= SINCOS_REDUCTION_LIMIT:
+                    _truth_at(head, state, work, ship_beams, parts, b, node, j, True, yaw)
             for g in range(n_gates):
                 distance = slant[b, g]
                 for j in range(count):
@@ -376,7 +383,7 @@ def kinematics(consts, pairs, amplitudes, components, sources, phases, window, n
                         ratio[node, g, j] = height / reference if shear else 1.0
 
 
-@njit(inline="always")
+@_inline
 def _slerp_one(work, j, exact):
     """The attitude a fraction of the way from sample 1 to sample 2 on the rotation group,
     ``R1 exp(a log(R1^T R2))`` (:func:`uq.physics.rotation.interpolate_rotation`), as the
@@ -427,22 +434,36 @@ def _slerp_one(work, j, exact):
     work[_READ_TRIG + 2, j] = math.sqrt((1.0 - m20) * (1.0 + m20))
     work[_READ_TRIG + 3, j] = m20
     work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j] = m22 / across, -m21 / across
-    work[_S2, j] = s2
+    work[_BIG, j] = s2
 
 
-@njit(cache=True)
+@_helper
 def _slerp(work, count):
     for j in range(count):
         _slerp_one(work, j, False)
     for j in range(count):                # a large rotation between samples: libm
-        if not work[_S2, j] <= SLERP_SERIES_LIMIT:
+        if not work[_BIG, j] <= SLERP_SERIES_LIMIT:
             _slerp_one(work, j, True)
 
 
-@njit(cache=True)
-def _sample_matrix(consts, work, count, row):
-    """The attitude of an INS sample (its values in work) as a row-major matrix."""
-    _attitude(consts, work, count, _READ_TRIG)
+@_helper
+def _attitude_rows(consts, state, work, count, row, with_errors):
+    """The (cos, sin) of the heading, pitch and roll of a state's values (plus the error
+    rows of a reading, `with_errors`) into work[row .. row + 5]."""
+    for i in range(3):
+        base, dof = (_HEADING, _PITCH, _ROLL)[i], 2 - i
+        for j in range(count):
+            work[_ANGLE, j] = consts[base] + state[_VALUE + dof, j]
+        if with_errors:
+            for j in range(count):
+                work[_ANGLE, j] += work[_ERROR + i, j]
+        sincos_rows(work, _ANGLE, row + 2 * i + 1, row + 2 * i, count)
+
+
+@_helper
+def _sample_matrix(consts, state, work, count, row):
+    """The attitude of an INS sample (its values in state) as a row-major matrix."""
+    _attitude_rows(consts, state, work, count, _READ_TRIG, False)
     for j in range(count):
         ch, sh = work[_READ_TRIG, j], work[_READ_TRIG + 1, j]
         cp, sp = work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j]
@@ -455,27 +476,28 @@ def _sample_matrix(consts, work, count, row):
         work[row + 6, j], work[row + 7, j], work[row + 8, j] = x2, y2, z2
 
 
-@njit(cache=True)
-def _sample_state(consts, pairs, amplitudes, components, read_table, k, c, turned, work,
-                  count, shifted):
-    """The INS's motion at read point k, shifted in time by work[_SHIFT] if `shifted`
-    (the phases turned into `turned`): values and rates of the degrees of freedom in
-    work, the INS velocity (north, east, up) in rows _READ_VELOCITY [m s-1]."""
-    phases = c
-    if shifted:
-        _turn_phases(components, c, work, count, turned)
-        phases = turned
-    _motion(pairs, amplitudes, read_table, k, phases, work, count)
-    ship_n, ship_e, ship_u = consts[_SHIP_NORTH], consts[_SHIP_EAST], consts[_SHIP_UP]
-    level_c, level_s = consts[_LEVEL_COS], consts[_LEVEL_SIN]
-    for j in range(count):
-        surge, sway = work[_RATE_ROW + 3, j], work[_RATE_ROW + 4, j]
-        work[_READ_VELOCITY, j] = ship_n + (level_c * surge - level_s * sway)
-        work[_READ_VELOCITY + 1, j] = ship_e + (level_s * surge + level_c * sway)
-        work[_READ_VELOCITY + 2, j] = ship_u + work[_RATE_ROW + 5, j]
+@_inline
+def _ins_velocity(head, state, j):
+    """The INS's true velocity (north, east, up) [m s-1]: the ship's plus the
+    translational motion's rates turned by the static heading."""
+    surge, sway = state[_RATE_ROW + 3, j], state[_RATE_ROW + 4, j]
+    level_c, level_s = head[_LEVEL_COS], head[_LEVEL_SIN]
+    return (head[_SHIP_NORTH] + (level_c * surge - level_s * sway),
+            head[_SHIP_EAST] + (level_s * surge + level_c * sway),
+            head[_SHIP_UP] + state[_RATE_ROW + 5, j])
 
 
-@njit(cache=True)
+@_inline
+def _velocity_errors(head, work, j, vn, ve, vu):
+    """A velocity reading with its errors (rows _SOG, _COG, _HEAVE: zero, (1, 0) and zero
+    when not given): sog along the static course, cog turns, heave adds."""
+    sog = work[_SOG, j]
+    vn, ve = vn + sog * head[_COURSE_COS], ve + sog * head[_COURSE_SIN]
+    ce, se = work[_COG, j], work[_COG + 1, j]
+    return ce * vn - se * ve, se * vn + ce * ve, vu + work[_HEAVE, j]
+
+
+@_helper
 def _sample_times(stamp, clock, offset, rate, second, mode, start, count, work):
     """The time shift from the stamp to the INS sample a read at stamp + delta uses
     (work[_SHIFT], the first or the `second` sample), with the fraction of the second
@@ -493,87 +515,165 @@ def _sample_times(stamp, clock, offset, rate, second, mode, start, count, work):
         work[_SHIFT, j] = (zero + (index + second) / rate) - stamp
 
 
-@njit(cache=True)
+@_helper
+def _error_rows(errors, has, start, count, k, work):
+    """The errors of reading k into the rows _ERROR (heading, pitch, roll [rad]), _SOG,
+    _COG ((cos, sin)) and _HEAVE; rows of errors not given keep their neutral values."""
+    for i in range(6):
+        if not has[i]:
+            continue
+        error = errors[i]
+        col = k if error.shape[1] > 1 else 0
+        row = (_ERROR, _ERROR + 1, _ERROR + 2, _SOG, _ANGLE, _HEAVE)[i]
+        scale = 1.0 if i == 3 or i == 5 else _DEG
+        if error.shape[0] == 1:
+            work[row, :count] = error[0, col] * scale
+        else:
+            for j in range(count):
+                work[row, j] = error[start + j, col] * scale
+        if i == 4:
+            sincos_rows(work, _ANGLE, _COG + 1, _COG, count)
+
+
+@_helper
 def _reading(consts, pairs, amplitudes, components, read_table, stamps, k, c, turned,
-             errors, has, start, count, work):
+             errors, has, start, count, state, work, trig_rows):
     """The INS reading of read point k (the beam k for ``pointwise``, else the scan's mid
-    time) for trials [start, start + count): the (cos, sin) of its heading, pitch and roll
-    with their errors (rows _READ_TRIG), the angular rates (_READ_RATE: heading, pitch,
-    roll) and the velocity with its errors (_READ_VELOCITY), as
-    :func:`uq.physics.timeresolved.ins_state` and the reading errors there."""
+    time) for trials [start, start + count), as :func:`uq.physics.timeresolved.ins_state`
+    and its reading errors: the motion's values and rates there in `state` (rates
+    interpolated for ``linear``) and the errors in work's rows; the (cos, sin) of the read
+    attitude with its errors (rows _READ_TRIG) and the read velocity with its errors
+    (_READ_VELOCITY) where the point-wise loop does not compute them (`trig_rows`, and
+    always for ``linear``). Returns whether those rows were written."""
+    head = _head(consts)
     mode, rate, stamp = int(consts[_INS_MODE]), consts[_RATE], stamps[k]
-    clock, offset = errors[_CLOCK][:, 0], errors[_OFFSET][:, 0]
+    _error_rows(errors, has, start, count, k, work)
     if mode == CONTINUOUS:                  # c turned by w delta beforehand (reconstruct)
-        _sample_state(consts, pairs, amplitudes, components, read_table, k, c, turned, work,
-                      count, False)
+        _motion(pairs, amplitudes, read_table, k, c, state, count)
     else:                                   # the INS samples at offset + i / rate
+        clock, offset = errors[_CLOCK][:, 0], errors[_OFFSET][:, 0]
         _sample_times(stamp, clock, offset, rate, 0, mode, start, count, work)
-        _sample_state(consts, pairs, amplitudes, components, read_table, k, c, turned, work,
-                      count, True)
+        _turn_phases(components, c, work, count, turned)
+        _motion(pairs, amplitudes, read_table, k, turned, state, count)
         if mode == LINEAR:                  # keep the first sample; then the second
-            _sample_matrix(consts, work, count, _MATRIX1)
+            _sample_matrix(consts, state, work, count, _MATRIX1)
+            for j in range(count):
+                work[_VELOCITY1, j], work[_VELOCITY1 + 1, j], work[_VELOCITY1 + 2, j] = \
+                    _ins_velocity(head, state, j)
             for i in range(3):
-                work[_RATES1 + i, :count] = work[_RATE_ROW + 2 - i, :count]
-                work[_VELOCITY1 + i, :count] = work[_READ_VELOCITY + i, :count]
+                work[_RATES1 + i, :count] = state[_RATE_ROW + 2 - i, :count]
             _sample_times(stamp, clock, offset, rate, 1, mode, start, count, work)
-            _sample_state(consts, pairs, amplitudes, components, read_table, k, c, turned,
-                          work, count, True)
-            _sample_matrix(consts, work, count, _MATRIX2)
-            for i in range(3):              # rates and velocity linearly
-                for j in range(count):
-                    a = work[_FRACTION, j]
-                    work[_RATE_ROW + 2 - i, j] = (1 - a) * work[_RATES1 + i, j] \
-                        + a * work[_RATE_ROW + 2 - i, j]
-                    work[_READ_VELOCITY + i, j] = (1 - a) * work[_VELOCITY1 + i, j] \
-                        + a * work[_READ_VELOCITY + i, j]
+            _turn_phases(components, c, work, count, turned)
+            _motion(pairs, amplitudes, read_table, k, turned, state, count)
+            _sample_matrix(consts, state, work, count, _MATRIX2)
+            for j in range(count):          # rates and velocity linearly, with errors
+                a = work[_FRACTION, j]
+                for i in range(3):
+                    state[_RATE_ROW + 2 - i, j] = (1 - a) * work[_RATES1 + i, j] \
+                        + a * state[_RATE_ROW + 2 - i, j]
+                vn, ve, vu = _ins_velocity(head, state, j)
+                vn = (1 - a) * work[_VELOCITY1, j] + a * vn
+                ve = (1 - a) * work[_VELOCITY1 + 1, j] + a * ve
+                vu = (1 - a) * work[_VELOCITY1 + 2, j] + a * vu
+                work[_READ_VELOCITY, j], work[_READ_VELOCITY + 1, j], \
+                    work[_READ_VELOCITY + 2, j] = _velocity_errors(head, work, j, vn, ve, vu)
             _slerp(work, count)
-    for i in range(3):                      # heading, pitch, roll rates
-        work[_READ_RATE + i, :count] = work[_RATE_ROW + 2 - i, :count]
-    # the attitude with its errors, added to the Euler angles
-    if mode == LINEAR:                      # (cos, sin) of the slerp's angles + error
-        for i in range(3):
-            if has[i]:
-                work[_ANGLE, :count] = 0.0
-                _error_row(errors[i], start, count, k, work, _ANGLE)
-                sincos_rows(work, _ANGLE, _ERROR + 1, _ERROR, count)
-                row = _READ_TRIG + 2 * i
-                for j in range(count):
-                    co, si = work[row, j], work[row + 1, j]
-                    ce, se = work[_ERROR, j], work[_ERROR + 1, j]
-                    work[row, j], work[row + 1, j] = co * ce - si * se, si * ce + co * se
+            for i in range(3):              # (cos, sin) of the slerp's angle + error
+                if has[i]:
+                    sincos_rows(work, _ERROR + i, _SINE, _COSINE, count)
+                    row = _READ_TRIG + 2 * i
+                    for j in range(count):
+                        co, si = work[row, j], work[row + 1, j]
+                        ce, se = work[_COSINE, j], work[_SINE, j]
+                        work[row, j], work[row + 1, j] = co * ce - si * se, si * ce + co * se
+            return True
+    if not trig_rows:
+        return False
+    _attitude_rows(consts, state, work, count, _READ_TRIG, True)
+    for j in range(count):
+        vn, ve, vu = _ins_velocity(head, state, j)
+        work[_READ_VELOCITY, j], work[_READ_VELOCITY + 1, j], work[_READ_VELOCITY + 2, j] = \
+            _velocity_errors(head, work, j, vn, ve, vu)
+    return True
+
+
+#: Where the point-wise loop takes a reading's attitude from: its angles (sines and
+#: cosines in the loop), the rows of :func:`_reading` (linear interpolation), or the
+#: truth's state at the same time (readings at the nodes, no attitude errors).
+FROM_ANGLES, FROM_ROWS, FROM_STATE = range(3)
+
+
+@_inline
+def _pointwise_at(head, state, work, nx, ny, nz, j, exact, heading_varies, source):
+    """Beam k's reading for trial j (point-wise): the beam it implies, ``R_read n_k``, into
+    rows _BEAM and the lidar velocity along it into _ALONG (see :data:`FROM_ANGLES`)."""
+    if source == FROM_ROWS:
+        ch, sh = work[_READ_TRIG, j], work[_READ_TRIG + 1, j]
+        cp, sp = work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j]
+        cr, sr = work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j]
+        vn, ve, vu = (work[_READ_VELOCITY, j], work[_READ_VELOCITY + 1, j],
+                      work[_READ_VELOCITY + 2, j])
     else:
-        _read_angle_trig(work, count, consts[_HEADING], 2, consts[_MOVES_YAW] > 0, errors[0],
-                         start, k, has[0], _READ_TRIG)
-        _read_angle_trig(work, count, consts[_PITCH], 1, consts[_MOVES_PITCH] > 0, errors[1],
-                         start, k, has[1], _READ_TRIG + 2)
-        _read_angle_trig(work, count, consts[_ROLL], 0, consts[_MOVES_ROLL] > 0, errors[2],
-                         start, k, has[2], _READ_TRIG + 4)
-    # the velocity with its errors: sog along the static course, cog turns, heave adds
-    if has[3]:
-        error = errors[3]
-        col = k if error.shape[1] > 1 else 0
-        course_c, course_s = consts[_COURSE_COS], consts[_COURSE_SIN]
-        for j in range(count):
-            e = error[start + j if error.shape[0] > 1 else 0, col]
-            work[_READ_VELOCITY, j] += e * course_c
-            work[_READ_VELOCITY + 1, j] += e * course_s
-    if has[4]:
-        work[_ANGLE, :count] = 0.0
-        _error_row(errors[4], start, count, k, work, _ANGLE)
-        sincos_rows(work, _ANGLE, _ERROR + 1, _ERROR, count)
-        for j in range(count):
-            vn, ve = work[_READ_VELOCITY, j], work[_READ_VELOCITY + 1, j]
-            ce, se = work[_ERROR, j], work[_ERROR + 1, j]
-            work[_READ_VELOCITY, j] = ce * vn - se * ve
-            work[_READ_VELOCITY + 1, j] = se * vn + ce * ve
-    if has[5]:
-        error = errors[5]
-        col = k if error.shape[1] > 1 else 0
-        for j in range(count):
-            work[_READ_VELOCITY + 2, j] += error[start + j if error.shape[0] > 1 else 0, col]
+        if source == FROM_STATE:
+            ch, sh = state[_TRIG, j], state[_TRIG + 1, j]
+            cp, sp = state[_TRIG + 2, j], state[_TRIG + 3, j]
+            cr, sr = state[_TRIG + 4, j], state[_TRIG + 5, j]
+        else:
+            heading = (head[_HEADING] + state[_VALUE + 2, j]) + work[_ERROR, j]
+            pitch = (head[_PITCH] + state[_VALUE + 1, j]) + work[_ERROR + 1, j]
+            roll = (head[_ROLL] + state[_VALUE, j]) + work[_ERROR + 2, j]
+            if heading_varies:
+                sh, ch = _trig(heading, exact)
+            else:
+                ch, sh = head[_LEVEL_COS], head[_LEVEL_SIN]
+            sp, cp = _trig(pitch, exact)
+            sr, cr = _trig(roll, exact)
+            work[_BIG, j] = abs(pitch) + abs(roll) + (abs(heading) if heading_varies else 0.0)
+        vn, ve, vu = _ins_velocity(head, state, j)
+        vn, ve, vu = _velocity_errors(head, work, j, vn, ve, vu)
+    if head[_HAS_ARM] > 0:                  # the lever arm's velocity, R' r
+        dx, dy, dz = rotate_rate(ch, sh, cp, sp, cr, sr, state[_RATE_ROW + 2, j],
+                                 state[_RATE_ROW + 1, j], state[_RATE_ROW, j],
+                                 head[_ARM_BOW], head[_ARM_STARBOARD], head[_ARM_UP])
+        vn, ve, vu = vn + dx, ve + dy, vu + dz
+    bx, by, bz = rotate(ch, sh, cp, sp, cr, sr, nx, ny, nz)
+    work[_BEAM, j], work[_BEAM + 1, j], work[_BEAM + 2, j] = bx, by, bz
+    work[_ALONG, j] = bx * vn + by * ve + bz * vu
 
 
-@njit(cache=True)
+@_helper
+def _pointwise(consts, state, work, normal, nx, ny, nz, count, heading_varies, source):
+    """:func:`_pointwise_at` for the block's trials (one SIMD loop per case, then libm
+    where an angle is beyond the reduction), and ``B^T B`` accumulated."""
+    head = _head(consts)
+    if source == FROM_ROWS:
+        for j in range(count):
+            _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_ROWS)
+    elif source == FROM_STATE:
+        for j in range(count):
+            _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_STATE)
+    else:
+        if heading_varies:
+            for j in range(count):
+                _pointwise_at(head, state, work, nx, ny, nz, j, False, True, FROM_ANGLES)
+        else:
+            for j in range(count):
+                _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_ANGLES)
+        for j in range(count):
+            if not work[_BIG, j] <= SINCOS_REDUCTION_LIMIT:
+                _pointwise_at(head, state, work, nx, ny, nz, j, True, heading_varies,
+                              FROM_ANGLES)
+    for j in range(count):
+        bx, by, bz = work[_BEAM, j], work[_BEAM + 1, j], work[_BEAM + 2, j]
+        normal[0, j] += bx * bx
+        normal[1, j] += bx * by
+        normal[2, j] += bx * bz
+        normal[3, j] += by * by
+        normal[4, j] += by * bz
+        normal[5, j] += bz * bz
+
+
+@_helper
 def _solve(normal, n_gates, count, out):
     """out[:, g] = (B^T B)^-1 B^T v of each gate, by Cholesky (B^T B is symmetric positive
     definite when the beams span the space); the factor overwrites B^T B."""
@@ -599,7 +699,7 @@ def _solve(normal, n_gates, count, out):
             out[2, g, j] = x2
 
 
-@njit(cache=True)
+@_helper
 def _scan_correction(consts, model, work, normal, n_gates, count, out):
     """Eq. 13 of Rubio and Gottschall (2022) with the scan's one reading
     (:mod:`uq.physics.correction`): ``none`` turns by the configured heading, ``yaw`` by
@@ -608,7 +708,8 @@ def _scan_correction(consts, model, work, normal, n_gates, count, out):
     vertical for ``full``; nothing for ``none``); the vertical wind of all but ``full`` is
     the lidar-frame one."""
     if model == NONE:
-        work[_READ_TRIG, :count], work[_READ_TRIG + 1, :count] = consts[_LEVEL_COS], consts[_LEVEL_SIN]
+        work[_READ_TRIG, :count] = consts[_LEVEL_COS]
+        work[_READ_TRIG + 1, :count] = consts[_LEVEL_SIN]
         for i in range(3):
             work[_READ_VELOCITY + i, :count] = 0.0
     if model == NONE or model == YAW:
@@ -627,24 +728,24 @@ def _scan_correction(consts, model, work, normal, n_gates, count, out):
             out[2, g, j] = up + work[_READ_VELOCITY + 2, j] if full else z
 
 
-@njit(f"void({_CV}, {_IM}, {_CM}, {_CM}, {_CT}, {_CV}, {_CM}, {_CM}, {_CV}, "
-      f"UniTuple({_M}, 8), int64[::1], {_T}, int64, int64, {_CM}, {_CT}, {_CT}, {_CT}, "
-      f"{_CT}, {_CM}, {_CT})", cache=True)
+@_kernel(f"void({_CV}, {_IM}, {_CM}, {_CM}, {_CT}, {_CV}, {_CM}, {_CM}, {_CV}, "
+         f"UniTuple({_M}, 8), int64[::1], {_T}, int64, int64, {_CM}, {_CT}, {_CT}, {_CT}, "
+         f"{_CT}, {_CT}, {_CM}, {_CT})")
 def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams, operator,
-                weights, errors, has, noise, start, count, work, c, turned, parts, profile,
-                normal, out):
+                weights, errors, has, noise, start, count, work, c, turned, states, parts,
+                profile, normal, out):
     """The reconstructed wind of trials [start, start + count).
 
     ``profile[node, g]`` is U(z) / U_ref at the gates (numpy's power law applied to the
     ratio of :func:`kinematics`); ``errors`` the INS inputs of :data:`INPUTS`, each (n or
-    1, k or 1), ``has`` which are given; ``normal`` (6 + 3 g, trials) scratch for the
-    least squares. Writes ``out[0, g]`` north, ``out[1, g]`` east, ``out[2, g]`` up
-    [m s-1].
+    1, k or 1), ``has`` which are given; ``states`` one per beam when the point-wise
+    readings are the truth's nodes (from :func:`kinematics`), else one of scratch;
+    ``normal`` (6 + 3 g, trials) scratch for the least squares. Writes ``out[0, g]``
+    north, ``out[1, g]`` east, ``out[2, g]`` up [m s-1].
     """
     n_beams, n_gates, n_nodes = int(consts[_N_BEAMS]), int(consts[_N_GATES]), int(consts[_N_NODES])
     model, mode, speed_ref = int(consts[_MODEL]), int(consts[_INS_MODE]), consts[_WIND_SPEED]
-    has_arm = consts[_HAS_ARM] > 0
-    arm_x, arm_y, arm_z = consts[_ARM_BOW], consts[_ARM_STARBOARD], consts[_ARM_UP]
+    at_nodes = states.shape[0] > 1
     phases = c
     if mode == CONTINUOUS and has[_CLOCK]:            # read at t + delta: turn the phases
         clock = errors[_CLOCK]
@@ -652,36 +753,30 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
             work[_SHIFT, j] = clock[start + j if clock.shape[0] > 1 else 0, 0]
         _turn_phases(components, c, work, count, turned)
         phases = turned
+    for i in range(3):                                # neutral errors
+        work[_ERROR + i, :count] = 0.0
+    work[_SOG, :count], work[_HEAVE, :count] = 0.0, 0.0
+    work[_COG, :count], work[_COG + 1, :count] = 1.0, 0.0
+    if not at_nodes:
+        states[0, :_TRIG, :count] = 0.0
     if model != NONE and model != POINTWISE:          # one reading per scan
         _reading(consts, pairs, amplitudes, components, read_table, stamps, 0, phases, turned,
-                 errors, has, start, count, work)
+                 errors, has, start, count, states[0], work, True)
     normal[:, :count] = 0.0
-    per_trial_noise = noise.shape[0] > 1
+    heading_varies = consts[_MOVES_YAW] > 0 or has[0]
     for b in range(n_beams):
-        nx, ny, nz = beams[b, 0], beams[b, 1], beams[b, 2]
-        if model == POINTWISE:        # this beam's own reading: the beam and velocity it implies
-            _reading(consts, pairs, amplitudes, components, read_table, stamps, b, phases,
-                     turned, errors, has, start, count, work)
-            for j in range(count):
-                ch, sh = work[_READ_TRIG, j], work[_READ_TRIG + 1, j]
-                cp, sp = work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j]
-                cr, sr = work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j]
-                vn, ve, vu = (work[_READ_VELOCITY, j], work[_READ_VELOCITY + 1, j],
-                              work[_READ_VELOCITY + 2, j])
-                if has_arm:
-                    dx, dy, dz = rotate_rate(ch, sh, cp, sp, cr, sr, work[_READ_RATE, j],
-                                             work[_READ_RATE + 1, j], work[_READ_RATE + 2, j],
-                                             arm_x, arm_y, arm_z)
-                    vn, ve, vu = vn + dx, ve + dy, vu + dz
-                bx, by, bz = rotate(ch, sh, cp, sp, cr, sr, nx, ny, nz)
-                work[_BEAM, j], work[_BEAM + 1, j], work[_BEAM + 2, j] = bx, by, bz
-                work[_ALONG, j] = bx * vn + by * ve + bz * vu
-                normal[0, j] += bx * bx
-                normal[1, j] += bx * by
-                normal[2, j] += bx * bz
-                normal[3, j] += by * by
-                normal[4, j] += by * bz
-                normal[5, j] += bz * bz
+        if model == POINTWISE:          # this beam's own reading: the beam and velocity it implies
+            state = states[b if at_nodes else 0]
+            if at_nodes:                # the truth's motion is the reading's: errors only
+                _error_rows(errors, has, start, count, b, work)
+                source = FROM_ANGLES if has[0] or has[1] or has[2] else FROM_STATE
+            else:
+                written = _reading(consts, pairs, amplitudes, components, read_table, stamps,
+                                   b, phases, turned, errors, has, start, count, state, work,
+                                   False)
+                source = FROM_ROWS if written else FROM_ANGLES
+            _pointwise(consts, state, work, normal, beams[b, 0], beams[b, 1], beams[b, 2],
+                       count, heading_varies, source)
         beam = b if noise.shape[1] > 1 else 0
         for g in range(n_gates):
             work[_MEASURED, :count] = 0.0                # the dwell mean of the truth
@@ -691,7 +786,7 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                     work[_MEASURED, j] += weight * (speed_ref * profile[node, g, j]
                                                     * parts[0, node, j] + parts[1, node, j])
             gate = g if noise.shape[2] > 1 else 0
-            if per_trial_noise:
+            if noise.shape[0] > 1:
                 for j in range(count):
                     work[_MEASURED, j] += noise[start + j, beam, gate]
             else:
@@ -715,7 +810,7 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
         _scan_correction(consts, model, work, normal, n_gates, count, out)
 
 
-@njit(f"void({_CT}, int64, {_CM}, {_CM})", cache=True)
+@_kernel(f"void({_CT}, int64, {_CM}, {_CM})")
 def wind_speed(out, count, speed, vertical):
     """speed[g, j] = |(north, east)| (sqrt(x^2 + y^2); libm's hypot where the squares could
     over- or underflow), vertical[g, j] = up, for the block's trials j < count."""
