@@ -2,6 +2,7 @@
 
 Nothing else in the package writes a bare number that carries meaning.
 """
+import math
 
 #: Coverage probability of the reported coverage intervals [1]. JCGM 101:2008, 7.7.
 COVERAGE_PROBABILITY = 0.95
@@ -251,3 +252,42 @@ WINDCUBE_PULSE_FWHM = 22.5
 ZEPHIR_WAVELENGTH_UM = 1.565
 ZEPHIR_BEAM_RADIUS_MM = 28.0
 ZEPHIR_TRUNCATION = 0.02
+
+# --- compiled time-resolved model (issue 17, item 8: uq.physics.fusedmotion) -------------
+
+#: pi / 2 in three parts [rad] for the Cody-Waite argument reduction of the compiled
+#: sine and cosine (:func:`uq.physics.fusedmotionkernels.sincos`): the first two carry
+#: 33 significant bits each, so k times them is exact for |k| < 2^20, and their sum with
+#: the third is pi / 2 to 1e-37 (tested). fdlibm's ``pio2_1``, ``pio2_2``, ``pio2_2t``
+#: (Sun Microsystems, e_rem_pio2.c, 1993); Cody, W. J. and Waite, W. (1980). Software
+#: Manual for the Elementary Functions. Prentice-Hall, Ch. 8.
+HALF_PI_PARTS = (float.fromhex("0x1.921fb54400000p+0"), float.fromhex("0x1.0b4611a600000p-34"),
+                 float.fromhex("0x1.3198a2e037073p-69"))
+
+#: Largest |angle| [rad] whose sine and cosine the compiled time-resolved model takes
+#: from its SIMD polynomials after reduction by k pi / 2 (beyond it, and for NaN, libm):
+#: 2^19 pi / 2 keeps |k| <= 2^19, where k times the 33-bit parts of
+#: :data:`HALF_PI_PARTS` is exact, so the reduced angle is exact to an ulp of itself
+#: (fdlibm's medium-size path covers |x| < 2^20 pi / 2). The model's angles (attitudes,
+#: w t of the motion) are below 1e4 rad.
+SINCOS_REDUCTION_LIMIT = 2.0**19 * math.pi / 2
+
+#: Largest sin^2 of the rotation between two INS samples [1] that the compiled slerp
+#: (:func:`uq.physics.fusedmotionkernels.slerp_factors`) takes from its power series
+#: (arcsin s / s to s^50; Abramowitz and Stegun (1964), 4.4.40): at sin^2 = 0.25 (30 deg
+#: between samples) the first omitted term is 5e-19 relative. Larger rotations (an INS
+#: slower than the motion) use libm.
+SLERP_SERIES_LIMIT = 0.25
+
+#: Doubles of node scratch per block of trials in the compiled time-resolved model [1]
+#: (beams x dwell nodes x (gates + 2) per trial, :mod:`uq.physics.fusedmotion`): 2^15
+#: doubles = 256 kB stay in the L2 cache (2 MB per core here) with the rest of a block's
+#: scratch; the block then holds 2^15 / (5 x 3) = 2048 trials of a DBS scan of one gate,
+#: 2^15 / (50 x 3) = 218 of a 50-beam conical scan.
+MOTION_BLOCK_VALUES = 2**15
+
+#: Fewest and most trials per block of the compiled time-resolved model [1]: at least
+#: 64 so that the per-block Python work (two kernel calls, numpy's log, exp and arctan2:
+#: ~20 us) stays below ~1 % of a block's time for any scan; at most 2^11, beyond which a
+#: larger block gains nothing (measured on a 5-beam DBS scan, scripts/bench_motion.py).
+MOTION_BLOCK_TRIALS = (64, 2**11)

@@ -156,7 +156,8 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
     `scene_draws` (bool): the errors carry the scene axes (independent draws per scene).
     `compiled` (bool): where it applies (:func:`uq.fused.applicable`: one scene, real
     errors, wind outputs), evaluate with the compiled loop of :mod:`uq.physics.fused`, which
-    gives the same values to 1e-12; False forces the numpy arrays below.
+    gives the same values to 1e-12; False forces the numpy arrays below. A time-resolved
+    scene passes it on (:func:`uq.physics.timeresolved.measurement_model`).
 
     Returns
     -------
@@ -169,7 +170,8 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
         scene = probe_volume.resolve(scene)
     if scene.time_resolved is not None:       # motion within the scan: its own model
         from uq.physics import timeresolved
-        return timeresolved.measurement_model(scene, outputs, scene_draws, **errors)
+        return timeresolved.measurement_model(scene, outputs, scene_draws, compiled=compiled,
+                                              **errors)
     if compiled:
         from uq.physics import fused  # (numba: imported only where it may apply)
         result = fused.evaluate(scene, outputs, scene_draws, errors)

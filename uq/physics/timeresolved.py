@@ -61,10 +61,20 @@ TIME_RESOLVED_INPUTS = ("motion_phases", "motion_window", "ins_clock_offset",
 PROBE_ERRORS = tuple(PARAMETER_SCALE)
 
 
-def measurement_model(scene, outputs, scene_draws=False, **errors):
+def measurement_model(scene, outputs, scene_draws=False, compiled=True, **errors):
     """The time-resolved model for a scene or a batch of scenes (evaluated scene by
     scene); same inputs and outputs as :func:`uq.physics.measurement.measurement_model`,
-    plus those of :data:`TIME_RESOLVED_INPUTS`."""
+    plus those of :data:`TIME_RESOLVED_INPUTS`.
+
+    `compiled` (bool): where it applies (:func:`uq.physics.fusedmotion.applicable`: real
+    inputs, wind outputs, no probe volume), evaluate with the compiled loops of
+    :mod:`uq.physics.fusedmotion`, which give the same values to 1e-12 m/s; False forces
+    the numpy arrays below.
+    """
+    if compiled and scene.probe is None:
+        from uq.physics import fusedmotion    # (numba: imported only where it may apply)
+        if fusedmotion.applicable(scene, outputs, errors, scene_draws):
+            return fusedmotion.measurement_model(scene, outputs, scene_draws, **errors)
     shape = scene.shape
     if not shape:
         return single_scene(scene, outputs, **errors)

@@ -1,0 +1,159 @@
+"""The compiled time-resolved model (:mod:`uq.physics.fusedmotion`) against the numpy
+model of :mod:`uq.physics.timeresolved`, its second implementation: the same trials
+(inputs drawn from the scenario's own engine inputs) give the same outputs to 1e-12 m/s.
+
+Why 1e-12: both compute the same products and sums of O(1-30) terms in float64 in a
+different order (the compiled model turns phase vectors where numpy evaluates sin(w t +
+psi) afresh, uses a Cholesky solve where numpy multiplies by A+, and SIMD polynomial sines
+to 1 ulp); each step loses a few ulp of the 10-30 m s-1 values, 2.2e-16 x 30 x ~100
+operations ~ 1e-12 m s-1 at most. Directions compare as angles times the speed (an
+arc length [m s-1]), so that a direction is held to the same 1e-12 m s-1.
+"""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from uq.engine.inputs import input_set
+from uq.physics import fusedmotion
+from uq.physics.measurement import measurement_model
+from uq.pipeline.runner import error_inputs, scene_from_settings
+from uq.pipeline.scenario import load_scenario
+
+OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind")
+VAD = [i * 7.2 for i in range(50)]
+TOLERANCE = 1e-12          # [m s-1] the module docstring's rounding bound
+
+BASE = {"wind": {"speed": 12.0, "direction": 210.0, "vertical": 0.1, "shear": 0.14},
+        "ship": {"heading": 35.0, "pitch": 1.0, "roll": -2.0, "sog": 1.2, "cog": 50.0},
+        "lidar": {"ranges": [40.0, 100.0, 200.0], "scan": {"beam_duration": 1.0},
+                  "lever_arm": [1.5, -0.8, 4.0],
+                  "errors": {"radial_velocity": {"dist": "normal", "u": 0.1}}},
+        "motion": {"roll": {"amplitude": 6.0, "period": 7.0},
+                   "pitch": {"amplitude": 4.0, "period": 5.5, "phase": 30.0},
+                   "heave": {"amplitude": 1.0, "period": 7.0}},
+        "ins": {"heading": {"dist": "normal", "u": 0.5}, "pitch": {"dist": "normal", "u": 0.1},
+                "roll": {"dist": "normal", "u": 0.1}, "sog": {"dist": "normal", "u": 0.05},
+                "cog": {"dist": "normal", "u": 1.0}},
+        "correction": "pointwise"}
+
+
+def merged(base, changes):
+    out = {key: (dict(value) if isinstance(value, dict) else value)
+           for key, value in base.items()}
+    for dotted, value in changes.items():
+        node = out
+        *parents, last = dotted.split(".")
+        for part in parents:
+            node[part] = dict(node.get(part, {}))
+            node = node[part]
+        if value is None:
+            node.pop(last, None)
+        else:
+            node[last] = value
+    return out
+
+
+def both(changes, n=300, seed=7, scene_draws=False, batch=None):
+    """(compiled, numpy) outputs of `n` trials of the scenario BASE + `changes`, the same
+    inputs for both, drawn from the scenario's engine inputs; `batch` (field -> array)
+    makes a batch of scenes of the scene's fields."""
+    settings = load_scenario({"name": "t", **merged(BASE, changes)}).settings
+    scene = dataclasses.replace(scene_from_settings(settings), **(batch or {}))
+    inputs = error_inputs(settings, scene.n_beams, len(scene.ranges))
+    constant = {k: v for k, v in inputs.items() if isinstance(v, float)}
+    random = input_set({k: v for k, v in inputs.items() if not isinstance(v, float)})
+    rng = np.random.default_rng(seed)
+    axes = scene.shape if scene_draws else ()
+    errors = random.values(rng.standard_normal((n * int(np.prod(axes)), random.dimension)))
+    if scene_draws:
+        errors = {k: v.reshape((n,) + axes + v.shape[1:]) for k, v in errors.items()}
+    errors.update(constant)
+    assert fusedmotion.applicable(scene, OUTPUTS, errors, scene_draws)
+    fast = measurement_model(scene, OUTPUTS, scene_draws, **errors)
+    slow = measurement_model(scene, OUTPUTS, scene_draws, compiled=False, **errors)
+    return fast, slow
+
+
+def assert_same(fast, slow):
+    speed = slow["wind_speed"]
+    assert np.all(np.isfinite(speed))
+    np.testing.assert_allclose(fast["wind_speed"], speed, rtol=0, atol=TOLERANCE)
+    np.testing.assert_allclose(fast["vertical_wind"], slow["vertical_wind"], rtol=0,
+                               atol=TOLERANCE)
+    turn = (fast["wind_direction"] - slow["wind_direction"] + 180.0) % 360.0 - 180.0
+    assert np.max(np.abs(np.deg2rad(turn)) * speed) < TOLERANCE
+
+
+CASES = {
+    "pointwise, continuous INS": {},
+    "pointwise, 10 Hz linear INS": {"ins.rate": 10.0, "ins.interpolation": "linear"},
+    "pointwise, 10 Hz nearest INS": {"ins.rate": 10.0, "ins.interpolation": "nearest"},
+    "pointwise, clock offset": {"ins.clock_offset": {"dist": "normal", "u": 0.02}},
+    "pointwise, Gauss-Markov INS": {"ins.heading.correlation_time": 3.0,
+                                    "ins.sog.correlation_time": 2.0},
+    "pointwise, beam INS": {"ins.correlation": "beam"},
+    "pointwise, dwell average": {"lidar.scan.dwell_average": True},
+    "pointwise, end stamps": {"lidar.scan.timestamp": "end"},
+    "full (one reading per scan)": {"correction": "full"},
+    "yaw": {"correction": "yaw"},
+    "tilt2d": {"correction": "tilt2d"},
+    "none": {"correction": "none"},
+    "no shear": {"wind.shear": 0.0},
+    "no lever arm": {"lidar.lever_arm": None},
+    "all six degrees of freedom": {
+        "motion.yaw": {"amplitude": 2.0, "period": 9.0},
+        "motion.surge": {"amplitude": 0.5, "period": 6.0, "phase": "random"},
+        "motion.sway": {"amplitude": 0.7, "period": 8.0}},
+    "geometry errors": {"lidar.errors.half_cone": {"dist": "normal", "u": 0.1},
+                        "lidar.errors.misalignment": {"dist": "normal", "u": 0.5},
+                        "lidar.errors.height": {"dist": "normal", "u": 0.2}},
+    "VAD of 50 lines of sight": {"lidar.azimuths": VAD, "lidar.vertical_beam": False,
+                                 "lidar.scan.beam_duration": 0.02},
+    "JONSWAP sea": {"motion": {"spectrum": {"kind": "jonswap", "hs": 2.0, "tp": 8.0,
+                                            "gamma": 3.3, "components": 12},
+                               "response": {"roll": {"factor": 2.0, "lag": 90},
+                                            "pitch": {"factor": 1.5},
+                                            "heave": {"factor": 1.0}}},
+                    "ins.rate": 10.0, "ins.interpolation": "linear"},
+}
+
+
+@pytest.mark.parametrize("changes", CASES.values(), ids=CASES.keys())
+def test_compiled_equals_numpy(changes):
+    assert_same(*both(changes))
+
+
+_DIRECTION, _ROLL = np.meshgrid([0.0, 120.0, 250.0], [-5.0, 0.0, 3.0], indexing="ij")
+BATCH = {"wind_direction": np.deg2rad(_DIRECTION), "roll": np.deg2rad(_ROLL)}  # 3 x 3 [rad]
+
+
+@pytest.mark.parametrize("scene_draws", [False, True], ids=["common draws", "scene draws"])
+def test_a_batch_of_scenes(scene_draws):
+    """A batch (swept wind direction x static roll): with common draws, and with each
+    scene's own draws (``scene_draws``)."""
+    assert_same(*both({}, n=64, scene_draws=scene_draws, batch=BATCH))
+
+
+def test_a_complex_step_takes_the_numpy_model():
+    """The GUM's complex steps are not compiled: applicable says no (the numpy model
+    alone evaluates them)."""
+    settings = load_scenario({"name": "t", **BASE}).settings
+    scene = scene_from_settings(settings)
+    assert not fusedmotion.applicable(scene, OUTPUTS, {"ins_sog": np.array([1e-20j])})
+    assert not fusedmotion.applicable(scene, OUTPUTS + ("radial_velocity",), {})
+
+
+def test_a_measured_record(tmp_path):
+    """A measured record (motion.series): its window start is the input
+    ``motion_window``, beside random phases of a harmonic."""
+    times = np.arange(0.0, 120.0, 0.1)
+    rng = np.random.default_rng(1)
+    with open(tmp_path / "rec.csv", "w") as file:
+        file.write("t,r,h\n")
+        for t, noise in zip(times, rng.normal(0.0, 0.3, len(times))):
+            file.write(f"{t},{3 * np.sin(2 * np.pi * t / 6) + noise},{np.cos(t / 3)}\n")
+    assert_same(*both({"motion": {"series": {"file": str(tmp_path / "rec.csv"), "time": "t",
+                                             "columns": {"roll": "r", "heave": "h"},
+                                             "components": 20},
+                                  "pitch": {"amplitude": 2.0, "period": 5.0}}}))

@@ -1,0 +1,337 @@
+"""The time-resolved measurement model compiled (numba): beams at their own times, the
+platform's motion, the INS read at the beams' stamps, point-wise correction.
+
+:mod:`uq.physics.timeresolved` evaluates a scan in motion with numpy array passes over
+(trials, beams, dwell nodes, gates, 3) and (..., 3, 3) stacks; this module computes the
+same quantities in compiled loops over blocks of trials (:mod:`uq.physics.fusedmotionkernels`),
+each loop over the block's trials innermost on rows of scratch that stay in the cache,
+so the loops are SIMD code. What is the same for every trial is computed once per scene
+(:func:`scene_plan`): the measurement and read times, the sines and cosines of
+``w_k t + psi_dk`` there (only the unit phases c_k of the motion vary between trials),
+the configured beams and least-squares operator, the slant ranges. Per trial remain the
+motion sums, the sines and cosines of the attitude (SIMD polynomials), the rotations and
+the least squares; the power law is numpy's SIMD ``log`` and ``exp`` on the block.
+
+It is a second implementation of the physics, written from the conventions of
+:mod:`uq.physics.rotation`, :mod:`uq.physics.motion`, :mod:`uq.physics.ins`,
+:mod:`uq.physics.timing` and :mod:`uq.physics.correction` (rotations as products of the
+elementary ones, the lever-arm velocity by the product rule, the INS time shift as a
+turn of the phase vectors, Cholesky for the least squares), not from the array code;
+``tests/physics/test_fusedmotion.py`` checks that the two agree to 1e-12 m/s. The numpy
+model stays the reference and alone runs complex-step (the GUM Jacobian), a probe volume
+and the outputs ``radial_velocity`` and ``gate_height``; :func:`applicable` says when
+the compiled model is used. A batch of scenes is evaluated scene after scene.
+
+Conventions: those of :mod:`uq.physics.timeresolved` (earth frame north, east, up; ship
+frame bow, starboard, up; body-to-earth ``Rz(heading) Ry(pitch) Rx(roll)``; the INS read
+at ``t + delta``, sampled at ``offset + i / rate``; its errors added to the Euler angles,
+``sog`` along the static course, ``cog`` turning the horizontal velocity).
+"""
+import dataclasses
+import functools
+import math
+
+import numpy as np
+
+from uq.constants import FULL_CIRCLE_DEG, MOTION_BLOCK_TRIALS, MOTION_BLOCK_VALUES
+from uq.physics import fusedmotionkernels as kernels
+from uq.physics.beams import least_squares_operator, slant_distances
+from uq.physics.correction import CORRECTION_MODELS
+from uq.physics.motion import DEGREES_OF_FREEDOM
+from uq.physics.rotation import rotation_about_vertical, rotation_pitch, rotation_roll
+from uq.physics.scene import SCENE_FIELDS, sample_count
+
+#: Outputs the compiled model computes; any other requested output uses the numpy model.
+FUSED_OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind")
+_INS_MODES = {None: kernels.CONTINUOUS, "nearest": kernels.NEAREST, "linear": kernels.LINEAR}
+#: Inputs per trial (n,) of the geometry.
+_GEOMETRY = ("lidar_half_cone", "lidar_misalignment", "lidar_height")
+
+
+def applicable(scene, outputs, errors, scene_draws=False):
+    """Can the compiled model evaluate this call of the time-resolved model?
+
+    A time-resolved scene without a probe volume, only :data:`FUSED_OUTPUTS`, real
+    inputs (not the GUM's complex steps), and inputs of the shapes the pipeline gives:
+    INS errors (n,) or (n, k), phases (n, K, 2), radial noise (n, beams, gates) (each
+    may also be a scalar or have one row). Any batch of scenes, common draws or
+    ``scene_draws``.
+    """
+    if scene.time_resolved is None or scene.probe is not None or \
+            not set(outputs) <= set(FUSED_OUTPUTS):
+        return False
+    if any(np.iscomplexobj(value) for value in errors.values()):
+        return False
+    dims = len(scene.shape) if scene_draws else 0          # the scene axes of the draws
+    for name, value in errors.items():
+        ndim = np.ndim(value) - (dims if np.ndim(value) > 1 else 0)
+        if name.startswith("ins_") and name not in kernels.INPUTS[6:] and ndim > 2:
+            return False
+        if name in ("motion_phases", "motion_window") and ndim not in (0, 3):
+            return False
+        if name == "lidar_radial_velocity" and ndim not in (0, 3):
+            return False
+        if name in _GEOMETRY + kernels.INPUTS[6:] and ndim > 1:
+            return False
+    return True
+
+
+def measurement_model(scene, outputs, scene_draws=False, **errors):
+    """The compiled :func:`uq.physics.timeresolved.measurement_model` (same inputs and
+    outputs: each (n, *S, n_gates) for a batch of scenes of shape S, evaluated one scene
+    after the other; with `scene_draws` each scene takes its own slice of the inputs)."""
+    shape, gates = scene.shape, len(scene.ranges)
+    n = sample_count(errors)
+    result = {q: np.empty((n,) + shape + (gates,)) for q in FUSED_OUTPUTS if q in outputs}
+    for index in np.ndindex(*shape):
+        mine = errors if not scene_draws else {
+            name: value[(slice(None),) + index] if np.ndim(value) > 1 else value
+            for name, value in errors.items()}
+        into = {q: result[q][(slice(None),) + index] for q in result}      # (n, gates) views
+        _evaluate(scene_plan(_scene_at(scene, index)), mine, n, into)
+    return result
+
+
+def _scene_at(scene, index):
+    """Scene `index` of a batch, with float fields."""
+    return dataclasses.replace(scene, **{
+        name: float(np.broadcast_to(getattr(scene, name), scene.shape)[index])
+        for name in SCENE_FIELDS})
+
+
+@dataclasses.dataclass(frozen=True)
+class Plan:
+    """What a scene's trials share (:func:`scene_plan`), as the kernels' arrays.
+
+    Attributes
+    ----------
+    consts : ndarray
+        The scalars of :data:`uq.physics.fusedmotionkernels.HEAD`.
+    pairs : ndarray of int, shape (P, 2)
+        (component, degree of freedom) of each moving pair, in the order of the components.
+    amplitudes : ndarray, shape (P, 2)
+        (A, A w) of each pair [rad or m; per s].
+    components : ndarray, shape (K, 3)
+        w [rad s-1] and the fixed unit phase (cos, sin) of each component (zeros if random).
+    sources : ndarray of int, shape (K, 2)
+        Where a component's phase comes from (0 fixed, 1 ``motion_phases``, 2
+        ``motion_window``) and its column there.
+    node_table, read_table : ndarray, shape (2, P, b q) and (2, P, k)
+        sin and cos of ``w t + psi`` of every pair at the measurement times (beam-major,
+        then dwell node) and at the INS read times (the beams' stamps, or the scan's mid).
+    stamps : ndarray, shape (k,)
+        The read times [s].
+    weights : ndarray, shape (q,)
+        Dwell-average weights (sum 1).
+    azimuths : ndarray, shape (a, 2)
+        cos and sin of the slanted beams' azimuths.
+    beams : ndarray, shape (b, 3)
+        Configured unit vectors in the ship frame.
+    operator : ndarray, shape (3, b)
+        Their least-squares operator A^+.
+    slant : ndarray, shape (b, g)
+        Slant distances of the gates [m].
+    n_phases, n_window : int
+        Columns the inputs ``motion_phases`` and ``motion_window`` need.
+    at_nodes : bool
+        The point-wise readings of a continuous INS are at the measurement times (no dwell
+        average): without a clock offset the reading's motion is the truth's.
+    """
+
+    consts: np.ndarray
+    pairs: np.ndarray
+    amplitudes: np.ndarray
+    components: np.ndarray
+    sources: np.ndarray
+    node_table: np.ndarray
+    read_table: np.ndarray
+    stamps: np.ndarray
+    weights: np.ndarray
+    azimuths: np.ndarray
+    beams: np.ndarray
+    operator: np.ndarray
+    slant: np.ndarray
+    n_phases: int
+    n_window: int
+    at_nodes: bool
+
+
+def scene_plan(scene):
+    """The :class:`Plan` of one scene (scalar fields); cached (a scene is called once per
+    slice of trials)."""
+    try:
+        return _scene_plan(scene)
+    except TypeError:                       # a field that cannot be hashed: no cache
+        return _scene_plan.__wrapped__(scene)
+
+
+@functools.lru_cache(maxsize=256)
+def _scene_plan(scene):
+    resolved = scene.time_resolved
+    motion, timing, ins = resolved.motion, resolved.timing, resolved.ins
+    n_beams, components = scene.n_beams, motion.components
+    fastest = max((c.angular_frequency for c in components), default=0.0)
+    times, weights = timing.nodes(n_beams, fastest)                      # (b, q), (q,)
+    pointwise = scene.correction == "pointwise"
+    stamps = timing.stamps(n_beams) if pointwise else \
+        np.array([timing.scan_mid_time(n_beams)])
+    pairs = [(k, d) for k, c in enumerate(components) for d in range(len(DEGREES_OF_FREEDOM))
+             if c.amplitudes[d] != 0]
+    amplitudes = np.array([(components[k].amplitudes[d],
+                            components[k].amplitudes[d] * components[k].angular_frequency)
+                           for k, d in pairs], dtype=float).reshape(-1, 2)
+
+    def table(at):                          # sin, cos(w t + psi) of every pair, (2, P, T)
+        angles = np.array([components[k].angular_frequency * at + components[k].lags[d]
+                           for k, d in pairs], dtype=float).reshape(len(pairs), len(at))
+        return np.ascontiguousarray(np.stack([np.sin(angles), np.cos(angles)]))
+
+    random = motion.random_components
+    n_window = motion.window
+    n_phases = len(random) - n_window
+    sources = np.zeros((len(components), 2), dtype=np.int64)
+    fixed = np.zeros((len(components), 3))
+    for k, c in enumerate(components):
+        fixed[k, 0] = c.angular_frequency
+        if c.phase is None:
+            order = random.index(k)
+            sources[k] = (1, order) if order < n_phases else (2, order - n_phases)
+        else:
+            fixed[k, 1:] = math.cos(c.phase), math.sin(c.phase)
+    moves = [any(d == dof for _, d in pairs) for dof in range(3)]      # roll, pitch, yaw
+    arm = np.asarray(motion.lever_arm, dtype=float)
+    static = rotation_about_vertical(scene.heading) @ rotation_pitch(scene.pitch) \
+        @ rotation_roll(scene.roll) @ arm                                # R r at rest
+    beams = scene.nominal_unit_vectors()
+    azimuths = np.asarray(scene.azimuths, dtype=float)
+    head = {"n_beams": n_beams, "n_gates": len(scene.ranges), "n_nodes": times.shape[1],
+            "n_slanted": len(azimuths), "model": CORRECTION_MODELS.index(scene.correction),
+            "ins_mode": _INS_MODES[ins.rate and ins.interpolation],
+            "rate": ins.rate or 0.0, "to_north": -math.cos(scene.wind_direction),
+            "to_east": -math.sin(scene.wind_direction),        # (wind "from": blows to -e)
+            "vertical_wind": scene.vertical_wind,
+            "ship_north": scene.sog * math.cos(scene.cog),
+            "ship_east": scene.sog * math.sin(scene.cog), "ship_up": scene.heave,
+            "level_cos": math.cos(scene.heading), "level_sin": math.sin(scene.heading),
+            "course_cos": math.cos(scene.cog), "course_sin": math.sin(scene.cog),
+            "arm_bow": arm[0], "arm_starboard": arm[1], "arm_up": arm[2],
+            "static_arm_up": static[2], "moves_yaw": moves[2],
+            "has_arm": bool(np.any(arm != 0))}
+    consts = np.array([head[name] if name in head else getattr(scene, name)
+                       for name in kernels.HEAD], dtype=float)
+    return Plan(consts=consts, pairs=np.array(pairs, dtype=np.int64).reshape(-1, 2),
+                amplitudes=np.ascontiguousarray(amplitudes), components=fixed,
+                sources=sources, node_table=table(times.ravel()), read_table=table(stamps),
+                stamps=np.asarray(stamps, dtype=float), weights=np.asarray(weights, float),
+                azimuths=np.ascontiguousarray(np.stack([np.cos(azimuths), np.sin(azimuths)],
+                                                       axis=-1).reshape(-1, 2)),
+                beams=np.ascontiguousarray(beams),
+                operator=np.ascontiguousarray(least_squares_operator(beams)),
+                slant=np.ascontiguousarray(slant_distances(
+                    scene.ranges, scene.half_cone, len(azimuths), scene.vertical_beam)),
+                n_phases=n_phases, n_window=n_window,
+                at_nodes=pointwise and ins.rate is None and times.shape[1] == 1
+                and bool(np.array_equal(times[:, 0], stamps)))
+
+
+def block_trials(plan):
+    """Trials per block: :data:`~uq.constants.MOTION_BLOCK_VALUES` doubles of node
+    scratch (beams x nodes x (gates + 2) per trial), a power of two within
+    :data:`~uq.constants.MOTION_BLOCK_TRIALS`."""
+    per_trial = plan.node_table.shape[2] * (plan.slant.shape[1] + 2)
+    low, high = MOTION_BLOCK_TRIALS
+    size = 2 ** int(math.floor(math.log2(max(1, MOTION_BLOCK_VALUES // per_trial))))
+    return int(np.clip(size, low, high))
+
+
+def _evaluate(plan, errors, n, into):
+    """The outputs of one scene into `into` (name -> (n, gates) view), block by block."""
+    consts = plan.consts
+    n_beams, n_gates = plan.slant.shape
+    n_nodes = len(plan.weights)
+    ins = tuple(_ins_input(errors.get(name), n) for name in kernels.INPUTS)
+    has = np.array([name in errors and not (np.ndim(errors[name]) == 0 and errors[name] == 0)
+                    for name in kernels.INPUTS], dtype=np.int64)
+    phases = _phase_input(errors.get("motion_phases"), plan.n_phases)
+    window = _phase_input(errors.get("motion_window"), plan.n_window)
+    geometry = [_column(errors.get(name)) for name in _GEOMETRY]
+    noise = errors.get("lidar_radial_velocity")
+    noise = np.zeros((1, 1, 1)) if noise is None else \
+        np.require(np.reshape(noise, (1, 1, 1)) if np.ndim(noise) == 0 else noise,
+                   dtype=float, requirements="W")
+    m = min(block_trials(plan), max(n, 1))
+    n_components = max(1, len(plan.components))
+    work = np.empty((kernels.WORK_ROWS, m))
+    c, turned = np.empty((2, n_components, m)), np.empty((2, n_components, m))
+    at_nodes = plan.at_nodes and not has[kernels.INPUTS.index("ins_clock_offset")]
+    states = np.empty((n_beams if at_nodes else 1, kernels.STATE_ROWS, m))
+    ship_beams = np.empty((n_beams, 3, m))
+    parts = np.empty((2, n_beams * n_nodes, m))
+    ratio = np.empty((n_beams * n_nodes, n_gates, m))
+    normal = np.empty((6 + 3 * n_gates, m))
+    out = np.empty((3, n_gates, m))
+    speed, vertical = np.empty((n_gates, m)), np.empty((n_gates, m))
+    shear = consts[kernels.HEAD.index("shear")]
+    for start in range(0, n, m):
+        count = min(m, n - start)
+        kernels.kinematics(consts, plan.pairs, plan.amplitudes, plan.components, plan.sources,
+                           phases, window, plan.node_table, plan.azimuths, plan.beams,
+                           plan.slant, *geometry, start, count, work, c, states, ship_beams,
+                           parts, ratio)
+        if shear != 0.0:                            # (z / z_ref)^alpha, SIMD; NaN stays NaN
+            block = ratio[:, :, :count]
+            np.log(block, out=block)
+            block *= shear
+            np.exp(block, out=block)
+        kernels.reconstruct(consts, plan.pairs, plan.amplitudes, plan.components,
+                            plan.read_table, plan.stamps, plan.beams, plan.operator,
+                            plan.weights, ins, has, noise, start, count, work, c, turned,
+                            states, parts, ratio, normal, out)
+        kernels.wind_speed(out, count, speed, vertical)
+        stop = start + count
+        if "wind_speed" in into:
+            into["wind_speed"][start:stop] = speed[:, :count].T
+        if "vertical_wind" in into:
+            into["vertical_wind"][start:stop] = vertical[:, :count].T
+        if "wind_direction" in into:
+            into["wind_direction"][start:stop] = _direction(out[0, :, :count],
+                                                            out[1, :, :count]).T
+
+
+def _direction(north, east):
+    """Meteorological ("from") direction [deg] in [0, 360) of (north, east) [m s-1]
+    (as :func:`uq.physics.wind.wind_direction`)."""
+    angle = np.arctan2(-east, -north)
+    np.multiply(angle, 180.0 / math.pi, out=angle)
+    np.add(angle, FULL_CIRCLE_DEG, out=angle, where=angle < 0.0)
+    np.subtract(angle, FULL_CIRCLE_DEG, out=angle, where=angle >= FULL_CIRCLE_DEG)
+    return angle
+
+
+def _column(value):
+    """A per-trial input as a writable float array of length n or 1 (absent: 0)."""
+    if value is None:
+        return np.zeros(1)
+    value = np.asarray(value, dtype=float)
+    value = value if value.ndim == 1 else np.atleast_1d(value).ravel()
+    return value if value.flags.writeable else value.copy()
+
+
+def _ins_input(value, n):
+    """An INS input as a writable float array (n or 1, k or 1): one per scan (n,) is
+    (n, 1); absent is zero."""
+    if value is None:
+        return np.zeros((1, 1))
+    value = np.asarray(value, dtype=float)
+    value = value.reshape(-1, 1) if value.ndim < 2 else value
+    return value if value.flags.writeable else value.copy()
+
+
+def _phase_input(value, columns):
+    """Unit phases (n or 1, columns, 2) as a writable float array; absent: zeros (their
+    mean, the error-free reconstruction)."""
+    if value is None or np.ndim(value) == 0:
+        return np.zeros((1, max(columns, 1), 2))
+    value = np.asarray(value, dtype=float)
+    value = np.broadcast_to(value, (value.shape[0], max(columns, value.shape[1]), 2))
+    return value if value.flags.writeable else value.copy()
