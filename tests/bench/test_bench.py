@@ -1,5 +1,6 @@
 """uq bench: the time-to-target rule on a hand-made result, and a tiny real run."""
 import numpy as np
+import pytest
 import xarray as xr
 
 from uq.bench import methods as bench
@@ -53,10 +54,9 @@ def test_bench_file_passes_the_cf_checker(monkeypatch, tmp_path, cf_compliance):
     from uq.bench.command import run_bench
     monkeypatch.setattr(bench, "REFERENCE_SAMPLES", 2**14)
     monkeypatch.setattr(bench, "SCENES", {"rubio2022_case_i": bench.SCENES["rubio2022_case_i"]})
-    monkeypatch.setattr(bench, "scan_throughput", lambda: 0.1)
     path = tmp_path / "bench.nc"
     (tmp_path / "bench.txt").write_text("not uq's")          # beside the outputs
-    run_bench(path, quick=True, sizes=[2**10, 2**11], repeats=2)
+    run_bench(path, quick=True, sizes=[2**10, 2**11], repeats=2, scale=2**-12)
     assert (tmp_path / "bench.txt").read_text() == "not uq's"
     cf_compliance(path)
     with xr.open_dataset(path) as ds:
@@ -65,3 +65,33 @@ def test_bench_file_passes_the_cf_checker(monkeypatch, tmp_path, cf_compliance):
         assert "rubio2022_case_i_sobol_cv_time_to_1e_3_s" in ds.attrs
         assert ds["time_to_target"].sizes == {"scene": 1, "method": 5}
         assert ds["time_to_target_extrapolated"].dtype == bool
+
+
+def test_the_numpy_scans_and_uq_measure_the_same_u():
+    """The benchmark's two implementations of 4-beam scans with radial noise u = 0.1 m/s
+    compute the same thing: u(Vh) = u / (sqrt(2) sin 28 deg) for a 10 m/s wind along a
+    beam pair (first order; the cross-pair term adds (u/(2 sin))^2/(2 U) ~ 1e-3 of it).
+    Tolerance: 4 sigma of a standard deviation from n draws, 4 / sqrt(2 n)."""
+    from uq.bench import targets
+    n = 2**16
+    expected = 0.1 / (np.sqrt(2) * np.sin(np.deg2rad(28.0)))
+    tolerance = 4 / np.sqrt(2 * n) + 2e-3          # sampling + the first-order neglect
+    assert targets.numpy_scans(n) == pytest.approx(expected, rel=tolerance)
+    result = targets.run(targets._scans(n, **{"wind.speed": 10.0, "wind.direction": 0.0}))
+    assert float(result["wind_speed_mc_u"]) == pytest.approx(expected, rel=tolerance)
+
+
+def test_the_draw_floor_replays_every_block_the_engine_draws():
+    """A run of n trials of d scalar inputs draws n x d normals: the recorded blocks hold
+    exactly that many (exact count: the floor replays neither more nor fewer)."""
+    from uq.bench import targets
+    from uq.engine.inputs import input_set
+    from uq.pipeline.runner import error_inputs, scene_from_settings
+    scenario = targets._scans(3000)
+    scene = scene_from_settings(scenario.settings)
+    dimension = input_set(error_inputs(scenario.settings, scene.n_beams,
+                                       len(scene.ranges))).dimension
+    with targets.recorded_draws() as shapes:
+        targets.run(scenario)
+    assert sum(rows * columns for rows, columns in shapes) == 3000 * dimension
+    assert targets.draw_floor(shapes, repeats=1) > 0

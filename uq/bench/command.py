@@ -5,14 +5,16 @@ import sys
 from pathlib import Path
 
 from uq.bench import methods as bench
+from uq.bench import targets as speed
 from uq.errors import ScenarioError
 from uq.files import check_target, save_figure, write_netcdf
 from uq.pipeline.metadata import cf_encode, flag_attributes, history
 
 
-def run_bench(output, quick=False, sizes=None, repeats=None):
+def run_bench(output, quick=False, sizes=None, repeats=None, scale=1):
     """Measure, print and write; returns the benchmark Dataset. `sizes` and `repeats`
-    replace the defaults of a full or ``--quick`` run (a small run for tests)."""
+    replace the defaults of a full or ``--quick`` run, `scale` shrinks the trial counts
+    of the speed targets (:func:`uq.bench.targets.measure`; a small run for tests)."""
     from uq.outputs.plots import plot_bench
     output = Path(output)
     if output.suffix != ".nc":
@@ -45,9 +47,13 @@ def run_bench(output, quick=False, sizes=None, repeats=None):
             print(f"{name:22s} {method:9s} time to 1e-3 in 95 % of runs: {seconds:9.3f} s"
                   f"{' (extrapolated)' if extrapolated else ''}  speed-up vs mc "
                   f"{plain / seconds:7.1f}x")
-    scans = bench.scan_throughput()
-    dataset.attrs["scans_1e6_s"] = scans
-    print(f"10^6 four-beam scans with radial noise: {scans:.3f} s")
+    figures = speed.measure(quick, progress=lambda text: print(f"  {text}",
+                                                                  file=sys.stderr),
+                              scale=scale)
+    dataset.attrs.update({attribute_name(name): value for name, value in figures.items()})
+    print("targets (each a ratio of two times measured in this run):")
+    for line in speed.verdicts(figures):
+        print(f"  {line}")
     if not quick:
         seconds, megabytes = bench.scale()
         dataset.attrs.update(scale_1e8_s=seconds, scale_1e8_peak_rss_mb=megabytes)

@@ -6,8 +6,8 @@ result shows the spread and not one lucky draw. The error is measured against a
 high-precision reference (randomised Sobol' with the control variate at 2^22 trials, whose
 own standard error is recorded). Results: ``results/bench.nc`` (dims scene, method, n,
 repeat) and a plot. Also measured in the same run: the time to draw each scene's random
-numbers alone (the floor of plain Monte Carlo) and 10^6 four-beam scans with
-radial-velocity noise.
+numbers alone (the floor of plain Monte Carlo); the speed targets are in
+:mod:`uq.bench.targets`.
 """
 import time
 
@@ -122,22 +122,6 @@ def draw_floor(name, n, repeats=5):
         generator.standard_normal((n, dimension))
         times.append(time.perf_counter() - started)
     return float(np.median(times)), dimension
-
-
-def scan_throughput(n=10**6, repeats=5):
-    """Wall time of n four-beam DBS scans with radial-velocity noise (one scene): the
-    median of `repeats` runs after a warm start."""
-    scenario = load_scenario({"name": "scans", "correction": "none", "outputs": ["wind_speed"],
-                              "lidar": {"errors": {"radial_velocity": {"dist": "normal",
-                                                                       "u": 0.1}}},
-                              "sampling": {"n": n, "seed": 1}})
-    run(scenario)                                        # warm start: imports, caches
-    times = []
-    for _ in range(repeats):
-        started = time.perf_counter()
-        run(scenario)
-        times.append(time.perf_counter() - started)
-    return float(np.median(times))
 
 
 SCALE_SCRIPT = """

@@ -24,8 +24,9 @@ from uq.files import write_text
 from uq.pipeline import sweep
 from uq.pipeline.runner import run
 from uq.pipeline.scenario import load_scenario
+from uq.pipeline.shipped import scenario_path
 
-SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "rubio2022_misalignment.yaml"
+SCENARIO = scenario_path("rubio2022_misalignment")
 MC_DRAWS = 10_000
 
 
@@ -45,10 +46,10 @@ def gum_grid(step=1.0):
     return seconds, int(dataset["mc_n_samples"].size)
 
 
-def monte_carlo(step=30.0, scene_by_scene=False):
-    """Monte Carlo at MC_DRAWS per scene on a coarse Fig. 2 grid: (seconds, scenes)."""
+def monte_carlo(step=30.0, scene_by_scene=False, draws=MC_DRAWS):
+    """Monte Carlo at `draws` per scene on a coarse Fig. 2 grid: (seconds, scenes)."""
     scenario = load_scenario(SCENARIO, {
-        "sampling.n": MC_DRAWS,
+        "sampling.n": draws,
         "sweep.lidar.misalignment": {"start": -180, "stop": 180, "step": step},
         "sweep.wind.direction": {"start": 0, "stop": 360, "step": step}})
     saved = sweep.SWEEP_CHUNK_ELEMENTS
@@ -61,10 +62,10 @@ def monte_carlo(step=30.0, scene_by_scene=False):
     return seconds, int(dataset["mc_n_samples"].size)
 
 
-def draw_floor(repeats=200):
-    """Seconds to draw one scene's 3 x MC_DRAWS standard normals (numpy Generator)."""
+def draw_floor(repeats=200, draws=MC_DRAWS):
+    """Seconds to draw one scene's 3 x `draws` standard normals (numpy Generator)."""
     generator = np.random.default_rng(1)
-    seconds, _ = _timed(lambda: [generator.standard_normal((MC_DRAWS, 3))
+    seconds, _ = _timed(lambda: [generator.standard_normal((draws, 3))
                                  for _ in range(repeats)])
     return seconds / repeats
 

@@ -1,0 +1,319 @@
+"""The speed targets (issues 17 and 18), each a ratio of two times measured in the same
+run on the same machine, so that a busy or slow host moves both alike.
+
+=====================================  ==========================================  ======
+figure                                 against                                     target
+=====================================  ==========================================  ======
+plain ``mc``, ``floating_lidar_full``   drawing its normals alone                   <= 3x
+as shipped (all five outputs), 2^19
+every shipped scenario, ``uq run``      drawing its normals + the process start     <= 4x
+(or ``uq golden``) in a new process
+Monte Carlo sweep, 10^4 draws/scene     drawing one scene's normals                 <= 2.5x
+Fig. 2 GUM grid, 518,400 scenes         the numpy model's complex step (before)     >= 5x
+10^6 four-beam scans, radial noise      numpy: 4 x 10^6 normals, differences, hypot  <= 1x
+10^6 point-wise scans in motion         10^6 static scans                           <= 4x
+conical scan, 50 lines of sight         a 4-beam scan in motion, per trial          <= 15x
+=====================================  ==========================================  ======
+
+The draw floor of a run is measured by replaying the engine's own draws: the run is
+made once with :func:`uq.engine.propagate.normal_scores` recorded (the shape of every
+block it draws), then the same blocks are drawn again with numpy's Generator alone.
+The process start is a new interpreter that imports what ``uq run`` imports (numpy,
+scipy, xarray, netCDF4, numba, matplotlib and uq's modules) and exits.
+"""
+import contextlib
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+from uq.bench.sweep import MC_DRAWS
+from uq.pipeline.runner import run
+from uq.pipeline.scenario import MIN_SAMPLES, load_scenario
+from uq.pipeline.shipped import scenario_path, shipped_folder
+
+#: The targets: figure -> (limit, "max" or "min") [1].
+TARGETS = {"floating_lidar_full_mc_over_draw_floor": (3.0, "max"),
+           "shipped_worst_over_floor_and_start": (4.0, "max"),
+           "sweep_mc_over_draw_floor": (2.5, "max"),
+           "gum_grid_speedup": (5.0, "min"),
+           "scans_over_numpy": (1.0, "max"),
+           "pointwise_motion_over_static": (4.0, "max"),
+           "conical_over_four_beam": (15.0, "max")}
+#: Imports of ``uq run`` that a new process pays before any work.
+START_SCRIPT = ("import numpy, scipy.stats, xarray, netCDF4, numba, matplotlib.pyplot; "
+                "import uq.cli.run, uq.pipeline.runner, uq.physics.fused, uq.outputs.plots")
+
+
+def median_time(function, repeats):
+    """Median wall time [s] of `repeats` calls after one warm call (imports, caches,
+    numba's kernels loaded)."""
+    function()
+    times = []
+    for _ in range(repeats):
+        started = time.perf_counter()
+        function()
+        times.append(time.perf_counter() - started)
+    return float(np.median(times))
+
+
+@contextlib.contextmanager
+def recorded_draws():
+    """Record the (rows, dimension) of every block the engine draws (a list, filled
+    while the context is open)."""
+    from uq.engine import propagate
+    original, shapes = propagate.normal_scores, []
+
+    def recording(method, seed, block, dimension, *args, out=None, rows=None, **kwargs):
+        result = original(method, seed, block, dimension, *args, out=out, rows=rows,
+                          **kwargs)
+        shapes.append(result.shape)
+        return result
+    propagate.normal_scores = recording
+    try:
+        yield shapes
+    finally:
+        propagate.normal_scores = original
+
+
+def draw_floor(shapes, repeats=5):
+    """Median time [s] to draw the blocks `shapes` with one numpy Generator into
+    preallocated arrays (the engine draws into its own buffer too)."""
+    generator = np.random.default_rng(1)
+    buffers = [np.empty(shape) for shape in shapes]
+
+    def draw():
+        for buffer in buffers:
+            generator.standard_normal(out=buffer)
+    return median_time(draw, repeats)
+
+
+def run_floor(scenario):
+    """The draw floor [s] of `scenario` (anything :func:`uq.run` takes)."""
+    with recorded_draws() as shapes:
+        run(scenario)
+    return draw_floor(shapes)
+
+
+def floating_lidar_full_as_shipped(n=2**19, repeats=5):
+    """(seconds, floor) of plain mc on ``floating_lidar_full`` with every shipped
+    output, at n trials."""
+    scenario = load_scenario(scenario_path("floating_lidar_full"),
+                             {"sampling.n": n, "sampling.method": "mc"})
+    return median_time(lambda: run(scenario), repeats), run_floor(scenario)
+
+
+def process_start(repeats=3):
+    """Median wall time [s] of a new interpreter importing what ``uq run`` imports."""
+    return median_time(lambda: subprocess.run([sys.executable, "-c", START_SCRIPT],
+                                              check=True), repeats)
+
+
+def _command(name, folder):
+    """The command a user runs for shipped scenario `name` (golden configurations run
+    with ``uq golden``), writing into `folder`."""
+    if name.startswith("golden_campaign"):
+        return ["golden", name, "-o", os.path.join(folder, name), "-q"]
+    return ["run", name, "-o", os.path.join(folder, f"{name}.nc"), "-q"]
+
+
+#: A child process that runs a command with the engine's draws recorded and prints their
+#: block shapes as JSON (the bench never imports the command line: it sits above it).
+RECORD_SCRIPT = """
+import contextlib, json, sys
+from uq.bench.targets import recorded_draws
+from uq.cli import main
+with recorded_draws() as shapes, contextlib.redirect_stdout(sys.stderr):
+    main(sys.argv[1:])
+print(json.dumps(shapes))
+"""
+
+
+def shipped_end_to_end(repeats=3, names=None):
+    """Per shipped scenario: (seconds of its command in a new process, its draw floor).
+    The command's outputs go to a temporary folder, removed afterwards."""
+    names = names or sorted(p.stem for p in shipped_folder().glob("*.yaml"))
+    rows = {}
+    with tempfile.TemporaryDirectory() as folder:
+        for name in names:
+            command = _command(name, folder)
+            _clean(folder)
+            recorded = subprocess.run([sys.executable, "-c", RECORD_SCRIPT] + command,
+                                      check=True, capture_output=True, text=True).stdout
+            floor = draw_floor([tuple(shape) for shape in json.loads(recorded)])
+
+            def in_new_process():
+                _clean(folder)
+                subprocess.run(uq_command() + command, check=True,
+                               stdout=subprocess.DEVNULL)
+            rows[name] = (median_time(in_new_process, repeats), floor)
+    return rows
+
+
+def uq_command():
+    """How a user starts uq: the ``uq`` script installed beside this interpreter, else
+    ``python -m uq.cli``."""
+    script = os.path.join(os.path.dirname(sys.executable), "uq")
+    return [script] if os.access(script, os.X_OK) else [sys.executable, "-m", "uq.cli"]
+
+
+def _clean(folder):
+    """Remove what the last command wrote in the temporary `folder` (ours alone)."""
+    import shutil
+    for entry in os.scandir(folder):
+        if entry.is_dir():
+            shutil.rmtree(entry.path)
+        else:
+            os.unlink(entry.path)
+
+
+def sweep_monte_carlo(draws=MC_DRAWS):
+    """(seconds per scene of a Monte Carlo sweep of ``rubio2022_misalignment`` at `draws`
+    per scene, the floor per scene: drawing that scene's normals)."""
+    from uq.bench import sweep
+    seconds, scenes = sweep.monte_carlo(draws=draws)
+    return seconds / scenes, sweep.draw_floor(draws=draws)
+
+
+def gum_grid(repeats=1):
+    """(seconds of the Fig. 2 GUM grid, seconds of the same with the numpy model's
+    complex step, the previous implementation), and the number of scenes."""
+    from uq.bench import sweep
+    from uq.pipeline import runner
+    new_s, scenes = sweep.gum_grid()
+    original = runner.measurement_model
+
+    def numpy_model(*args, **kwargs):
+        return original(*args, **{**kwargs, "compiled": False})
+    runner.measurement_model = numpy_model
+    try:
+        old_s, _ = sweep.gum_grid()
+    finally:
+        runner.measurement_model = original
+    return new_s, old_s, scenes
+
+
+def _scans(n, **changes):
+    settings = {"name": "scans", "correction": "none", "outputs": ["wind_speed"],
+                "lidar": {"errors": {"radial_velocity": {"dist": "normal", "u": 0.1}}},
+                "sampling": {"n": n, "seed": 1}}
+    for dotted, value in changes.items():
+        node = settings
+        *parents, last = dotted.split(".")
+        for part in parents:
+            node = node.setdefault(part, {})
+        node[last] = value
+    return load_scenario(settings)
+
+
+def numpy_scans(n, u=0.1, generator=None):
+    """The straightforward numpy version of n four-beam scans with radial noise, level
+    and at rest: draw the 4 n normals, difference opposite beams, hypot; u(Vh) [m s-1]."""
+    generator = generator or np.random.default_rng(1)
+    noise = generator.standard_normal((n, 4)) * u
+    sine = np.sin(np.deg2rad(28.0))
+    north = 10.0 + (noise[:, 0] - noise[:, 2]) / (2 * sine)
+    east = (noise[:, 1] - noise[:, 3]) / (2 * sine)
+    return float(np.std(np.hypot(north, east)))
+
+
+def scans_against_numpy(n=10**6, repeats=5):
+    """(seconds of uq.run of n four-beam scans with radial noise, seconds of
+    :func:`numpy_scans`)."""
+    scenario = _scans(n)
+    return (median_time(lambda: run(scenario), repeats),
+            median_time(lambda: numpy_scans(n), repeats))
+
+
+def motion_scans(n=10**6, repeats=5):
+    """(seconds of n point-wise corrected DBS scans under harmonic roll and pitch of
+    random phase, 1 s per beam, with radial noise; seconds of n static scans)."""
+    moving = _scans(n, **{"correction": "pointwise", "lidar.scan.beam_duration": 1.0,
+                          "motion.roll": {"amplitude": 5.0, "period": 6.0},
+                          "motion.pitch": {"amplitude": 3.0, "period": 5.0}})
+    static = _scans(n)
+    return (median_time(lambda: run(moving), repeats),
+            median_time(lambda: run(static), repeats))
+
+
+def conical_scans(n=2**17, repeats=5):
+    """(seconds of n conical scans of 50 lines of sight in 1 s, seconds of n 4-beam
+    scans of 1 s), both without a vertical beam, under 5 deg pitch of random phase."""
+    common = {"lidar.vertical_beam": False, "motion.pitch": {"amplitude": 5.0,
+                                                              "period": 3.33}}
+    conical = _scans(n, **common, **{"lidar.azimuths": [7.2 * i for i in range(50)],
+                                     "lidar.scan.beam_duration": 0.02})
+    four = _scans(n, **common, **{"lidar.scan.beam_duration": 0.25})
+    return (median_time(lambda: run(conical), repeats),
+            median_time(lambda: run(four), repeats))
+
+
+def measure(quick=False, progress=None, scale=1):
+    """Every figure of the table above as ``{name: value}`` (times [s], ratios [1]);
+    `quick` leaves out the two slow ones (every shipped scenario end to end, the GUM
+    grid) and uses 2^17 trials for ``floating_lidar_full``; `scale` (a power of two <= 1)
+    shrinks every trial count (a test's small run)."""
+    say = progress or (lambda text: None)
+    figures = {}
+
+    def trials(n):
+        return max(MIN_SAMPLES, int(n * scale))
+
+    n = trials(2**17 if quick else 2**19)
+    seconds, floor = floating_lidar_full_as_shipped(n)
+    figures.update(floating_lidar_full_mc_n=n, floating_lidar_full_mc_s=seconds,
+                   floating_lidar_full_draw_floor_s=floor,
+                   floating_lidar_full_mc_over_draw_floor=seconds / floor)
+    say(f"floating_lidar_full as shipped, plain mc at n = {n}: {seconds:.3f} s, its draws "
+        f"{floor:.3f} s")
+    seconds, numpy_s = scans_against_numpy(trials(10**6))
+    figures.update(scans_1e6_s=seconds, scans_1e6_numpy_s=numpy_s,
+                   scans_over_numpy=seconds / numpy_s)
+    say(f"10^6 four-beam scans: {seconds:.3f} s, numpy {numpy_s:.3f} s")
+    seconds, static_s = motion_scans(trials(10**6))
+    figures.update(pointwise_motion_1e6_s=seconds, static_1e6_s=static_s,
+                   pointwise_motion_over_static=seconds / static_s)
+    say(f"10^6 point-wise scans in motion: {seconds:.3f} s, static {static_s:.3f} s")
+    seconds, four_s = conical_scans(trials(2**17))
+    figures.update(conical_2e17_s=seconds, four_beam_motion_2e17_s=four_s,
+                   conical_over_four_beam=seconds / four_s)
+    say(f"2^17 conical scans of 50 lines of sight: {seconds:.3f} s, 4-beam {four_s:.3f} s")
+    per_scene, floor = sweep_monte_carlo(trials(MC_DRAWS))
+    figures.update(sweep_mc_s_per_scene=per_scene, sweep_draw_floor_s_per_scene=floor,
+                   sweep_mc_over_draw_floor=per_scene / floor)
+    say(f"Monte Carlo sweep: {1e3 * per_scene:.3f} ms per scene, its draws "
+        f"{1e3 * floor:.3f} ms")
+    if quick:
+        return figures
+    new_s, old_s, scenes = gum_grid()
+    figures.update(gum_grid_scenes=scenes, gum_grid_s=new_s, gum_grid_numpy_s=old_s,
+                   gum_grid_us_per_scene=1e6 * new_s / scenes, gum_grid_speedup=old_s / new_s)
+    say(f"Fig. 2 GUM grid, {scenes} scenes: {new_s:.2f} s, numpy complex step {old_s:.2f} s")
+    start = process_start()
+    figures["process_start_s"] = start
+    worst = 0.0
+    for name, (seconds, floor) in shipped_end_to_end().items():
+        ratio = seconds / (floor + start)
+        figures.update({f"shipped_{name}_s": seconds, f"shipped_{name}_draw_floor_s": floor,
+                        f"shipped_{name}_over_floor_and_start": ratio})
+        worst = max(worst, ratio)
+        say(f"uq run {name}: {seconds:.2f} s; draws {floor:.3f} s + start {start:.2f} s")
+    figures["shipped_worst_over_floor_and_start"] = worst
+    return figures
+
+
+def verdicts(figures):
+    """Lines "figure value (target): met / NOT met" for the targets measured."""
+    lines = []
+    for name, (limit, sense) in TARGETS.items():
+        if name in figures:
+            value = figures[name]
+            met = value <= limit if sense == "max" else value >= limit
+            bound = "<=" if sense == "max" else ">="
+            lines.append(f"{name:42s} {value:8.2f}  (target {bound} {limit:g}): "
+                         f"{'met' if met else 'NOT met'}")
+    return lines
