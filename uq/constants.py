@@ -23,8 +23,9 @@ RNG_BLOCK_SIZE = 2**16
 BATCH_SIZE = 2**14
 
 #: Default number of blocks evaluated together in one chunk [1]. Bounds memory: the lidar
-#: model holds a few dozen float64 arrays of (chunk, beams, gates) at a time.
-DEFAULT_BLOCKS_PER_CHUNK = 2
+#: model holds a few dozen float64 arrays of (chunk, beams, gates) at a time. One block:
+#: the next chunk's draws overlap this one's evaluation from 2^16 trials on.
+DEFAULT_BLOCKS_PER_CHUNK = 1
 
 #: Largest number of Monte Carlo trials adaptive sampling (``digits``) may use [1].
 ADAPTIVE_MAX_SAMPLES = 2**24

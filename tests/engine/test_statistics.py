@@ -133,3 +133,29 @@ def test_tail_buffer_keeps_exactly_the_smallest():
         tail.add(values[values < tail.threshold])
     expected = np.sort(np.concatenate(seen))[:500]
     np.testing.assert_array_equal(np.sort(tail.values()), expected)
+
+
+@pytest.mark.parametrize("threads", [1, 2, 3, 4])
+def test_the_order_statistics_do_not_depend_on_the_threads(threads, rng, monkeypatch):
+    """The elements' order statistics are shared between threads by contiguous parts;
+    each part writes only its own endpoints, so any number of threads gives the exact
+    sorted-array ranks (JCGM 101 7.7.2), element by element."""
+    from uq.engine import statistics
+    monkeypatch.setattr(statistics, "STATISTICS_THREADS", threads)
+    values = rng.standard_normal((50_000, 7, 3)) * np.arange(1, 22).reshape(7, 3)
+    stats = StreamingStatistics((7, 3), tail_capacity(50_000) + 1, expected=50_000)
+    stats.add(values, 2**14)
+    result = stats.result()
+    ordered = np.sort(values, axis=0)
+    low, high = statistics._symmetric_ranks(50_000, 0.95)
+    np.testing.assert_array_equal(result["low"], ordered[low])
+    np.testing.assert_array_equal(result["high"], ordered[high])
+
+
+def test_element_parts_cover_every_element_once():
+    from uq.engine.statistics import element_parts
+    for size in (1, 2, 3, 7, 27, 100):
+        for threads in (1, 2, 4):
+            covered = np.concatenate([np.arange(size)[part]
+                                      for part in element_parts(size, threads)])
+            np.testing.assert_array_equal(covered, np.arange(size))

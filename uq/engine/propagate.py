@@ -10,6 +10,7 @@ References
    (validation of the GUM framework).
 """
 import logging
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import xarray as xr
@@ -237,24 +238,18 @@ class _Runner:
         self.linear = {q: Moments(shape) for q, shape in shapes.items()}
         self.comoments = {q: CoMoments(shapes[q]) for q in self.covariance}
 
-    def _pieces(self, first_block, n_blocks, n_samples):
+    def _pieces(self, first_block, n_blocks, n_samples, drawn=None):
         """Outputs (and linear deviations, with a control variate) of n_samples trials
-        from the blocks first_block .., in pieces to accumulate: inputs are made slice by
-        slice (in the cache). A model that blocks its own trials (``whole_chunks``, e.g.
-        a compiled loop) is called once per statistics batch, and each batch is yielded
-        while its outputs are still in the cache; any other model's slices are joined
-        into one piece per chunk (batches may span its slices)."""
-        scores = np.empty((n_samples, self.inputs.dimension))
-        for k in range(n_blocks):               # the last block only as far as needed
-            rows = min(RNG_BLOCK_SIZE, n_samples - k * RNG_BLOCK_SIZE)
-            normal_scores(self.method, self.seed, first_block + k, self.inputs.dimension,
-                          out=scores[k * RNG_BLOCK_SIZE:k * RNG_BLOCK_SIZE + rows], rows=rows)
+        from the blocks first_block .., in pieces to accumulate. A model that blocks its
+        own trials (``whole_chunks``, e.g. a compiled loop) is called once per statistics
+        batch, and each batch is yielded while its outputs are still in the cache; any
+        other model's slices are joined into one piece per chunk (batches may span its
+        slices). `drawn`: the chunk's inputs, already made (:meth:`_drawn`)."""
+        if drawn is None:
+            drawn = self._drawn(first_block, n_blocks, n_samples)
         whole = self.model.whole_chunks
-        step = self.batch_size if whole else model_slice_size(self.inputs.dimension)
         pieces, linear = [], []
-        for start in range(0, n_samples, step):
-            size = min(step, n_samples - start)
-            values = self.inputs.values(scores[start:start + size], overwrite=True)
+        for values, size in drawn:
             pieces.append(self._model(values, size))
             if self.control:
                 columns = controlvariate.input_columns(values, self.inputs)
@@ -264,6 +259,21 @@ class _Runner:
                 yield pieces.pop(), (linear.pop() if self.control else None)
         if not whole:
             yield _joined(pieces), (_joined(linear) if self.control else None)
+
+    def _drawn(self, first_block, n_blocks, n_samples):
+        """The inputs of the chunk, ``[(values, size), ...]`` per model slice (a
+        statistics batch for a self-blocking model): the normal scores of the blocks
+        first_block .. (the last block only as far as needed), turned into input values
+        in place, slice by slice."""
+        scores = np.empty((n_samples, self.inputs.dimension))
+        for k in range(n_blocks):
+            rows = min(RNG_BLOCK_SIZE, n_samples - k * RNG_BLOCK_SIZE)
+            normal_scores(self.method, self.seed, first_block + k, self.inputs.dimension,
+                          out=scores[k * RNG_BLOCK_SIZE:k * RNG_BLOCK_SIZE + rows], rows=rows)
+        step = self.batch_size if self.model.whole_chunks else \
+            model_slice_size(self.inputs.dimension)
+        return [(self.inputs.values(scores[start:start + step], overwrite=True),
+                 min(step, n_samples - start)) for start in range(0, n_samples, step)]
 
     def _model(self, values, size):
         """The model on one slice of `size` trials; slices start on block boundaries, so
@@ -332,15 +342,26 @@ class _Runner:
         return np.std(np.array(self.batches[q]["u"]), axis=0, ddof=1) / np.sqrt(h)
 
     def run_fixed(self, n):
+        """n trials, chunk by chunk; the next chunk's inputs are drawn and made in a
+        second thread while this one is evaluated (numpy's generators and ufuncs, and the
+        compiled kernels, run without the GIL).
+        Each block has its own generator and the chunks are accumulated in order, so the
+        result is the same as drawing them in turn (and for any chunk size)."""
         total_blocks = -(-n // RNG_BLOCK_SIZE)
-        for first in range(0, total_blocks, self.blocks_per_chunk):
-            blocks = min(self.blocks_per_chunk, total_blocks - first)
-            for outputs, linear in self._pieces(first, blocks, min(
-                    n - first * RNG_BLOCK_SIZE, blocks * RNG_BLOCK_SIZE)):
-                if self.stats is None:
-                    self._start(tail_capacity(n, kind=self.interval) + 1,
-                                {q: v.shape[1:] for q, v in outputs.items()}, expected=n)
-                self._accumulate(outputs, linear)
+        chunks = [(first, min(self.blocks_per_chunk, total_blocks - first),
+                   min(n - first * RNG_BLOCK_SIZE, self.blocks_per_chunk * RNG_BLOCK_SIZE))
+                  for first in range(0, total_blocks, self.blocks_per_chunk)]
+        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="uq-draws") as drawer:
+            pending = drawer.submit(self._drawn, *chunks[0])
+            for index, chunk in enumerate(chunks):
+                drawn = pending.result()
+                if index + 1 < len(chunks):
+                    pending = drawer.submit(self._drawn, *chunks[index + 1])
+                for outputs, linear in self._pieces(*chunk, drawn):
+                    if self.stats is None:
+                        self._start(tail_capacity(n, kind=self.interval) + 1,
+                                    {q: v.shape[1:] for q, v in outputs.items()}, expected=n)
+                    self._accumulate(outputs, linear)
 
     def run_adaptive(self, digits, stopping="jcgm101", gum_targets=None):
         """JCGM 101:2008, 7.9.4: batches of M >= 10^4 trials, one RNG block per step, until

@@ -22,6 +22,10 @@ References
 .. [2] Chan, T. F., Golub, G. H. and LeVeque, R. J. (1983). Algorithms for computing the
    sample variance. The American Statistician 37(3), 242-247.
 """
+import functools
+import os
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 from uq.constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG, STORED_VALUES
@@ -187,6 +191,40 @@ class CoMoments:
         return self.comoment / scale[..., None, None]
 
 
+#: Threads that share the order statistics of the elements (the cores this process may
+#: use, at most 4: the selections are passes over memory).
+STATISTICS_THREADS = min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                         else os.cpu_count() or 1)
+#: Fewest elements per thread worth a thread's hand-over (~20 us).
+_MIN_PART = 2
+
+
+def element_parts(size, threads=None):
+    """Contiguous slices of `size` elements, one per thread (one slice when too few)."""
+    threads = max(1, min(threads or STATISTICS_THREADS, size // _MIN_PART))
+    bounds = np.linspace(0, size, threads + 1).astype(int)
+    return [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+
+
+@functools.cache
+def _pool():
+    return ThreadPoolExecutor(max_workers=STATISTICS_THREADS,
+                              thread_name_prefix="uq-statistics")
+
+
+def in_parallel(calls):
+    """Run ``(function, *arguments)`` calls of compiled kernels that release the GIL,
+    each on its own elements, and wait for all (the first on this thread). Every call
+    writes only its own outputs, so the result does not depend on the threads."""
+    if len(calls) == 1:
+        calls[0][0](*calls[0][1:])
+        return
+    futures = [_pool().submit(function, *arguments) for function, *arguments in calls[1:]]
+    calls[0][0](*calls[0][1:])
+    for future in futures:
+        future.result()
+
+
 class StreamingStatistics:
     """Mean, standard deviation and coverage intervals of an array-valued output.
 
@@ -225,7 +263,7 @@ class StreamingStatistics:
         room = self._budget // max(self.size, 1)
         self._columns = np.empty((self.size, min(int(expected), room) if expected else 0))
         self._count = 0                            # samples held in _columns
-        self._scratch = np.empty((2, 0))
+        self._scratch = []                         # per part of the elements
 
     @property
     def _stored(self):
@@ -300,11 +338,14 @@ class StreamingStatistics:
         if kind == "symmetric":
             ranks = np.array([_symmetric_ranks(int(c), probability) or (-1, -1)
                               for c in count], dtype=np.int64).reshape(-1, 2)
-            if self._scratch.shape[1] < stop - start:
-                self._scratch = np.empty((2, stop - start))
-            statkernels.select_pairs(columns, start, stop, np.ascontiguousarray(count,
-                                     dtype=np.int64), ranks[:, 0].copy(), ranks[:, 1].copy(),
-                                     low, high, self._scratch)
+            parts = element_parts(self.size)
+            if len(self._scratch) != len(parts) or self._scratch[0].shape[1] < stop - start:
+                self._scratch = [np.empty((2, stop - start)) for _ in parts]
+            count = np.ascontiguousarray(count, dtype=np.int64)
+            low_rank, high_rank = ranks[:, 0].copy(), ranks[:, 1].copy()
+            in_parallel([(statkernels.select_pairs, columns[part], start, stop, count[part],
+                          low_rank[part], high_rank[part], low[part], high[part], scratch)
+                         for part, scratch in zip(parts, self._scratch)])
             return low, high
         for j in range(self.size):
             column = columns[j, start:stop]

@@ -62,7 +62,7 @@ def _mod360(x):
     return x % FULL_CIRCLE_DEG
 
 
-@njit(_SIG, cache=True)
+@njit(_SIG, cache=True, nogil=True)
 def transpose(values, reference, circular, out, offset):
     """out[e, offset + i] = values[i, e], unwrapped about reference[e] into
     (reference - 180, reference + 180] for a circular output (as
@@ -81,7 +81,7 @@ def transpose(values, reference, circular, out, offset):
 
 
 @njit("void(float64[:, ::1], int64, int64, int64[::1], float64[::1], float64[::1])",
-      cache=True)
+      cache=True, nogil=True)
 def moments(columns, start, stop, count, mean, m2):
     """Count, mean and sum of squared deviations of the finite values of
     columns[e, start:stop], for every element e."""
@@ -118,7 +118,7 @@ def moments(columns, start, stop, count, mean, m2):
 
 
 @njit("void(float64[:, ::1], int64, int64, float64[::1], float64[::1], float64[::1])",
-      cache=True)
+      cache=True, nogil=True)
 def resultant(columns, start, stop, reference, cos_sum, sin_sum):
     """Add sum cos(d) and sum sin(d) of the finite values' deviations d = value -
     reference [deg] of columns[e, start:stop] to cos_sum[e], sin_sum[e]: the length of
@@ -150,7 +150,7 @@ def resultant(columns, start, stop, reference, cos_sum, sin_sum):
         sin_sum[e] += (sums[4] + sums[5]) + (sums[6] + sums[7])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _select(values, rank, low, high):
     """The value of 0-based `rank` of values[low:high] (reordered in place): Hoare's
     selection with a median-of-three pivot."""
@@ -177,7 +177,7 @@ def _select(values, rank, low, high):
     return values[rank]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _bracket(rank, n, sample):
     """Sample values (a, b) that enclose `rank` of n with a margin (+-inf at the ends)."""
     s = sample.shape[0]
@@ -187,7 +187,7 @@ def _bracket(rank, n, sample):
     return (sample[first] if first >= 0 else -np.inf), (sample[last] if last < s else np.inf)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _select_two(column, n_finite, low_rank, high_rank, keep_low, keep_high):
     """The values of 0-based ranks low_rank < high_rank among the n_finite (all) values
     of `column`. The column's first ~4 sqrt(n) values (at most ORDER_SAMPLE; the trials
@@ -201,16 +201,14 @@ def _select_two(column, n_finite, low_rank, high_rank, keep_low, keep_high):
     low_a, low_b = _bracket(low_rank, n_finite, sample)
     high_a, high_b = _bracket(high_rank, n_finite, sample)
     below_low = below_high = kept_low = kept_high = 0
-    for j in range(n):
+    for j in range(n):              # branch-free: every value is written, kept by the count
         value = column[j]
         below_low += value < low_a
         below_high += value < high_a
-        if low_a <= value <= low_b:
-            keep_low[kept_low] = value
-            kept_low += 1
-        elif high_a <= value <= high_b:
-            keep_high[kept_high] = value
-            kept_high += 1
+        keep_low[kept_low] = value
+        kept_low += (value >= low_a) & (value <= low_b)
+        keep_high[kept_high] = value
+        kept_high += (value >= high_a) & (value <= high_b)
     if below_low <= low_rank < below_low + kept_low:
         low = _select(keep_low, low_rank - below_low, 0, kept_low)
     else:
@@ -222,7 +220,7 @@ def _select_two(column, n_finite, low_rank, high_rank, keep_low, keep_high):
     return low, high
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _finite(column, out):
     """Copy the finite values of `column` into out; their number."""
     n = 0
@@ -234,7 +232,7 @@ def _finite(column, out):
 
 
 @njit("void(float64[:, ::1], int64, int64, int64[::1], int64[::1], int64[::1], "
-      "float64[::1], float64[::1], float64[:, ::1])", cache=True)
+      "float64[::1], float64[::1], float64[:, ::1])", cache=True, nogil=True)
 def select_pairs(columns, start, stop, count, low_rank, high_rank, low, high, scratch):
     """low[e], high[e]: the order statistics of 0-based ranks low_rank[e] <
     high_rank[e] among the count[e] finite values of columns[e, start:stop] (NaN where
@@ -261,7 +259,7 @@ def select_pairs(columns, start, stop, count, low_rank, high_rank, low, high, sc
 
 
 @njit(types.void(types.Array(types.float64, 3, "A", readonly=True), types.int64[::1],
-                 types.float64[:, ::1], types.float64[:, :, ::1]), cache=True)
+                 types.float64[:, ::1], types.float64[:, :, ::1]), cache=True, nogil=True)
 def comoments(values, count, mean, comoment):
     """For values (m, S, g): per s, the count of trials whose g values are all finite,
     their mean (g) and the sum of products of their deviations (g, g), two passes."""

@@ -208,7 +208,7 @@ TRIG_COS, TRIG_SIN = _COS, _SIN
 _TRIG_FIELDS = tuple(TABLE.index(name) for name in TRIG)
 
 
-@njit("void(float64[:, ::1], intp[::1], float64[:, ::1])", cache=True)
+@njit("void(float64[:, ::1], intp[::1], float64[:, ::1])", cache=True, nogil=True)
 def fill_table(fields, index, out):
     """The scene table row by row (sequential writes): the scalars (fields, one row per
     TABLE name), libm's cos and sin of TRIG, and the scene's row of the geometry table."""
@@ -649,5 +649,5 @@ def compiled(dtype):
     each number type is compiled (or loaded from numba's on-disk cache) on first use,
     so a Monte Carlo run never compiles the complex kernels."""
     number = types.complex128 if np.dtype(dtype).kind == "c" else types.float64
-    return {name: njit(_signature(kind, number), cache=True)(function)
+    return {name: njit(_signature(kind, number), cache=True, nogil=True)(function)
             for name, (function, kind) in _KERNELS.items()}

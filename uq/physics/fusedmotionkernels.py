@@ -101,12 +101,12 @@ _READ_TRIG, _READ_VELOCITY = 40, 46                   # 6, 3 rows
 _ERROR, _SOG, _COG, _HEAVE = 49, 52, 53, 55           # heading, pitch, roll [rad]; m s-1;
 WORK_ROWS = 56                                        # (cos, sin); m s-1
 
-_helper = njit(cache=True, error_model="numpy")
+_helper = njit(cache=True, nogil=True, error_model="numpy")
 _inline = njit(inline="always", error_model="numpy")
 
 
 def _kernel(signature):
-    return njit(signature, cache=True, error_model="numpy")
+    return njit(signature, cache=True, nogil=True, error_model="numpy")
 
 
 @_inline
