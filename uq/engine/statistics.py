@@ -195,6 +195,9 @@ class CoMoments:
 #: use, at most 4: the selections are passes over memory).
 STATISTICS_THREADS = min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
                          else os.cpu_count() or 1)
+#: Samples per element handed to the tails at once when the store spills (the tails'
+#: copies and masks are then a few MB, not copies of the whole 64 MB store).
+_SPILL_VALUES = 2**18
 #: Fewest elements per thread worth a thread's hand-over (~20 us).
 _MIN_PART = 2
 
@@ -339,8 +342,9 @@ class StreamingStatistics:
             ranks = np.array([_symmetric_ranks(int(c), probability) or (-1, -1)
                               for c in count], dtype=np.int64).reshape(-1, 2)
             parts = element_parts(self.size)
-            if len(self._scratch) != len(parts) or self._scratch[0].shape[1] < stop - start:
-                self._scratch = [np.empty((2, stop - start)) for _ in parts]
+            length = statkernels.scratch_length(stop - start)
+            if len(self._scratch) != len(parts) or self._scratch[0].shape[1] < length:
+                self._scratch = [np.empty((2, length)) for _ in parts]
             count = np.ascontiguousarray(count, dtype=np.int64)
             low_rank, high_rank = ranks[:, 0].copy(), ranks[:, 1].copy()
             in_parallel([(statkernels.select_pairs, columns[part], start, stop, count[part],
@@ -357,7 +361,9 @@ class StreamingStatistics:
         """Hand the stored values to the tails (the memory bound of long runs)."""
         self._low = [_Tail(self.capacity) for _ in range(self.size)]
         self._high = [_Tail(self.capacity) for _ in range(self.size)]      # holds -values
-        self._add_to_tails(self._columns[:, :self._count].T)
+        for start in range(0, self._count, _SPILL_VALUES):   # bounded temporaries
+            self._add_to_tails(self._columns[:, start:min(self._count,
+                                                          start + _SPILL_VALUES)].T)
         self._columns = np.empty((self.size, 0))
 
     def _symmetric(self, j, m, probability):

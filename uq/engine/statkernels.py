@@ -193,30 +193,33 @@ def _select_two(column, n_finite, low_rank, high_rank, keep_low, keep_high):
     of `column`. The column's first ~4 sqrt(n) values (at most ORDER_SAMPLE; the trials
     are exchangeable, so a prefix is a sample, and reading it touches few cache lines)
     bracket each rank; one streaming pass counts the values below each bracket and keeps
-    those inside; only the kept values are partitioned. Where a bracket misses its rank
-    (rare; or an ordered column), all values are partitioned: exact either way."""
+    those inside (in keep_low, keep_high: ~4 % of the values, at most their length);
+    only the kept values are partitioned. Where a bracket misses its rank or its values
+    overflow the buffer (rare; or an ordered column), all values are partitioned (in a
+    fresh array): exact either way."""
     n = column.shape[0]
     size = min(ORDER_SAMPLE, max(32, int(4.0 * math.sqrt(n_finite))), n)
     sample = np.sort(column[:size].copy())
     low_a, low_b = _bracket(low_rank, n_finite, sample)
     high_a, high_b = _bracket(high_rank, n_finite, sample)
     below_low = below_high = kept_low = kept_high = 0
+    last_low, last_high = keep_low.shape[0] - 1, keep_high.shape[0] - 1
     for j in range(n):              # branch-free: every value is written, kept by the count
         value = column[j]
         below_low += value < low_a
         below_high += value < high_a
-        keep_low[kept_low] = value
+        keep_low[min(kept_low, last_low)] = value
         kept_low += (value >= low_a) & (value <= low_b)
-        keep_high[kept_high] = value
+        keep_high[min(kept_high, last_high)] = value
         kept_high += (value >= high_a) & (value <= high_b)
-    if below_low <= low_rank < below_low + kept_low:
+    if below_low <= low_rank < below_low + kept_low and kept_low <= last_low:
         low = _select(keep_low, low_rank - below_low, 0, kept_low)
     else:
-        low = _select(keep_low, low_rank, 0, _finite(column, keep_low))
-    if below_high <= high_rank < below_high + kept_high:
+        low = _select(column.copy(), low_rank, 0, n)
+    if below_high <= high_rank < below_high + kept_high and kept_high <= last_high:
         high = _select(keep_high, high_rank - below_high, 0, kept_high)
     else:
-        high = _select(keep_high, high_rank, 0, _finite(column, keep_high))
+        high = _select(column.copy(), high_rank, 0, n)
     return low, high
 
 
@@ -237,8 +240,8 @@ def select_pairs(columns, start, stop, count, low_rank, high_rank, low, high, sc
     """low[e], high[e]: the order statistics of 0-based ranks low_rank[e] <
     high_rank[e] among the count[e] finite values of columns[e, start:stop] (NaN where
     the ranks are -1: too few values); the ranks are those of the count,
-    :func:`uq.engine.statistics._symmetric_ranks`. `scratch` (2, >= stop - start) is
-    the caller's, reused (no fresh pages per call)."""
+    :func:`uq.engine.statistics._symmetric_ranks`. `scratch` (2, k) is the caller's,
+    reused (no fresh pages per call), k >= 2 ORDER_SAMPLE (:func:`scratch_length`)."""
     n = stop - start
     keep_low, keep_high = scratch[0], scratch[1]
     for e in range(columns.shape[0]):
@@ -252,10 +255,18 @@ def select_pairs(columns, start, stop, count, low_rank, high_rank, low, high, sc
             high[e] = _select(keep_low, high_rank[e], low_rank[e], finite)
             continue
         if count[e] < n:                           # NaN among them: the finite ones
-            finite = _finite(column, keep_high)
-            column = keep_high[:finite].copy()
+            finite_values = np.empty(count[e])
+            _finite(column, finite_values)
+            column = finite_values
         low[e], high[e] = _select_two(column, count[e], low_rank[e], high_rank[e],
                                       keep_low, keep_high)
+
+
+def scratch_length(n):
+    """Values per side of the scratch :func:`select_pairs` needs for n values: room for
+    the kept values of a bracket (~4 % of n at most n >= 2^14, twice that here) and for
+    2 ORDER_SAMPLE values partitioned whole; an overflow is detected (exact anyway)."""
+    return max(2 * ORDER_SAMPLE, n // 8)
 
 
 @njit(types.void(types.Array(types.float64, 3, "A", readonly=True), types.int64[::1],
