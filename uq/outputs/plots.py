@@ -95,7 +95,11 @@ def plot_bench(dataset):
         ax.set_xlabel("wall time [s]")
         ax.set_ylabel("relative error of u(wind speed) [1]")
         ax.grid(alpha=0.3, which="both")
-    axes[0, 0].legend(fontsize=7, title="method (points: runs; line: median)", title_fontsize=7)
+    # below the panels: inside, the legend would cover runs' points
+    figure.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside lower center",
+                  ncols=len(dataset["method"]), fontsize=8,
+                  title="method (points: runs; line: median); dashed: the 1e-3 target",
+                  title_fontsize=8)
     return figure
 
 
