@@ -173,3 +173,18 @@ def test_paper_figures_show_their_effect(results):
         gum = [line for line in lines if line.get_linestyle() == "--"]
         assert mc and gum and min(m.get_zorder() for m in mc) > max(g.get_zorder() for g in gum)
         plt.close(figure)
+
+
+def test_report_gives_the_systematic_error_of_a_deterministic_scene():
+    """A tilted VAD without correction and without random errors has no uncertainty but a
+    systematic error: the closed form U [sqrt(cos^2 tau cos^2 D + sin^2 D) - 1] (D from
+    the tilt plane), -0.152 m/s at D = 0 and none at D = 90 deg for tau = 10 deg, U =
+    10 m/s; the report states that range instead of "nothing to report"."""
+    vad = [i * 7.2 for i in range(50)]
+    ds = uq.run({"wind": {"speed": 10.0}, "ship": {"pitch": 10.0},
+                 "lidar": {"half_cone": 30.0, "azimuths": vad, "vertical_beam": False},
+                 "correction": "none", "sampling": {"method": "none"},
+                 "outputs": ["wind_speed"], "sweep": {"wind.direction": [0.0, 90.0]}})
+    expected = 10.0 * (np.cos(np.deg2rad(10.0)) - 1.0)
+    speed = render_report(ds).split("<h3>Wind speed</h3>")[1].split("</p>")[0]
+    assert f"from {expected:+.3g} to +0 m/s" in speed, speed

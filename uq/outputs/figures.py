@@ -334,6 +334,17 @@ CAPTIONS = {
     "histogram": "The Monte Carlo trials against the GUM's Gaussian, with both 95 % "
     "intervals (JCGM 101, clause 8): where the dashed and solid lines part by more than "
     "delta, the GUM interval is not validated.",
+    "tiana2017_speed_error_map": "The horizontal wind speed of the error-free "
+    "reconstruction minus the true one (no correction) over wind direction and tilt or "
+    "motion amplitude, cf. Tiana-Alsina et al. (2017), Figs. 3a and 4a: the static tilt "
+    "biases Vh low in every direction; a sinusoidal tilt during the scan biases it up or "
+    "down with the wind direction, by far more than the same static tilt. The title states "
+    "the time-stamp and phase conventions.",
+    "motion_correction_comparison": "The scatter of the reconstructed minus the true "
+    "horizontal and vertical wind, per correction model, from the run's own trials; the "
+    "bars are bias +- u. One INS reading per scan applied to beams measured at other "
+    "phases of the motion (full) can scatter more than no correction; point-wise "
+    "correction removes the motion.",
     "probe_bias_against_range": "The systematic error of the horizontal wind speed from "
     "the probe volume (the radial velocities weighted along the beams, minus the same at "
     "the gate centres) against the range gate, a line per probe kind. Under a power-law "

@@ -126,7 +126,7 @@ def _answers(dataset, targets):
         if f"{quantity}_budget" not in dataset:
             continue
         if not planning.uncertain(dataset, quantity):
-            out.append(_no_uncertainty(quantity))
+            out.append(_no_uncertainty(dataset, quantity))
             continue
         out += [_budget(dataset, quantity), _disagreement(dataset, quantity),
                 _bias(dataset, quantity)]
@@ -168,11 +168,26 @@ def _percent_range(values):
     return f"{low:.2f} %" if np.isclose(low, high) else f"{low:.2f} to {high:.2f} %"
 
 
-def _no_uncertainty(quantity):
+def _no_uncertainty(dataset, quantity):
+    """No random error: say so, and give the systematic error of the error-free
+    reconstruction (nominal minus true) where it is not zero (e.g. uncorrected motion)."""
     unit = QUANTITY_UNITS[quantity]
-    return (f"<h3>{quantity.replace('_', ' ').capitalize()}</h3><p>No uncertainty in these "
-            f"scenes: u at most {_ZERO} {unit} (rounding) in every model, so no "
-            "budget, no comparison and no bias to report.</p>")
+    title = f"<h3>{quantity.replace('_', ' ').capitalize()}</h3>"
+    text = (f"<p>No uncertainty in these scenes: u at most {_ZERO} {unit} (rounding) in "
+            "every model, so no budget and no comparison of models.")
+    nominal, true = dataset.get(f"{quantity}_nominal"), dataset.get(f"{quantity}_true")
+    if nominal is None or true is None:
+        return title + text + "</p>"
+    error = np.asarray(nominal - true, dtype=float)
+    if quantity == "wind_direction":
+        error = (error + 180.0) % 360.0 - 180.0
+    error = np.where(np.abs(error) <= NUMERICAL_ZERO, 0.0, error)      # rounding is none
+    if not np.nanmax(np.abs(error), initial=0.0) > NUMERICAL_ZERO:
+        return title + text + " The error-free reconstruction equals the truth.</p>"
+    return (title + text + f" The error-free reconstruction is systematically off: "
+            f"reconstructed minus true from {np.nanmin(error):+.3g} to {np.nanmax(error):+.3g} "
+            f"{unit} over the scenes (the model's own error, e.g. uncorrected motion or "
+            "tilt; see the figures).</p>")
 
 
 def _ratio(value):
