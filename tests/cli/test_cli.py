@@ -217,3 +217,22 @@ def test_quiet_prints_nothing_and_results_go_to_stdout(tmp_path):
     assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == ""
     loud = uq("run", str(path), "-o", "l.nc", cwd=tmp_path)
     assert "wrote l.nc" in loud.stdout and "wrote" not in loud.stderr
+
+
+@pytest.mark.parametrize("slow, said", [(True, True), (False, False)])
+def test_a_slow_kernel_load_is_announced(slow, said, tmp_path, monkeypatch, capsys):
+    """The first run after an install compiles numba's kernels for a minute or more: `uq
+    run` says so on stderr when loading them takes longer than KERNEL_NOTICE_AFTER (here a
+    load made to take 0.5 s against 0.1 s), and says nothing when it is quick."""
+    import time
+
+    from uq.cli import run as run_command
+    from uq.physics import fusedkernels
+    original = fusedkernels.compiled
+    monkeypatch.setattr(run_command, "KERNEL_NOTICE_AFTER", 0.1)
+    monkeypatch.setattr(fusedkernels, "compiled", lambda dtype: (
+        time.sleep(0.25) if slow else None, original(dtype))[1])
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "rubio2022_case_i", "--set", "sampling.n=100",
+                 "--set", "sweep={}", "-o", "out.nc"]) == 0
+    assert ("compiling the model's kernels" in capsys.readouterr().err) == said

@@ -45,6 +45,7 @@ def command(args):
         raise ScenarioError("-o", str(output), "the output file must end in .nc")
     check_target(output)                     # before any work: refused targets cost nothing
     check_scale_out(args)
+    load_kernels(args, scenario)
     progress = None if args.quiet else ProgressBar()
     new_folders = missing_folders(output.parent)
     checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume).acquire()
@@ -67,6 +68,34 @@ def command(args):
     say(args, summary_table(dataset))
     say(args, f"wrote {output}")
     return EXIT_OK
+
+
+#: Seconds a kernel load may take before the user is told it is compiling [s] (a load from
+#: numba's cache takes ~0.3 s; the first compile after an install ~90 s).
+KERNEL_NOTICE_AFTER = 3.0
+
+
+def load_kernels(args, scenario):
+    """Load the compiled kernels the run uses (the statistics', the model's in real and
+    complex arithmetic, the time-resolved model's for motion), and say so on stderr if
+    that takes longer than KERNEL_NOTICE_AFTER: the first run after an install compiles
+    them into numba's cache, silently for a minute or more."""
+    from uq.pipeline import motionsection
+    import threading
+    notice = threading.Timer(KERNEL_NOTICE_AFTER, lambda: None if args.quiet else print(
+        "uq: compiling the model's kernels into numba's cache (once after an install, "
+        "about 1-2 min)...", file=sys.stderr, flush=True))
+    notice.daemon = True
+    notice.start()
+    try:
+        import uq.engine.statkernels  # noqa: F401  (numba compiles or loads on import)
+        from uq.physics import fusedkernels
+        fusedkernels.compiled(float)
+        fusedkernels.compiled(complex)                # the GUM's complex steps
+        if motionsection.is_time_resolved(scenario.settings):
+            import uq.physics.fusedmotionkernels  # noqa: F401
+    finally:
+        notice.cancel()
 
 
 def check_scale_out(args):
