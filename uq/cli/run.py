@@ -71,7 +71,7 @@ def command(args):
 
 
 #: Seconds a kernel load may take before the user is told it is compiling [s] (a load from
-#: numba's cache takes ~0.3 s; the first compile after an install ~90 s).
+#: numba's cache takes ~0.6 s; the first compile after an install ~90 s).
 KERNEL_NOTICE_AFTER = 3.0
 
 
