@@ -188,3 +188,15 @@ def test_report_gives_the_systematic_error_of_a_deterministic_scene():
     expected = 10.0 * (np.cos(np.deg2rad(10.0)) - 1.0)
     speed = render_report(ds).split("<h3>Wind speed</h3>")[1].split("</p>")[0]
     assert f"from {expected:+.3g} to +0 m/s" in speed, speed
+
+
+def test_a_map_panel_does_not_stretch_noise_over_its_colour_bar():
+    """A panel with its own colour scale spans at least MAP_MIN_RELATIVE_SPAN (1 %) of
+    its mean: u = 0.1506 +- 1e-5 m/s (Monte Carlo noise) is drawn flat, centred; a real
+    variation of 20 % keeps its own range."""
+    from uq.outputs.plots import MAP_MIN_RELATIVE_SPAN, _panel_limits
+    noisy = 0.1506 + np.array([-1e-5, 0.0, 1e-5])
+    low, high = _panel_limits(noisy)
+    assert high - low == pytest.approx(MAP_MIN_RELATIVE_SPAN * 0.1506, rel=1e-6)
+    assert (low + high) / 2 == pytest.approx(0.1506, abs=1e-12)
+    assert _panel_limits(np.array([0.1, 0.12])) == (0.1, 0.12)

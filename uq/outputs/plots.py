@@ -36,6 +36,12 @@ from uq.outputs.planning import uncertain  # noqa: E402
 SHARED_SCALE_FRACTION = 0.3
 #: Gates drawn where a figure has room for a few: the lowest, the middle, the highest.
 SHOWN_GATES = 3
+#: Smallest colour span of a map panel with its own scale, relative to its mean [1]: a
+#: variation below it (e.g. Monte Carlo noise of u, ~1e-4 relative at 10^5 trials) is
+#: shown as flat instead of stretched over the whole colour bar.
+MAP_MIN_RELATIVE_SPAN = 0.01
+#: Largest number of values of a numeric sweep axis that get a tick each [1].
+MAP_VALUE_TICKS = 12
 #: Histogram bins of the Monte Carlo trials.
 HISTOGRAM_BINS = 80
 
@@ -331,12 +337,13 @@ def plot_maps(dataset, quantity, x, y, facet=None):
             ax = axes[i, j]
             mesh = ax.pcolormesh(_positions(at[x]), _positions(at[y]),
                                  panel.transpose(y, x).values, shading="nearest",
-                                 cmap="viridis",
-                                 **({"vmin": limits[0], "vmax": limits[1]} if shared else {}))
+                                 cmap="viridis", **dict(zip(("vmin", "vmax"), limits if shared
+                                                            else _panel_limits(panel.values))))
             _name_ticks(ax.xaxis, at[x])
             _name_ticks(ax.yaxis, at[y])
             if not shared:
-                figure.colorbar(mesh, ax=ax, label=quantity_label(quantity))
+                bar = figure.colorbar(mesh, ax=ax, label=quantity_label(quantity))
+                bar.formatter.set_useOffset(False)           # the values, not an offset
             title = model_style(model)["label"]
             if facet is not None:
                 title += f"\n{coordinate_label(at, facet)} = {value:g}"
@@ -360,10 +367,24 @@ def _positions(coordinate):
     return values if values.dtype.kind in "iuf" else np.arange(values.size)
 
 
+def _panel_limits(values):
+    """(vmin, vmax) of a panel with its own colour scale: its range, widened about its
+    middle to at least MAP_MIN_RELATIVE_SPAN of its mean magnitude."""
+    low, high = float(np.nanmin(values)), float(np.nanmax(values))
+    span = MAP_MIN_RELATIVE_SPAN * float(np.nanmean(np.abs(values)))
+    if high - low >= span:
+        return low, high
+    middle = (low + high) / 2
+    return middle - span / 2, middle + span / 2
+
+
 def _name_ticks(axis, coordinate):
-    """Ticks named by the values of a text or flag coordinate."""
+    """Ticks named by the values of a text or flag coordinate; a tick at each value of a
+    numeric one of few values."""
     values = coordinate.values
-    if values.dtype.kind not in "iuf":
+    if values.dtype.kind in "iuf" and values.size <= MAP_VALUE_TICKS:
+        axis.set_ticks(values)
+    elif values.dtype.kind not in "iuf":
         axis.set_ticks(np.arange(values.size), [str(v).lower() if values.dtype == bool
                                                else str(v) for v in values])
 
