@@ -141,6 +141,9 @@ def _stacked_terms(ax, c):
         ax.bar(c["bin"], variance, bottom=bottom, width=0.4, color=colour,
                label=f"{label}$^2$")
         bottom = bottom + variance
+    top = float(np.max(bottom, initial=0.0))
+    if top > 0:
+        ax.set_ylim(0, 1.15 * top)              # room above the tallest stack
     ax.set(ylabel="variance u$^2$ [(m/s)$^2$]\n(stack: u$_{cal}^2$)")
 
 

@@ -21,7 +21,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.ticker import NullFormatter  # noqa: E402
+from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 from scipy.stats import norm  # noqa: E402
 
 from uq.constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, NUMERICAL_ZERO  # noqa: E402
@@ -80,6 +80,13 @@ def plot_uncertainty_against_direction(results, axes_pair=None):
     return figure
 
 
+def _two_and_five(value, _position):
+    """Minor tick labels of a log axis at 2 and 5 times a power of ten (the others
+    unlabelled, so that they do not overlap)."""
+    mantissa = value / 10 ** np.floor(np.log10(value) + 1e-9)
+    return f"{value:g}" if np.isclose(mantissa, 2) or np.isclose(mantissa, 5) else ""
+
+
 def plot_bench(dataset):
     """Relative error of u(wind speed) against wall time, one panel per scene: every
     repeated run as a point, the median per method and sample size as a line."""
@@ -96,7 +103,7 @@ def plot_bench(dataset):
         ax.axhline(1e-3, color="k", lw=0.8, ls="--")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.xaxis.set_minor_formatter(NullFormatter())     # decades only: no overlaps
+        ax.xaxis.set_minor_formatter(FuncFormatter(_two_and_five))   # 0.02, 0.05, ...
         ax.set_title(str(scene), fontsize=9)
         ax.set_xlabel("wall time [s]")
         ax.set_ylabel("relative error of u(wind speed) [1]")
