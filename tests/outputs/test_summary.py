@@ -1,4 +1,5 @@
 """The summary table of uq run: readable columns, no empty ones, the verdict explained."""
+import numpy as np
 import re
 
 import uq
@@ -32,3 +33,13 @@ def test_report_states_the_apparent_turbulence_intensity():
     page = render_report(ds, true_ti=0.05)
     assert "Apparent turbulence intensity" in page and "5 %" in page
     assert f"{100 * np.hypot(0.05, ti):.2f} %" in page
+
+
+def test_a_direction_at_north_is_one_value_not_a_sweep():
+    """359.99999999999994 deg (atan2's rounding of north) and 1e-14 deg are the same
+    direction: the summary shows 0, not "swept" or "360"; a real -0.03 deg shows as such."""
+    from uq.outputs.summary import _cell, _shown
+    north = np.array([359.99999999999994, 1e-14])
+    assert _cell(_shown(north, "wind_direction", "true"), "true") == "0"
+    assert _cell(_shown(np.array([359.97]), "wind_direction", "mc_mean"), "mc_mean") == "-0.03"
+    assert _cell(_shown(np.array([359.97]), "wind_speed", "mc_mean"), "mc_mean") == "360"

@@ -1,11 +1,14 @@
 """Compact text summary of a results Dataset (printed by ``uq run``)."""
 import numpy as np
 
-from uq.constants import NUMERICAL_ZERO
+from uq.constants import FULL_CIRCLE_DEG, NUMERICAL_ZERO
 from uq.pipeline.metadata import QUANTITIES
 
 _COLUMNS = ("true", "nominal", "mc_mean", "mc_u", "gum_u", "paper_u")
 _VALUES = ("true", "nominal", "mc_mean")
+#: Directions this close below 360 deg would print as "360" at four significant digits
+#: (half a unit of the fourth digit) [deg]: they are shown as the small negative angle.
+DIRECTION_ROUNDING = 0.05
 #: Space between columns [characters].
 _GAP = 3
 
@@ -31,8 +34,8 @@ def summary_table(dataset):
         for gate in gates:
             select = {} if gate is None else {"range": gate}
             label = q if gate is None else f"{q} @{gate:g} m"
-            cells = {c: _cell(dataset[f"{q}_{c}"].sel(select).values, c) if f"{q}_{c}"
-                     in dataset else "nan" for c in _COLUMNS}
+            cells = {c: _cell(_shown(dataset[f"{q}_{c}"].sel(select).values, q, c), c)
+                     if f"{q}_{c}" in dataset else "nan" for c in _COLUMNS}
             cells["GUM valid"] = _verdict(dataset, q, select)
             rows.append((label, cells))
     columns = [c for c in _COLUMNS if any(cells[c] != "nan" for _, cells in rows)]
@@ -74,13 +77,23 @@ def _motion_line(dataset):
     return [f"motion-induced turbulence-intensity increment [%]: {ti}"]
 
 
+def _shown(values, quantity, column):
+    """A direction in [0, 360) within DIRECTION_ROUNDING of 360 [deg] is shown as the
+    small negative angle it is (359.9999999 and 0.0000001 are not two values)."""
+    if quantity != "wind_direction" or column not in _VALUES:
+        return values
+    values = np.asarray(values, dtype=float)
+    return np.where(values > FULL_CIRCLE_DEG - DIRECTION_ROUNDING, values - FULL_CIRCLE_DEG,
+                    values)
+
+
 def _cell(values, column):
     values = np.asarray(values, dtype=float).reshape(-1)
     if np.all(np.isnan(values)):
         return "nan"
     low, high = np.nanmin(values), np.nanmax(values)
-    if np.isclose(low, high, rtol=1e-6, atol=NUMERICAL_ZERO):
-        return _number(low)
+    if np.isclose(low, high, rtol=1e-6, atol=NUMERICAL_ZERO) or _number(low) == _number(high):
+        return _number(low)                     # (the same at the digits shown)
     return "swept" if column in _VALUES else f"{_number(low)}..{_number(high)}"
 
 
