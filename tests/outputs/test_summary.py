@@ -1,6 +1,7 @@
 """The summary table of uq run: readable columns, no empty ones, the verdict explained."""
-import numpy as np
 import re
+
+import numpy as np
 
 import uq
 from uq.outputs.summary import summary_table
