@@ -109,8 +109,9 @@ def _answers(dataset, targets):
     if "lidar_misalignment" in dims:
         rows = [(planning.MODEL_NAMES[m],
                  f"{a['best']:g}" if a["gain"] > planning.EQUAL_WITHIN else "any (no effect)",
-                 f"{a['u_best']:.4g}", f"{a['worst']:g}", f"{a['u_worst']:.4g}",
-                 f"{100 * a['gain']:.2f} %")
+                 f"{a['u_best']:.4g}",
+                 f"{a['worst']:g}" if a["gain"] > planning.EQUAL_WITHIN else "any",
+                 f"{a['u_worst']:.4g}", f"{100 * a['gain']:.2f} %")
                 for m, a in planning.misalignment_answer(dataset).items()]
         out += ["<h3>Best misalignment</h3><p>u(Vh) averaged over the other swept keys.</p>",
                 _table(("model", "best [deg]", "u [m/s]", "worst [deg]", "u [m/s]",
