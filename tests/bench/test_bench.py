@@ -95,3 +95,16 @@ def test_the_draw_floor_replays_every_block_the_engine_draws():
         targets.run(scenario)
     assert sum(rows * columns for rows, columns in shapes) == 3000 * dimension
     assert targets.draw_floor(shapes, repeats=1) > 0
+
+
+def test_the_scale_run_reports_its_own_peak_memory_not_its_parents():
+    """Linux keeps ru_maxrss across fork and exec: a child of a 640 MB parent would report
+    640 MB. The scale run reads its own high-water mark (VmHWM), so a 2000-trial run
+    under such a parent reports what uq itself needs (~270 MB: Python and the
+    libraries), well below the parent."""
+    import sys
+    if not sys.platform.startswith("linux"):
+        pytest.skip("VmHWM is Linux's; elsewhere the scale run falls back to ru_maxrss")
+    parent = np.ones(80_000_000)                       # 640 MB, touched
+    _, megabytes = bench.scale(2000)
+    assert parent[-1] == 1.0 and megabytes < 500, megabytes
