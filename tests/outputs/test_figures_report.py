@@ -200,3 +200,16 @@ def test_a_map_panel_does_not_stretch_noise_over_its_colour_bar():
     assert high - low == pytest.approx(MAP_MIN_RELATIVE_SPAN * 0.1506, rel=1e-6)
     assert (low + high) / 2 == pytest.approx(0.1506, abs=1e-12)
     assert _panel_limits(np.array([0.1, 0.12])) == (0.1, 0.12)
+
+
+def test_a_correction_sweep_gets_a_budget_column_per_correction():
+    """Averaging a budget over correction models would mix them. Without correction no INS
+    reading enters, so there is no variance to share ("-"); with the yaw correction the
+    heading error turns the wind vector: it is the wind direction's whole budget."""
+    ds = uq.run({"ins": {"heading": {"dist": "normal", "u": 1.0}},
+                 "ship": {"sog": 2.0}, "sampling": {"method": "none"},
+                 "outputs": ["wind_direction"], "sweep": {"correction": ["none", "yaw"]}})
+    page = render_report(ds)
+    budget = page.split("Uncertainty budget of wind direction")[1].split("</table>")[0]
+    assert "share, none" in budget and "share, yaw" in budget
+    assert "<td>ins.heading</td><td>-</td><td>100.0 %</td>" in budget, budget

@@ -198,8 +198,20 @@ def _ratio(value):
 
 
 def _budget(dataset, quantity):
-    rows = [(_e(name), f"{100 * share:.1f} %") for name, share in
-            planning.budget_answer(dataset, quantity)]
+    corrections = _swept_corrections(dataset)
+    if corrections:                  # one column per correction model: averaging would mix them
+        shares = {c: dict(planning.budget_answer(dataset.sel(correction=c), quantity))
+                  for c in corrections}
+        names = sorted({n for share in shares.values() for n in share},
+                       key=lambda n: -np.nanmax([share.get(n, 0.0) for share in shares.values()]
+                                                + [0.0]))
+        rows = [(_e(n), *[_percent(shares[c].get(n, 0.0)) for c in corrections])
+                for n in names]
+        header = ("input", *[f"share, {c}" for c in corrections])
+    else:
+        rows = [(_e(name), f"{100 * share:.1f} %") for name, share in
+                planning.budget_answer(dataset, quantity)]
+        header = ("input", "share")
     validity = planning.gum_validity_answer(dataset, quantity)
     variable = f"{quantity}_gum_u"
     note = "" if validity is None else (
@@ -207,9 +219,23 @@ def _budget(dataset, quantity):
         f"{_share(validity['valid_count'], validity['compared'], dataset, variable)}; the "
         f"verdict is conclusive (not decided by sampling noise) for "
         f"{validity['conclusive_count']} of the {validity['compared']}.</p>")
+    over = "per correction model, each averaged over the other swept keys" if corrections \
+        else f"averaged over {extent(dataset, variable)}"
     return (f"<h3>Uncertainty budget of {quantity.replace('_', ' ')}</h3><p>Share of the GUM "
-            f"variance, averaged over {extent(dataset, variable)}; the first input "
-            f"dominates.</p>" + _table(("input", "share"), rows) + note)
+            f"variance, {over}; the first input dominates.</p>"
+            + _table(header, rows) + note)
+
+
+def _percent(share):
+    """A share of the variance in per cent; "-" where there is no variance to share."""
+    return "-" if not np.isfinite(share) else f"{100 * share:.1f} %"
+
+
+def _swept_corrections(dataset):
+    """The swept correction models (a column each in the budget), or ()."""
+    if "correction" not in dataset.dims or dataset.sizes["correction"] < 2:
+        return ()
+    return tuple(str(c) for c in dataset["correction"].values)
 
 
 def _disagreement(dataset, quantity):
