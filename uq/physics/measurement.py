@@ -263,14 +263,7 @@ def _ship_velocity(scene):
 
 
 def _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors):
-    result = {}
-    north, east, up = wind_vector[..., 0, :], wind_vector[..., 1, :], wind_vector[..., 2, :]
-    if "wind_speed" in outputs:
-        result["wind_speed"] = wind.wind_speed(north, east)
-    if "wind_direction" in outputs:
-        result["wind_direction"] = wind.wind_direction(north, east)
-    if "vertical_wind" in outputs:
-        result["vertical_wind"] = up
+    result = wind.wind_outputs(wind_vector, outputs)
     if "radial_velocity" in outputs:
         result["radial_velocity"] = _corrected_radial(scene, measured, navigation,
                                                       unit_vectors)

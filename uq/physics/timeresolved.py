@@ -288,14 +288,7 @@ def _pointwise_reading(navigation, resolved):
 
 
 def _outputs(scene, outputs, wind_vector, corrected_radial, heights):
-    north, east, up = wind_vector[..., 0, :], wind_vector[..., 1, :], wind_vector[..., 2, :]
-    result = {}
-    if "wind_speed" in outputs:
-        result["wind_speed"] = wind.wind_speed(north, east)
-    if "wind_direction" in outputs:
-        result["wind_direction"] = wind.wind_direction(north, east)
-    if "vertical_wind" in outputs:
-        result["vertical_wind"] = up
+    result = wind.wind_outputs(wind_vector, outputs)
     if "radial_velocity" in outputs:
         result["radial_velocity"] = corrected_radial
     if "gate_height" in outputs:

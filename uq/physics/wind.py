@@ -53,6 +53,21 @@ def wind_direction(north, east):
     return complexstep.mod(angle, FULL_CIRCLE_DEG)
 
 
+def wind_outputs(wind_vector, outputs):
+    """The wind outputs named in `outputs` of reconstructed earth-frame wind vectors
+    (..., 3, gates) [m s-1]: ``wind_speed`` [m s-1], ``wind_direction`` [deg] ("from"),
+    ``vertical_wind`` [m s-1], each (..., gates)."""
+    north, east, up = wind_vector[..., 0, :], wind_vector[..., 1, :], wind_vector[..., 2, :]
+    result = {}
+    if "wind_speed" in outputs:
+        result["wind_speed"] = wind_speed(north, east)
+    if "wind_direction" in outputs:
+        result["wind_direction"] = wind_direction(north, east)
+    if "vertical_wind" in outputs:
+        result["vertical_wind"] = up
+    return result
+
+
 def power_law_speed(speed_ref, height, reference_height, exponent):
     """Power-law wind profile U(z) = U_ref (z / z_ref)^alpha [m s-1].
 
