@@ -92,10 +92,8 @@ def _series(check, value):
     key = "motion.series"
     check.mapping(value, key)
     check.keys(value, key, SERIES_KEYS)
-    for name in ("file", "columns"):
-        if name not in value:
-            check.fail(f"{key}.{name}", "missing; a record needs its file and the columns of "
-                       "its degrees of freedom")
+    check.required(value, key, ("file", "columns"),
+                   "a record needs its file and the columns of its degrees of freedom")
     path = check.text(value["file"], f"{key}.file")
     columns = value["columns"]
     check.mapping(columns, f"{key}.columns")
@@ -173,9 +171,7 @@ def _spectrum(check, value):
     key = "motion.spectrum"
     check.mapping(value, key)
     check.keys(value, key, SPECTRUM_KEYS)
-    for name in ("hs", "tp"):
-        if name not in value:
-            check.fail(f"{key}.{name}", "missing; a spectrum needs hs [m] and tp [s]")
+    check.required(value, key, ("hs", "tp"), "a spectrum needs hs [m] and tp [s]")
     tp = check.number(value["tp"], f"{key}.tp", low=0.0, low_open=True)
     band = value.get("band", [SPECTRUM_BAND[0] / tp, SPECTRUM_BAND[1] / tp])
     band = check.number_list(band, f"{key}.band", low=0.0, low_open=True)
@@ -198,8 +194,7 @@ def _response(check, value):
         key = f"motion.response.{dof}"
         check.mapping(spec, key)
         check.keys(spec, key, RESPONSE_KEYS)
-        if "factor" not in spec:
-            check.fail(f"{key}.factor", "missing; allowed: the amplitude per metre of wave "
+        check.required(spec, key, ("factor",), "allowed: the amplitude per metre of wave "
                        "amplitude (deg/m or m/m)")
         out[dof] = {"factor": check.number(spec["factor"], f"{key}.factor", low=0.0),
                     "lag": check.number(spec.get("lag", 0.0), f"{key}.lag", low=-360.0,
@@ -210,10 +205,8 @@ def _response(check, value):
 def _harmonic(check, value, key, angular):
     check.mapping(value, key)
     check.keys(value, key, HARMONIC_KEYS)
-    for name in ("amplitude", "period"):
-        if name not in value:
-            check.fail(f"{key}.{name}", "missing; a harmonic needs amplitude and period "
-                       "(phase defaults to random)")
+    check.required(value, key, ("amplitude", "period"),
+                   "a harmonic needs amplitude and period (phase defaults to random)")
     high = MAX_ANGULAR_AMPLITUDE_DEG if angular else None
     phase = value.get("phase", "random")
     return {"amplitude": check.number(value["amplitude"], f"{key}.amplitude", low=0.0,

@@ -47,10 +47,8 @@ def validate_probe(check, value):
     check.mapping(value, "lidar.probe")
     check.keys(value, "lidar.probe", PROBE_KEYS)
     kind = check.choice(value.get("kind", "point"), "lidar.probe.kind", PROBE_KINDS)
-    for name in KIND_PARAMETERS[kind]:
-        if name not in value:
-            check.fail(f"lidar.probe.{name}", f"missing; kind {kind!r} needs "
-                       f"{', '.join(KIND_PARAMETERS[kind])}")
+    check.required(value, "lidar.probe", KIND_PARAMETERS[kind],
+                   f"kind {kind!r} needs {', '.join(KIND_PARAMETERS[kind])}")
     out = {"kind": kind}
     for name in ("gate_length", "pulse_fwhm", "wavelength", "beam_radius"):
         if name in value:

@@ -543,6 +543,12 @@ class Checker:
                 dotted = f"{prefix}.{key}" if prefix else str(key)
                 self.fail(dotted, f"unknown key; allowed: {', '.join(allowed)}")
 
+    def required(self, mapping, prefix, names, needs):
+        """Fail on the first of `names` missing from `mapping`, as "missing; `needs`"."""
+        for name in names:
+            if name not in mapping:
+                self.fail(f"{prefix}.{name}", f"missing; {needs}")
+
     def mapping(self, value, key):
         if not isinstance(value, dict):
             self.fail(key, f"expected a mapping, got {_kind(value)}")
