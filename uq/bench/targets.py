@@ -201,13 +201,7 @@ def _scans(n, **changes):
     settings = {"name": "scans", "correction": "none", "outputs": ["wind_speed"],
                 "lidar": {"errors": {"radial_velocity": {"dist": "normal", "u": 0.1}}},
                 "sampling": {"n": n, "seed": 1}}
-    for dotted, value in changes.items():
-        node = settings
-        *parents, last = dotted.split(".")
-        for part in parents:
-            node = node.setdefault(part, {})
-        node[last] = value
-    return load_scenario(settings)
+    return load_scenario(settings, changes)                # dotted keys, as uq run --set
 
 
 def numpy_scans(n, u=0.1, generator=None):
