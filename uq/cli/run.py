@@ -76,8 +76,8 @@ KERNEL_NOTICE_AFTER = 3.0
 
 
 def load_kernels(args, scenario):
-    """Load the compiled kernels the run uses (the statistics', the model's in real and
-    complex arithmetic, the time-resolved model's for motion), and say so on stderr if
+    """Load the compiled kernels the run uses (the statistics', and the static model's in
+    real and complex arithmetic or the time-resolved model's), and say so on stderr if
     that takes longer than KERNEL_NOTICE_AFTER: the first run after an install compiles
     them into numba's cache, silently for a minute or more."""
     from uq.pipeline import motionsection
@@ -89,11 +89,12 @@ def load_kernels(args, scenario):
     notice.start()
     try:
         import uq.engine.statkernels  # noqa: F401  (numba compiles or loads on import)
-        from uq.physics import fusedkernels
-        fusedkernels.compiled(float)
-        fusedkernels.compiled(complex)                # the GUM's complex steps
-        if motionsection.is_time_resolved(scenario.settings):
+        if motionsection.is_time_resolved(scenario.settings):   # the static model unused
             import uq.physics.fusedmotionkernels  # noqa: F401
+        else:
+            from uq.physics import fusedkernels
+            fusedkernels.compiled(float)
+            fusedkernels.compiled(complex)            # the GUM's complex steps
     finally:
         notice.cancel()
 
