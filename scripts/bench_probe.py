@@ -30,7 +30,7 @@ from uq.constants import (WINDCUBE_GATE_LENGTH, WINDCUBE_PULSE_FWHM, ZEPHIR_BEAM
                           ZEPHIR_TRUNCATION, ZEPHIR_WAVELENGTH_UM)
 from uq.physics import probe as probe_volume
 from uq.physics.measurement import COMPILED_OUTPUTS, measurement_model
-from uq.pipeline.runner import error_inputs, scene_from_settings
+from uq.pipeline.modelsetup import error_inputs, scene_from_settings
 from uq.pipeline.scenario import load_scenario
 from uq.pipeline.shipped import shipped_path
 

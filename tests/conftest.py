@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from uq.pipeline.runner import scene_from_settings
+from uq.pipeline.modelsetup import scene_from_settings
 from uq.pipeline.scenario import load_scenario
 
 

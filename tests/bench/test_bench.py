@@ -86,7 +86,7 @@ def test_the_draw_floor_replays_every_block_the_engine_draws():
     exactly that many (exact count: the floor replays neither more nor fewer)."""
     from uq.bench import targets
     from uq.engine.inputs import input_set
-    from uq.pipeline.runner import error_inputs, scene_from_settings
+    from uq.pipeline.modelsetup import error_inputs, scene_from_settings
     scenario = targets._scans(3000)
     scene = scene_from_settings(scenario.settings)
     dimension = input_set(error_inputs(scenario.settings, scene.n_beams,

@@ -13,7 +13,7 @@ from uq.fit.bayesfit import ProfilePosterior, posterior_summary, profile_data, s
 from uq.cli import main
 from uq.engine.inputs import input_set
 from uq.physics.measurement import measurement_model
-from uq.pipeline.runner import error_inputs, scene_from_settings
+from uq.pipeline.modelsetup import error_inputs, scene_from_settings
 from uq.fit.fitting import combine_fits
 from uq.fit.plots import plot_corner
 from uq.fit.profilefit import least_squares_profile

@@ -17,7 +17,7 @@ import pytest
 from uq.engine.inputs import input_set
 from uq.physics import fusedmotion
 from uq.physics.measurement import measurement_model
-from uq.pipeline.runner import error_inputs, scene_from_settings
+from uq.pipeline.modelsetup import error_inputs, scene_from_settings
 from uq.pipeline.scenario import load_scenario
 
 OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind")

@@ -109,7 +109,7 @@ def time_to_target(dataset):
 def draw_floor(name, n, repeats=5):
     """Seconds to draw n trials' standard normals for the scene's random inputs (the
     median of `repeats`, as the run times it is compared with), and their dimension."""
-    from uq.pipeline.runner import error_inputs, scene_from_settings
+    from uq.pipeline.modelsetup import error_inputs, scene_from_settings
     from uq.engine.inputs import input_set
     scenario = scene(name)
     base = scene_from_settings(scenario.settings)

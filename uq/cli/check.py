@@ -13,7 +13,8 @@ def add_parser(commands):
 
 
 def command(args):
-    from uq.pipeline.scenario import load_scenario, read_yaml
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.yamlfile import read_yaml
     from uq.pipeline.shipped import scenario_path
     path = scenario_path(args.scenario)
     raw = read_yaml(path)

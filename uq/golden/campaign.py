@@ -30,7 +30,7 @@ from uq.constants import FULL_CIRCLE_DEG
 from uq.data import brightwind_mast
 from uq.engine.inputs import Input
 from uq.physics.measurement import measurement_model
-from uq.pipeline.runner import error_inputs, scene_from_settings
+from uq.pipeline.modelsetup import error_inputs, scene_from_settings
 from uq.pipeline.scenario import load_scenario
 from uq.engine.statistics import circular_mean_deg
 

@@ -14,7 +14,8 @@ from uq.constants import (GOLDEN_BIN_WIDTH, GOLDEN_MIN_RECORDS, GOLDEN_REQUIRED_
                          GOLDEN_SIGNIFICANCE, KPI_AVAILABILITY)
 from uq.errors import ScenarioError
 from uq.files import check_name
-from uq.pipeline.scenario import Checker, read_yaml
+from uq.pipeline.scenario import Checker
+from uq.pipeline.yamlfile import read_yaml
 
 TOP_KEYS = ("name", "description", "instruments", "comparisons", "smc", "classification",
             "bins", "kpi", "synthetic")

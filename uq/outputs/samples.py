@@ -13,7 +13,7 @@ from uq.constants import RNG_BLOCK_SIZE
 from uq.engine.inputs import input_set
 from uq.engine.sampling import normal_scores
 from uq.physics.measurement import measurement_model
-from uq.pipeline.runner import error_inputs, scene_from_settings
+from uq.pipeline.modelsetup import error_inputs, scene_from_settings
 from uq.pipeline.scenario import load_scenario
 
 #: Trials drawn again for a histogram: 2^17 put ~3,000 draws in each 2.5 % tail.

@@ -52,11 +52,14 @@ References
 """
 import numpy as np
 
+from uq.physics.modelinputs import Correction
 from uq.physics.rotation import apply_matrix, attitude_matrix, rotation_about_vertical
 
-CORRECTION_MODELS = ("none", "yaw", "tilt2d", "full", "pointwise")
+#: The scenario's names of the models of :class:`~uq.physics.modelinputs.Correction`.
+CORRECTION_MODELS = tuple(model.key for model in Correction)
 #: The models of a static scan (``pointwise`` needs the time-resolved model).
-STATIC_CORRECTION_MODELS = CORRECTION_MODELS[:4]
+STATIC_CORRECTION_MODELS = tuple(model.key for model in Correction
+                                 if model != Correction.POINTWISE)
 
 
 def correction_rotation(model, heading, pitch, roll, nominal_heading):

@@ -48,8 +48,9 @@ from uq.physics import fusedkernels as kernels
 from uq.physics import wind as wind_formulas
 from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
 from uq.constants import FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS
-from uq.physics.correction import CORRECTION_MODELS
-from uq.physics.scene import OUTPUTS, SCENE_FIELDS
+from uq.physics import modelinputs
+from uq.physics.modelinputs import STATIC_COMPILED, Correction
+from uq.physics.scene import OUTPUTS
 from uq.physics.rotation import attitude_matrix
 
 #: Outputs the fused loop computes: all of them.
@@ -71,13 +72,32 @@ def applicable(scene, outputs, errors, scene_draws=False):
     return _prepared(scene, outputs, errors, scene_draws) is not None
 
 
+def declined(scene, outputs, errors, scene_draws=False):
+    """Why the compiled model does not take this call, in words ('' where it does): a
+    time-resolved scene or a probe volume (models of their own), an output or an input
+    it does not implement, or an input of a shape it does not take."""
+    if scene.time_resolved is not None:
+        return "a time-resolved scene"
+    if scene.probe is not None:
+        return "a probe volume"
+    if not set(outputs) <= _OUTPUT_SET:
+        return f"output(s) {', '.join(sorted(set(outputs) - _OUTPUT_SET))}"
+    lacked = modelinputs.lacks(STATIC_COMPILED, errors)
+    if lacked:
+        return f"input(s) {', '.join(lacked)}"
+    if _prepared(scene, outputs, errors, scene_draws) is None:
+        return "an input of a shape it does not take"
+    return ""
+
+
 def measurement_model(scene, outputs, scene_draws=False, **errors):
     """The fused equivalent of :func:`uq.measurement.measurement_model` (same inputs,
     degrees for angular errors; same outputs, shape (n, *S, n_gates), radial velocity
     (n, *S, n_beams, n_gates)). Complex errors give complex outputs (complex step)."""
     result = evaluate(scene, outputs, scene_draws, errors)
     if result is None:
-        raise ValueError("the compiled model does not apply to this call (see applicable)")
+        raise ValueError(f"the compiled static model does not take this call: "
+                         f"{declined(scene, outputs, errors, scene_draws)}")
     return result
 
 
@@ -93,7 +113,7 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype):
     scenes = math.prod(shape)
     (table, shapes), kept = scene_table(scene, shape)
     structure = np.array([len(scene.azimuths), int(scene.vertical_beam), n_gates,
-                          CORRECTION_MODELS.index(scene.correction)]
+                          Correction.of(scene.correction)]
                          + [int(q in outputs) for q in OUTPUTS], dtype=np.int64)
     out = {q: np.empty((scenes,) + ((n_beams,) if q == "radial_velocity" else ())
                        + (n_gates, n), dtype=dtype) if q in outputs else _UNUSED[dtype][q]
@@ -248,7 +268,10 @@ def _prepared(scene, outputs, errors, scene_draws):
             tuple(laid.get(name, zero) for name in _GEOMETRY), laid.get(_NOISE, zero), dtype)
 
 
-_OUTPUT_SET, _ERROR_SET = set(FUSED_OUTPUTS), {*_INS, *_GEOMETRY, _NOISE}
+_OUTPUT_SET = set(FUSED_OUTPUTS)
+#: The inputs the compiled static model implements (:mod:`uq.physics.modelinputs`); the
+#: kernels' argument order (``INS_ORDER``, ``GEO_ORDER``) names the same inputs (tested).
+_ERROR_SET = set(modelinputs.names(STATIC_COMPILED))
 #: An absent error: zero, a (1, 1, 1) placeholder per dtype (the kernels only read it).
 _ZERO = {float: np.zeros((1, 1, 1)), complex: np.zeros((1, 1, 1), dtype=complex)}
 

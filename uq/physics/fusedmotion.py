@@ -36,7 +36,8 @@ import numpy as np
 from uq.constants import FULL_CIRCLE_DEG, MOTION_BLOCK_TRIALS, MOTION_BLOCK_VALUES
 from uq.physics import fusedmotionkernels as kernels
 from uq.physics.beams import least_squares_operator, slant_distances
-from uq.physics.correction import CORRECTION_MODELS
+from uq.physics import modelinputs
+from uq.physics.modelinputs import MOTION_COMPILED, Correction
 from uq.physics.motion import DEGREES_OF_FREEDOM
 from uq.physics.rotation import rotation_about_vertical, rotation_pitch, rotation_roll
 from uq.physics.scene import SCENE_FIELDS, sample_count
@@ -52,28 +53,42 @@ def applicable(scene, outputs, errors, scene_draws=False):
     """Can the compiled model evaluate this call of the time-resolved model?
 
     A time-resolved scene without a probe volume, only :data:`FUSED_OUTPUTS`, real
-    inputs (not the GUM's complex steps), and inputs of the shapes the pipeline gives:
+    inputs (not the GUM's complex steps) that it implements
+    (:data:`uq.physics.modelinputs.MOTION_COMPILED`), in the shapes the pipeline gives:
     INS errors (n,) or (n, k), phases (n, K, 2), radial noise (n, beams, gates) (each
     may also be a scalar or have one row). Any batch of scenes, common draws or
-    ``scene_draws``.
+    ``scene_draws``. :func:`declined` says why not.
     """
-    if scene.time_resolved is None or scene.probe is not None or \
-            not set(outputs) <= set(FUSED_OUTPUTS):
-        return False
+    return not declined(scene, outputs, errors, scene_draws)
+
+
+def declined(scene, outputs, errors, scene_draws=False):
+    """Why the compiled model does not take this call, in words ('' where it does)."""
+    if scene.time_resolved is None:
+        return "a static scene"
+    if scene.probe is not None:
+        return "a probe volume"
+    if not set(outputs) <= set(FUSED_OUTPUTS):
+        return f"output(s) {', '.join(sorted(set(outputs) - set(FUSED_OUTPUTS)))}"
+    lacked = modelinputs.lacks(MOTION_COMPILED, errors)
+    if lacked:
+        return f"input(s) {', '.join(lacked)}"
     if any(np.iscomplexobj(value) for value in errors.values()):
-        return False
+        return "complex inputs (the GUM's complex steps)"
     dims = len(scene.shape) if scene_draws else 0          # the scene axes of the draws
     for name, value in errors.items():
         ndim = np.ndim(value) - (dims if np.ndim(value) > 1 else 0)
-        if name.startswith("ins_") and name not in kernels.INPUTS[6:] and ndim > 2:
-            return False
-        if name in ("motion_phases", "motion_window") and ndim not in (0, 3):
-            return False
-        if name == "lidar_radial_velocity" and ndim not in (0, 3):
-            return False
-        if name in _GEOMETRY + kernels.INPUTS[6:] and ndim > 1:
-            return False
-    return True
+        if ndim > _MOST_AXES[modelinputs.input_named(name).shape] or \
+                (ndim and ndim < _LEAST_AXES[modelinputs.input_named(name).shape]):
+            return f"input {name} of {ndim} axes"
+    return ""
+
+
+#: Axes (trials first, scene axes not counted) the kernels take per shape of input
+#: (:data:`uq.physics.modelinputs.SHAPES`): an INS reading (n,) or (n, k), a draw per
+#: scan (n,), noise (n, beams, gates), phases (n, K, 2); 0 (a scalar) is always taken.
+_MOST_AXES = {"reading": 2, "scan": 1, "beam_gate": 3, "phase": 3}
+_LEAST_AXES = {"reading": 1, "scan": 1, "beam_gate": 3, "phase": 3}
 
 
 def measurement_model(scene, outputs, scene_draws=False, **errors):
@@ -205,7 +220,7 @@ def _scene_plan(scene):
     beams = scene.nominal_unit_vectors()
     azimuths = np.asarray(scene.azimuths, dtype=float)
     head = {"n_beams": n_beams, "n_gates": len(scene.ranges), "n_nodes": times.shape[1],
-            "n_slanted": len(azimuths), "model": CORRECTION_MODELS.index(scene.correction),
+            "n_slanted": len(azimuths), "model": Correction.of(scene.correction),
             "ins_mode": _INS_MODES[ins.rate and ins.interpolation],
             "rate": ins.rate or 0.0, "to_north": -math.cos(scene.wind_direction),
             "to_east": -math.sin(scene.wind_direction),        # (wind "from": blows to -e)

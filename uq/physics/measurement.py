@@ -63,8 +63,9 @@ from uq.physics import wind
 from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
 from uq.physics.correction import correction_rotation, correction_ship_velocity, reconstruct_wind
 from uq.physics.rotation import attitude_matrix, rotate_vectors
-from uq.physics.scene import (ANGULAR_NAVIGATION, COMPILED_OUTPUTS, NAVIGATION, OUTPUTS,  # noqa: F401
-                              SCENE_FIELDS, Scene, sample_count)
+from uq.physics import modelinputs
+from uq.physics.modelinputs import STATIC, STATIC_COMPILED
+from uq.physics.scene import ANGULAR_NAVIGATION, NAVIGATION, OUTPUTS, sample_count
 
 def true_wind(scene, heights, trailing=1):
     """True wind (north, east, up) [m s-1] at `heights` [m] of shape (..., *S, *T) with
@@ -177,6 +178,8 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
         result = fused.evaluate(scene, outputs, scene_draws, errors)
         if result is not None:                  # None: a call the compiled loop does not take
             return result
+        modelinputs.log_fallback(STATIC_COMPILED, fused.declined(scene, outputs, errors, scene_draws))
+    modelinputs.check_names(STATIC, errors)
     n = sample_count(errors)
     scenes = scene.shape if scene_draws else (1,) * len(scene.shape)
     err = {name: _error_shape(np.asarray(errors.get(name, 0.0)), name, scenes, scene_draws)
@@ -214,10 +217,8 @@ def _full_shape(result, leading, n_beams):
 
 #: Errors of the probe's parameters (model inputs ``lidar_<parameter>``, scenario units).
 PROBE_ERRORS = tuple(probe_volume.PARAMETER_SCALE)
-_ERROR_NAMES = tuple(f"ins_{key}" for key in NAVIGATION) + (
-    "lidar_half_cone", "lidar_misalignment", "lidar_radial_velocity", "lidar_height") + \
-    tuple(f"lidar_{key}" for key in PROBE_ERRORS)
-
+#: The inputs of the static numpy model (:mod:`uq.physics.modelinputs`).
+_ERROR_NAMES = modelinputs.names(STATIC)
 
 def _measure(scene, err, batch):
     """True radial velocities plus noise, and the INS readings (true + error)."""

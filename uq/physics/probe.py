@@ -422,18 +422,6 @@ class ContinuousWaveProbe(_Probe):
                 "and renormalised")
 
 
-def make_probe(settings):
-    """The probe of a validated ``lidar.probe`` mapping (scenario units), or None for a
-    point (or absent) probe."""
-    if not settings or settings["kind"] == "point":
-        return None
-    if settings["kind"] == "pulsed":
-        return PulsedProbe(settings["gate_length"], settings["pulse_fwhm"])
-    return ContinuousWaveProbe(settings["wavelength"] * PARAMETER_SCALE["wavelength"],
-                               settings["beam_radius"] * PARAMETER_SCALE["beam_radius"],
-                               settings["truncation"])
-
-
 def node_count(probe, heights, vertical, focus, shear, tolerance=PROBE_QUADRATURE_TOLERANCE):
     """Fewest Gauss-Legendre nodes whose weighted power-law speed is within `tolerance`
     (relative) of the :data:`~uq.constants.PROBE_REFERENCE_NODES`-node rule at every

@@ -12,6 +12,7 @@ import numpy as np
 
 from uq.physics.beams import beam_unit_vectors
 from uq.physics.ins import InsSampling
+from uq.physics.modelinputs import navigation_keys
 from uq.physics.motion import Motion
 from uq.physics.timing import ScanTiming
 
@@ -21,8 +22,9 @@ SCENE_FIELDS = ("wind_speed", "wind_direction", "vertical_wind", "shear", "refer
 OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity", "gate_height")
 #: The outputs the compiled model (:mod:`uq.physics.fused`) computes: all of them.
 COMPILED_OUTPUTS = OUTPUTS
-NAVIGATION = ("heading", "pitch", "roll", "sog", "cog", "heave")
-ANGULAR_NAVIGATION = ("heading", "pitch", "roll", "cog")
+#: What the INS reports with an error, and the angles among them (:mod:`uq.physics.modelinputs`).
+NAVIGATION = navigation_keys()
+ANGULAR_NAVIGATION = navigation_keys(angular_only=True)
 
 
 @dataclass(frozen=True)

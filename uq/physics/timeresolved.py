@@ -53,10 +53,13 @@ from uq.physics.probe import PARAMETER_SCALE
 from uq.physics.rotation import (attitude_from_matrix_analytic, attitude_matrix,
                                  attitude_matrix_rate, interpolate_rotation,
                                  rotation_about_vertical)
-from uq.physics.scene import ANGULAR_NAVIGATION, NAVIGATION, sample_count
+from uq.physics import modelinputs
+from uq.physics.modelinputs import MOTION, MOTION_COMPILED
+from uq.physics.scene import sample_count
 
-TIME_RESOLVED_INPUTS = ("motion_phases", "motion_window", "ins_clock_offset",
-                        "ins_sample_offset")
+#: The inputs a scan in motion adds to the static model's (:mod:`uq.physics.modelinputs`).
+TIME_RESOLVED_INPUTS = tuple(name for name in modelinputs.names(MOTION)
+                             if name not in modelinputs.names(modelinputs.STATIC))
 #: Probe parameters with errors (inputs ``lidar_<parameter>``, :mod:`uq.physics.probe`).
 PROBE_ERRORS = tuple(PARAMETER_SCALE)
 
@@ -71,10 +74,13 @@ def measurement_model(scene, outputs, scene_draws=False, compiled=True, **errors
     :mod:`uq.physics.fusedmotion`, which give the same values to 1e-12 m/s; False forces
     the numpy arrays below.
     """
-    if compiled and scene.probe is None:
+    if compiled:
         from uq.physics import fusedmotion    # (numba: imported only where it may apply)
-        if fusedmotion.applicable(scene, outputs, errors, scene_draws):
+        reason = fusedmotion.declined(scene, outputs, errors, scene_draws)
+        if not reason:
             return fusedmotion.measurement_model(scene, outputs, scene_draws, **errors)
+        modelinputs.log_fallback(MOTION_COMPILED, reason)
+    modelinputs.check_names(MOTION, errors)
     shape = scene.shape
     if not shape:
         return single_scene(scene, outputs, **errors)
@@ -130,9 +136,8 @@ def single_scene(scene, outputs, **errors):
     return _outputs(scene, outputs, wind_vector, measured + along, heights)
 
 
-_ALL_INPUTS = tuple(f"ins_{key}" for key in NAVIGATION) + (
-    "lidar_half_cone", "lidar_misalignment", "lidar_radial_velocity", "lidar_height") + \
-    TIME_RESOLVED_INPUTS
+#: The inputs of the time-resolved numpy model (:mod:`uq.physics.modelinputs`).
+_ALL_INPUTS = modelinputs.names(MOTION)
 
 
 def _phases(phases, window, resolved, n):
@@ -297,4 +302,4 @@ def _outputs(scene, outputs, wind_vector, corrected_radial, heights):
     return {q: np.broadcast_to(v, (n,) + np.shape(v)[1:]) for q, v in result.items()}
 
 
-__all__ = ["measurement_model", "TIME_RESOLVED_INPUTS", "ANGULAR_NAVIGATION"]
+

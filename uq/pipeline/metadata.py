@@ -22,6 +22,7 @@ import datetime
 import numpy as np
 
 from uq._version import __version__
+from uq.physics.modelinputs import error_units
 
 QUANTITIES = {
     "wind_speed": {"units": "m s-1", "long_name": "horizontal wind speed",
@@ -111,10 +112,8 @@ FLAG_MEANINGS = {"gum_valid": "not_validated validated",
 SCENARIO_UNITS = {"deg": "degree", "m s-1": "m s-1", "m": "m", "1": "1", "um": "um",
                   "mm": "mm"}
 #: Units of an error's size (``ins.<quantity>.<parameter>``), by quantity.
-ERROR_UNITS = {"heading": "degree", "pitch": "degree", "roll": "degree", "cog": "degree",
-               "sog": "m s-1", "heave": "m s-1", "half_cone": "degree",
-               "misalignment": "degree", "radial_velocity": "m s-1", "height": "m",
-               "gate_length": "m", "pulse_fwhm": "m", "wavelength": "um", "beam_radius": "mm"}
+#: (:mod:`uq.physics.modelinputs`).
+ERROR_UNITS = error_units()
 #: Parameters of an error distribution that are numbers without unit.
 DIMENSIONLESS_PARAMETERS = ("dof",)
 #: Statistics linked to their quantity's Monte Carlo mean and GUM value

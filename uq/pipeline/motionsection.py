@@ -318,4 +318,3 @@ def beam_stamps(settings, n_beams):
     return ScanTiming(**scan).stamps(n_beams)
 
 
-__all__ = ["validate_motion", "time_resolved", "np"]

@@ -26,7 +26,7 @@ value of a swept kind has the same inputs).
 """
 import math
 
-from uq.physics.probe import PARAMETER_SCALE, PROBE_KINDS
+from uq.physics.probe import PARAMETER_SCALE, PROBE_KINDS, ContinuousWaveProbe, PulsedProbe
 
 #: Parameters each kind needs (scenario units: m, m; um, mm, 1).
 KIND_PARAMETERS = {"point": (), "pulsed": ("gate_length", "pulse_fwhm"),
@@ -91,11 +91,22 @@ def unused_errors(settings, kind=None):
             if name in lidar["errors"] and name not in KIND_PARAMETERS[kind]]
 
 
+def make_probe(settings):
+    """The probe of a validated ``lidar.probe`` mapping (scenario units: m, m, um, mm), in
+    SI units (:mod:`uq.physics.probe`), or None for a point (or absent) probe."""
+    if not settings or settings["kind"] == "point":
+        return None
+    if settings["kind"] == "pulsed":
+        return PulsedProbe(settings["gate_length"], settings["pulse_fwhm"])
+    return ContinuousWaveProbe(settings["wavelength"] * PARAMETER_SCALE["wavelength"],
+                               settings["beam_radius"] * PARAMETER_SCALE["beam_radius"],
+                               settings["truncation"])
+
+
 def describe(settings, swept=()):
     """The probe model in words (the results' ``probe`` attribute): each kind the
     scenario runs (``swept``: the values of a swept ``lidar.probe.kind``), with its
     parameters and, for CW, the truncation of the Lorentzian's tails."""
-    from uq.physics.probe import make_probe
     probe = settings["lidar"].get("probe", {"kind": "point"})
     kinds = list(swept) or [probe["kind"]]
     lines = []

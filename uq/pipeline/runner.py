@@ -17,23 +17,30 @@ import xarray as xr
 
 from uq._version import __version__
 from uq.pipeline.distributions import error_distribution
-from uq.engine.inputs import Input, UniformCircle
-from uq.physics.ins import gauss_markov_correlation
-from uq.pipeline import motionsection, probesection
+from uq.engine.inputs import Input
+from uq.pipeline import probesection
+from uq.pipeline.modelsetup import (MOTION_INPUTS, error_inputs, input_label, scene_from_settings,
+                                    skipped_work)
 from uq.physics import probe as probe_volume
-from uq.physics.measurement import ANGULAR_NAVIGATION, OUTPUTS, Scene, measurement_model, true_values
+from uq.physics.measurement import measurement_model, true_values
+from uq.physics.modelinputs import error_keys, navigation_keys
+from uq.physics.scene import OUTPUTS
 from uq.pipeline.metadata import (COORDINATES, QUANTITIES, ancillary_variables, cf_encode,
                                   history, swept_key_attributes, variable_attributes)
 from uq.engine.propagate import propagate
 from uq.physics.rubio2022 import rubio2022_scene_uncertainty
 from uq.engine.sampling import new_seed
-from uq.pipeline.scenario import INS_KEYS, LIDAR_ERROR_KEYS, load_scenario
+from uq.pipeline.scenario import load_scenario
 from uq.engine.statistics import unwrap
 from uq.engine.stopping import STOPPED_BY
 from uq.pipeline.sweep import batch_scene, group_assignments, sweep_plan, vector_fields
 
 
-def run(scenario, progress=None, *, client=None, checkpoint=None):
+#: The values of ``uq run --model`` (and of :func:`run`'s `model`).
+MODEL_CHOICES = ("compiled", "numpy")
+
+
+def run(scenario, progress=None, *, client=None, checkpoint=None, model="compiled"):
     """Run a scenario and return its results.
 
     Parameters
@@ -46,6 +53,10 @@ def run(scenario, progress=None, *, client=None, checkpoint=None):
         Compute the chunks on this dask cluster; the result is identical to a local run.
     checkpoint : uq.pipeline.checkpoint.Checkpoint, optional
         Keeps finished chunks on disk and reuses those it already has (``--resume``).
+    model : {"compiled", "numpy"}
+        ``compiled`` (default): the compiled model wherever it applies (else numpy, logged
+        at ``-v``); ``numpy``: the numpy reference model throughout. Both give the same
+        numbers to 1e-12 m/s (``tests/pipeline/test_model_switch.py``).
 
     Returns
     -------
@@ -53,6 +64,8 @@ def run(scenario, progress=None, *, client=None, checkpoint=None):
         The variables listed in the README ("Results files").
     """
     started = time.perf_counter()
+    if model not in MODEL_CHOICES:
+        raise ValueError(f"model must be one of {', '.join(MODEL_CHOICES)}, not {model!r}")
     scenario = load_scenario(scenario)
     plan = sweep_plan(scenario)
     with (checkpoint.held() if checkpoint else contextlib.nullcontext()):
@@ -61,18 +74,20 @@ def run(scenario, progress=None, *, client=None, checkpoint=None):
             seed = checkpoint.seed if checkpoint and checkpoint.seed is not None else new_seed()
         if checkpoint:
             checkpoint.start(scenario, seed, plan.chunks)
-        results = _compute(scenario, plan, seed, progress, client, checkpoint)
+        results = _compute(scenario, plan, seed, progress, client, checkpoint,
+                           model == "compiled")
     dataset = _assemble(scenario, plan, results)
-    dataset.attrs.update(_global_attributes(scenario, seed, dataset, started))
+    dataset.attrs.update(_global_attributes(scenario, seed, dataset, started, model))
     return dataset
 
 
-def _compute(scenario, plan, seed, progress, client, checkpoint):
+def _compute(scenario, plan, seed, progress, client, checkpoint, compiled):
     """Results of every chunk, by index: from the checkpoint, else computed."""
     results = checkpoint.load() if checkpoint else {}
     todo = [chunk for chunk in plan.chunks if chunk.index not in results]
-    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed)) for chunk in todo) \
-        if client is None else _distributed(client, scenario, plan, todo, seed)
+    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed, compiled))
+                for chunk in todo) if client is None else \
+        _distributed(client, scenario, plan, todo, seed, compiled)
     if progress and results:
         progress(len(results), len(plan.chunks))
     for index, dataset in finished:
@@ -84,122 +99,36 @@ def _compute(scenario, plan, seed, progress, client, checkpoint):
     return results
 
 
-def _distributed(client, scenario, plan, chunks, seed):
+def _distributed(client, scenario, plan, chunks, seed, compiled):
     """Chunks on a dask cluster, yielded as they finish."""
     from dask.distributed import as_completed
-    futures = {client.submit(run_chunk, scenario, plan, chunk, seed, pure=False): chunk.index
+    futures = {client.submit(run_chunk, scenario, plan, chunk, seed, compiled, pure=False): chunk.index
                for chunk in chunks}
     for future in as_completed(futures, loop=client.loop):
         yield futures[future], future.result()
 
 
-def run_chunk(scenario, plan, chunk, seed):
-    """Results of one chunk of scenes: a Dataset with a ``scene`` dimension."""
+def run_chunk(scenario, plan, chunk, seed, compiled=True):
+    """Results of one chunk of scenes: a Dataset with a ``scene`` dimension (`compiled`:
+    the compiled model where it applies, else the numpy model throughout)."""
     if plan.group_keys:
         scenario = scenario.with_values(group_assignments(scenario, plan, chunk.group))
     base = scene_from_settings(scenario.settings)
     fields = vector_fields(scenario, plan, chunk) or {"wind_speed": np.array([base.wind_speed])}
-    return run_scene(scenario, batch_scene(base, fields), seed)
+    return run_scene(scenario, batch_scene(base, fields), seed, compiled)
 
 
-def scene_from_settings(settings):
-    """The nominal :class:`Scene` (SI, radians) of validated settings (degrees)."""
-    w, s, lid = settings["wind"], settings["ship"], settings["lidar"]
-    rad = np.deg2rad
-    return Scene(
-        wind_speed=w["speed"], wind_direction=rad(w["direction"]), vertical_wind=w["vertical"],
-        shear=w["shear"], reference_height=w["reference_height"],
-        sog=s["sog"], cog=rad(s["cog"]), heading=rad(s["heading"]), pitch=rad(s["pitch"]),
-        roll=rad(s["roll"]), heave=s["heave"],
-        lidar_height=lid["height"], ranges=tuple(lid["ranges"]), half_cone=rad(lid["half_cone"]),
-        misalignment=rad(lid["misalignment"]), azimuths=tuple(rad(lid["azimuths"])),
-        vertical_beam=lid["vertical_beam"], correction=settings["correction"],
-        time_resolved=motionsection.time_resolved(settings),
-        probe=probe_volume.make_probe(lid.get("probe")))
-
-
-def error_inputs(settings, n_beams, n_gates):
-    """Engine inputs (name -> distribution, float or Input) of the declared errors.
-
-    INS errors: one per scan (``scan``), one per beam (``beam``), or with a
-    ``correlation_time`` tau a Gauss-Markov process over the beams' time stamps
-    (correlation ``exp(-|t_k - t_l| / tau)``; tau = inf is one per scan). Time-resolved
-    scans add the unit phases of the random-phase motion components
-    (:class:`uq.engine.inputs.UniformCircle`), the clock offset and, for a sampled INS,
-    the offset of its samples (uniform over one period). Errors of the probe's parameters
-    (``lidar.errors.gate_length`` ...) are one draw per scan, in scenario units; those of
-    a parameter the probe's kind does not use stay inputs without effect (so that every
-    value of a swept ``lidar.probe.kind`` has the same inputs).
-    """
-    inputs = {}
-    beam_mode = settings["ins"]["correlation"] == "beam"
-    for key in INS_KEYS:
-        if key in settings["ins"]:
-            inputs[f"ins_{key}"] = _ins_input(settings, key, n_beams, beam_mode)
-    for key, spec in settings["lidar"]["errors"].items():
-        dist = error_distribution(spec)
-        shaped = key == "radial_velocity" and not isinstance(dist, float)
-        inputs[f"lidar_{key}"] = Input(dist, (n_beams, n_gates)) if shaped else dist
-    inputs.update(_motion_inputs(settings))
-    return inputs
-
-
-def _ins_input(settings, key, n_beams, beam_mode):
-    spec = settings["ins"][key]
-    dist = error_distribution({k: v for k, v in spec.items() if k != "correlation_time"})
-    if isinstance(dist, float):
-        return dist
-    tau = spec.get("correlation_time")
-    if tau is None:
-        return Input(dist, (n_beams,)) if beam_mode else dist
-    if tau == np.inf:
-        return dist                                   # the limit: one error per scan
-    stamps = motionsection.beam_stamps(settings, n_beams)
-    return Input(dist, (n_beams,), correlation=gauss_markov_correlation(stamps, tau))
-
-
-def _motion_inputs(settings):
-    inputs = {}
-    random = motionsection.random_phase_count(settings)
-    if random:
-        inputs["motion_phases"] = Input(UniformCircle(1.0), (random, 2))
-    series, window = motionsection.series_motion(settings.get("motion") or {})
-    if series:
-        inputs["motion_window"] = Input(window, (len(series), 2))
-    ins = settings["ins"]
-    if "clock_offset" in ins:
-        inputs["ins_clock_offset"] = error_distribution(ins["clock_offset"])
-    if "rate" in ins and motionsection.is_time_resolved(settings):
-        period = 1.0 / ins["rate"]
-        inputs["ins_sample_offset"] = error_distribution(
-            {"dist": "uniform", "half_width": period / 2, "mean": period / 2})
-    return inputs
-
-
-#: Budget labels of the inputs that are not scenario keys of their own.
-INPUT_LABELS = {"motion_phases": "motion (phases)", "motion_window": "motion.series (window)",
-                "ins_sample_offset": "ins.rate (sampling)"}
-
-
-def input_label(name):
-    """Dotted scenario key of an engine input name (``ins_sog`` -> ``ins.sog``)."""
-    if name in INPUT_LABELS:
-        return INPUT_LABELS[name]
-    section, key = name.split("_", 1)
-    return f"ins.{key}" if section == "ins" else f"lidar.errors.{key}"
-
-
-def run_scene(scenario, scene, seed):
+def run_scene(scenario, scene, seed, compiled=True):
     """Results of a batch of scenes (dimension ``scene``) that share `scenario`'s structure."""
     settings = scenario.settings
     outputs = model_outputs(scenario.outputs)
     n_gates = len(scene.ranges)
     scene = probe_volume.resolve(scene)       # the probe's node count, once per batch
     inputs = error_inputs(settings, scene.n_beams, n_gates)
-    engine = _propagate(scene, settings, outputs, inputs, seed)
-    dataset = _scene_dataset(scene, settings, outputs, engine)
+    engine = _propagate(scene, settings, outputs, inputs, seed, compiled)
+    dataset = _scene_dataset(scene, settings, outputs, engine, compiled)
     if wants_motion_ti(settings):
-        dataset = dataset.assign(_motion_ti(scene, settings, inputs, seed, dataset))
+        dataset = dataset.assign(_motion_ti(scene, settings, inputs, seed, dataset, compiled))
     return dataset
 
 
@@ -219,11 +148,7 @@ def model_outputs(outputs):
     return tuple(model)
 
 
-#: Inputs that are the motion itself (random phases and when the INS samples it).
-MOTION_INPUTS = ("motion_phases", "motion_window", "ins_sample_offset")
-
-
-def _motion_ti(scene, settings, inputs, seed, dataset):
+def _motion_ti(scene, settings, inputs, seed, dataset, compiled):
     """``wind_speed_motion_ti``: u of the scan's Vh from the motion alone (every other
     error at its mean), over the true Vh; Monte Carlo with the run's seed and sampling,
     and ``wind_speed_motion_ti_gum`` from the motion inputs' share of the GUM budget."""
@@ -234,7 +159,7 @@ def _motion_ti(scene, settings, inputs, seed, dataset):
         u_motion = np.zeros_like(truth) if not any(n in inputs for n in MOTION_INPUTS) \
             else np.full_like(truth, np.nan)
     else:
-        engine = _propagate(scene, settings, ("wind_speed",), motion_only, seed)
+        engine = _propagate(scene, settings, ("wind_speed",), motion_only, seed, compiled)
         u_motion = engine["wind_speed_mc_u"].values
     dims = dataset["wind_speed_true"].dims
     budget = dataset["wind_speed_budget"]
@@ -253,13 +178,13 @@ def _mean_of(spec):
     return float(distribution.mean())
 
 
-def _propagate(scene, settings, outputs, inputs, seed):
+def _propagate(scene, settings, outputs, inputs, seed, compiled):
     sampling = settings["sampling"]
     n_gates = len(scene.ranges)
 
     def model(**errors):
-        return measurement_model(scene, outputs, **errors)
-    model.whole_chunks = scene.time_resolved is None      # compiled: blocks its own trials
+        return measurement_model(scene, outputs, compiled=compiled, **errors)
+    model.whole_chunks = compiled and scene.time_resolved is None  # blocks its own trials
 
     return propagate(model, inputs,
                        n=sampling.get("n"), digits=sampling.get("digits"),
@@ -284,9 +209,9 @@ def _dims(quantity):
     return ("scene", "beam", "range") if quantity == "radial_velocity" else ("scene", "range")
 
 
-def _scene_dataset(scene, settings, outputs, engine):
+def _scene_dataset(scene, settings, outputs, engine, compiled):
     truth = true_values(scene, outputs)
-    nominal = measurement_model(scene, outputs)
+    nominal = measurement_model(scene, outputs, compiled=compiled)
     paper = _paper_uncertainty(scene, settings, truth["wind_speed"])
     data = {}
     for q in outputs:
@@ -352,8 +277,8 @@ def _beam_coordinates(scene):
 def _paper_uncertainty(scene, settings, gate_speeds):
     """Rubio & Gottschall (2022) u per output; NaN outside their model."""
     ins = settings["ins"]
-    u = {key: _standard_uncertainty(ins.get(key)) for key in INS_KEYS}
-    u = {key: np.deg2rad(value) if key in ANGULAR_NAVIGATION else value
+    u = {key: _standard_uncertainty(ins.get(key)) for key in error_keys("ins")}
+    u = {key: np.deg2rad(value) if key in navigation_keys(angular_only=True) else value
          for key, value in u.items()}
     per_gate = [rubio2022_scene_uncertainty(scene, gate_speeds[..., i], u["heading"],
                                             u["pitch"], u["roll"], u["sog"], u["cog"])
@@ -444,32 +369,7 @@ def _annotate(ds, scenario):
     return cf_encode(ds)
 
 
-def skipped_work(settings, outputs, probe_kinds=()):
-    """What the model did not compute for this scenario, in words (the ``skipped``
-    attribute): each line names a shortcut the measurement model took. `probe_kinds`: the
-    values of a swept ``lidar.probe.kind`` (default: the scenario's kind)."""
-    lidar, ins = settings["lidar"], settings["ins"]
-    lines = [f"input not sampled (no error declared): {key}" for key in
-             [f"ins.{k}" for k in INS_KEYS if k not in ins]
-             + [f"lidar.errors.{k}" for k in LIDAR_ERROR_KEYS
-                if k not in lidar["errors"]]]
-    if not ({"half_cone", "misalignment"} & set(lidar["errors"])):
-        lines.append("true beams and true radial velocities computed once per scene, not "
-                     "per trial (no geometry errors)")
-    if settings["correction"] in ("none", "yaw"):
-        lines.append(f"correction '{settings['correction']}': no pitch/roll rotation")
-    lines += [f"output not requested, not computed: {q}" for q in OUTPUTS if q not in outputs]
-    if "probe" in lidar:
-        for kind in probe_kinds or (lidar["probe"]["kind"],):
-            lines += [f"probe parameter error without effect where lidar.probe.kind is "
-                      f"{kind} (it does not use it): lidar.errors.{key}"
-                      for key in probesection.unused_errors(settings, kind)]
-        lines.append("probe volume: evaluated by the numpy model (the compiled model is "
-                     "point-wise)")
-    return "; ".join(lines) or "nothing"
-
-
-def _global_attributes(scenario, seed, dataset, started):
+def _global_attributes(scenario, seed, dataset, started, model):
     return {"title": f"uq results: {scenario.name}",
             "skipped": skipped_work(scenario.settings, scenario.outputs,
                                     dict(scenario.sweep).get("lidar.probe.kind", ())),
@@ -483,7 +383,9 @@ def _global_attributes(scenario, seed, dataset, started):
             "seed": seed,
             "correction": scenario.settings["correction"],
             "ins_correlation": scenario.settings["ins"]["correlation"],
-            "runtime_s": time.perf_counter() - started, **_probe_attributes(scenario)}
+            "runtime_s": time.perf_counter() - started, **_probe_attributes(scenario),
+            **({"model": "numpy: the numpy reference model throughout (uq run --model "
+                         "numpy)"} if model == "numpy" else {})}
 
 
 def _probe_attributes(scenario):

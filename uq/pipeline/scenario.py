@@ -30,16 +30,19 @@ from uq.pipeline.fitconfig import validate_fit
 from uq.pipeline.motionsection import (validate_ins_timing, validate_lever_arm, validate_motion,
                                        validate_scan)
 from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
-from uq.physics.measurement import OUTPUTS
+from uq.physics.modelinputs import error_keys
+from uq.physics.scene import OUTPUTS
 from uq.engine.sampling import PROPAGATION_METHODS
 from uq.engine.statistics import INTERVALS
 from uq.engine.stopping import STOPPING_RULES
 from uq.pipeline.sweep import VECTOR_KEYS
-from uq.pipeline.yamlfile import read_yaml  # noqa: F401  (read_yaml is the scenario reader)
+from uq.pipeline.yamlfile import read_yaml
 
 INS_CORRELATIONS = ("scan", "beam")
-INS_KEYS = ("heading", "pitch", "roll", "sog", "cog", "heave")
-LIDAR_ERROR_KEYS = ("half_cone", "misalignment", "radial_velocity", "height")
+#: The errors of the INS readings (``ins.<key>``) and of the lidar (``lidar.errors.<key>``,
+#: the probe's parameters' apart), as :mod:`uq.physics.modelinputs` declares them.
+INS_KEYS = error_keys("ins")
+LIDAR_ERROR_KEYS = tuple(key for key in error_keys("lidar") if key not in PROBE_ERROR_KEYS)
 #: Largest tilt the model accepts [deg]; beyond it the lidar looks sideways.
 MAX_TILT_DEG = 89.0
 MAX_SAMPLES = 10**10
@@ -322,9 +325,9 @@ def _lidar(check, value):
     _check_beams_determine_wind(check, out)
     errors = lid["errors"] if lid["errors"] is not None else {}
     check.mapping(errors, "lidar.errors")
-    check.keys(errors, "lidar.errors", LIDAR_ERROR_KEYS + PROBE_ERROR_KEYS)
+    check.keys(errors, "lidar.errors", error_keys("lidar"))
     out["errors"] = {key: validate_error(errors[key], f"lidar.errors.{key}", check)
-                     for key in LIDAR_ERROR_KEYS + PROBE_ERROR_KEYS if key in errors}
+                     for key in error_keys("lidar") if key in errors}
     if "lever_arm" in lid:
         out["lever_arm"] = validate_lever_arm(check, lid["lever_arm"])
     if "scan" in lid:
