@@ -3,6 +3,7 @@
     python scripts/shipped_digest.py > before.json      # on the old version
     python scripts/shipped_digest.py --compare before.json   # on the new one
     python scripts/shipped_digest.py --values-only > before.json   # values, not metadata
+    python scripts/shipped_digest.py --model numpy --agree   # numpy against compiled
 
 
 Each scenario runs as shipped (``uq run``'s code path, ``uq golden`` for golden
@@ -61,8 +62,9 @@ def values_digest(dataset):
     return out
 
 
-def shipped(digest=digest):
-    """Name -> digest of every shipped scenario's results."""
+def shipped(digest=digest, model="compiled"):
+    """Name -> digest of every shipped scenario's results, run with `model` (``uq run
+    --model``; golden reports run as ``uq golden`` does)."""
     import uq
     from uq.cli import main
     results = {}
@@ -79,8 +81,27 @@ def shipped(digest=digest):
                     results[path.stem] = digest(ds.load())
             continue
         print(f"running {path.name}", file=sys.stderr)
-        results[path.stem] = digest(uq.run(str(path)))
+        results[path.stem] = digest(uq.run(str(path), model=model))
     return results
+
+
+def agreement(model="numpy"):
+    """Name -> (variable, largest |difference|) between `model` and the compiled model on
+    every shipped ``uq run`` scenario as shipped (the worst variable of each), and the
+    overall largest difference of the wind outputs' values [m s-1 or deg]."""
+    import uq
+    worst = {}
+    for path in sorted(SCENARIOS.glob("*.yaml")):
+        if "golden:" in path.read_text():
+            continue
+        print(f"running {path.name} twice", file=sys.stderr)
+        one, two = uq.run(str(path)), uq.run(str(path), model=model)
+        gaps = {name: float(np.nanmax(np.abs(one[name].values - two[name].values)))
+                for name in one.data_vars if one[name].dtype.kind == "f"
+                and np.any(np.isfinite(one[name].values))}
+        name = max(gaps, key=gaps.get)
+        worst[path.stem] = (name, gaps[name])
+    return worst
 
 
 def main():
@@ -88,8 +109,17 @@ def main():
     parser.add_argument("--compare", help="digest file of the earlier version")
     parser.add_argument("--values-only", action="store_true",
                         help="digest the values of the variables only, not their metadata")
+    parser.add_argument("--model", choices=("compiled", "numpy"), default="compiled",
+                        help="the measurement model of the runs (uq run --model)")
+    parser.add_argument("--agree", action="store_true",
+                        help="run every scenario with --model and with the compiled model "
+                        "and print the largest difference of each")
     args = parser.parse_args()
-    now = shipped(values_digest if args.values_only else digest)
+    if args.agree:
+        for name, (variable, gap) in agreement(args.model).items():
+            print(f"{name}: largest difference {gap:.3g} ({variable})")
+        return 0
+    now = shipped(values_digest if args.values_only else digest, args.model)
     if not args.compare:
         json.dump(now, sys.stdout, indent=1)
         return 0

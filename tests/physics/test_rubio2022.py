@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import make_scene
+from uq.physics import modelinputs
 from uq.physics.correction import reconstruct_wind
 from uq.physics.beams import least_squares_operator
 from uq.physics.measurement import true_values
@@ -48,9 +49,9 @@ def test_eq6_equals_physical_model(p):
                           "ship.heading": np.rad2deg(p["yaw"]), "lidar.half_cone": np.rad2deg(p["cone"]),
                           "wind.reference_height": 100.0, "lidar.height": 0.0,
                           "lidar.ranges": [100.0], "correction": "yaw"})
-    from uq.physics.measurement import _measure, _ERROR_NAMES
+    from uq.physics.measurement import _measure
     measured, _, _ = _measure(scene, {n: np.zeros(1) if not n.startswith("ins_") else np.zeros((1, 1))
-                                   for n in _ERROR_NAMES}, 1)
+                                   for n in modelinputs.names(modelinputs.STATIC)}, 1)
     np.testing.assert_allclose(measured[0, :, 0], radial_i(p), rtol=1e-13, atol=1e-13)
 
 
@@ -79,9 +80,9 @@ def test_eq7_equals_physical_model(p, tilt):
                           "ship.sog": p["sog"], "ship.cog": np.rad2deg(p["cog"]),
                           "ship.heading": np.rad2deg(heading), "ship.pitch": np.rad2deg(pitch), "ship.roll": np.rad2deg(roll),
                           "lidar.half_cone": np.rad2deg(p["cone"]), "correction": "tilt2d"})
-    from uq.physics.measurement import _measure, _ERROR_NAMES
+    from uq.physics.measurement import _measure
     measured, _, _ = _measure(scene, {n: np.zeros(1) if not n.startswith("ins_") else np.zeros((1, 1))
-                                   for n in _ERROR_NAMES}, 1)
+                                   for n in modelinputs.names(modelinputs.STATIC)}, 1)
     np.testing.assert_allclose(measured[0, :, 0], radial_ii(p, *tilt), rtol=1e-12, atol=1e-13)
 
 

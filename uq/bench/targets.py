@@ -183,17 +183,8 @@ def gum_grid(repeats=1):
     """(seconds of the Fig. 2 GUM grid, seconds of the same with the numpy model's
     complex step, the previous implementation), and the number of scenes."""
     from uq.bench import sweep
-    from uq.pipeline import runner
     new_s, scenes = sweep.gum_grid()
-    original = runner.measurement_model
-
-    def numpy_model(*args, **kwargs):
-        return original(*args, **{**kwargs, "compiled": False})
-    runner.measurement_model = numpy_model
-    try:
-        old_s, _ = sweep.gum_grid()
-    finally:
-        runner.measurement_model = original
+    old_s, _ = sweep.gum_grid(model="numpy")          # uq run --model numpy
     return new_s, old_s, scenes
 
 

@@ -1,4 +1,5 @@
-"""``uq run SCENARIO [-o OUT.nc] [--set k=v] [--resume] [--workers N]``."""
+"""``uq run SCENARIO [-o OUT.nc] [--set k=v] [--resume] [--model numpy|compiled]
+[--workers N]``."""
 import contextlib
 import logging
 import os
@@ -20,6 +21,10 @@ def add_parser(commands):
     run.add_argument("--resume", action="store_true",
                      help="continue an interrupted run: reuse the finished chunks kept in "
                      "OUT.nc.partial/ and compute only the missing scenes")
+    run.add_argument("--model", choices=("compiled", "numpy"), default="compiled",
+                     help="the measurement model: 'compiled' (default; numba, wherever it "
+                     "applies, else numpy, said at -v) or 'numpy' (the reference model "
+                     "throughout; the same numbers to 1e-12 m/s, slower)")
     scale = run.add_mutually_exclusive_group()
     scale.add_argument("--workers", type=int, metavar="N",
                        help="run the sweep on a local dask cluster of N processes "
@@ -51,7 +56,8 @@ def command(args):
     checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume).acquire()
     try:
         with dask_client(args) as client:
-            dataset = run(scenario, progress=progress, client=client, checkpoint=checkpoint)
+            dataset = run(scenario, progress=progress, client=client, checkpoint=checkpoint,
+                          model=args.model)
         write_netcdf(dataset, output)
         checkpoint.clear()                   # still locked: no other run can be in it
     except KeyboardInterrupt:
@@ -89,6 +95,8 @@ def load_kernels(args, scenario):
     notice.start()
     try:
         import uq.engine.statkernels  # noqa: F401  (numba compiles or loads on import)
+        if getattr(args, "model", "compiled") == "numpy":
+            return                                    # no model kernel is called
         if motionsection.is_time_resolved(scenario.settings):   # the static model unused
             import uq.physics.fusedmotionkernels  # noqa: F401
         else:

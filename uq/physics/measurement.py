@@ -183,7 +183,7 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
     n = sample_count(errors)
     scenes = scene.shape if scene_draws else (1,) * len(scene.shape)
     err = {name: _error_shape(np.asarray(errors.get(name, 0.0)), name, scenes, scene_draws)
-           for name in _ERROR_NAMES}
+           for name in modelinputs.names(STATIC)}
     measured, navigation, beams_earth = _measure(scene, err, (n,) + scenes)
     unit_vectors = scene.nominal_unit_vectors()
     operator = least_squares_operator(unit_vectors)
@@ -217,8 +217,6 @@ def _full_shape(result, leading, n_beams):
 
 #: Errors of the probe's parameters (model inputs ``lidar_<parameter>``, scenario units).
 PROBE_ERRORS = tuple(probe_volume.PARAMETER_SCALE)
-#: The inputs of the static numpy model (:mod:`uq.physics.modelinputs`).
-_ERROR_NAMES = modelinputs.names(STATIC)
 
 def _measure(scene, err, batch):
     """True radial velocities plus noise, and the INS readings (true + error)."""

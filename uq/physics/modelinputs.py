@@ -116,6 +116,12 @@ class ModelInput:
         return self.key.split(".")[0]
 
     @property
+    def holds_distribution(self):
+        """Its scenario key holds its error distribution (``ins.heading: {dist: ...}``),
+        rather than a setting it is derived from (``ins.rate``, ``motion``)."""
+        return self.name.split("_", 1)[1] == self.short_key and self.section != "motion"
+
+    @property
     def short_key(self):
         """The key within its section's error mapping (``ins.heading`` -> ``heading``,
         ``lidar.errors.height`` -> ``height``)."""
@@ -201,10 +207,10 @@ def navigation_keys(angular_only=False):
 
 
 def error_units():
-    """Short key -> unit of every error of ``ins`` and ``lidar.errors``
-    (``heading`` -> ``degree``)."""
-    return {row.short_key: row.unit for row in INPUTS
-            if row.shape == "reading" or row.key.startswith("lidar.errors.")}
+    """Short key -> unit of every error distribution of ``ins`` and ``lidar.errors``
+    (``heading`` -> ``degree``, ``clock_offset`` -> ``s``): the inputs whose scenario key
+    holds their distribution (not ``ins.rate``, whose input is derived from it)."""
+    return {row.short_key: row.unit for row in INPUTS if row.holds_distribution}
 
 
 def label(name):

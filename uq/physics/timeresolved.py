@@ -109,7 +109,7 @@ def single_scene(scene, outputs, **errors):
     """The model for one scene (scalar fields); outputs of shape (n, g) or (n, b, g)."""
     resolved = scene.time_resolved
     n = sample_count(errors)
-    err = {name: np.asarray(errors.get(name, 0.0)) for name in set(errors) | set(_ALL_INPUTS)}
+    err = {name: np.asarray(errors.get(name, 0.0)) for name in set(errors) | set(modelinputs.names(MOTION))}
     # the motion and the INS timing vary over n_time trials (1 when none of their inputs
     # is random): the platform's kinematics are evaluated that many times, not n
     n_time = max([1] + [np.shape(err[k])[0] for k in TIME_RESOLVED_INPUTS if np.ndim(err[k])])
@@ -136,8 +136,6 @@ def single_scene(scene, outputs, **errors):
     return _outputs(scene, outputs, wind_vector, measured + along, heights)
 
 
-#: The inputs of the time-resolved numpy model (:mod:`uq.physics.modelinputs`).
-_ALL_INPUTS = modelinputs.names(MOTION)
 
 
 def _phases(phases, window, resolved, n):

@@ -126,20 +126,22 @@ class Checkpoint:
         except (OSError, ValueError):
             return {}
 
-    def start(self, scenario, seed, chunks):
+    def start(self, scenario, seed, chunks, model="compiled"):
         """Check (resume) or write (fresh) the manifest of this run; `chunks` is the
-        sweep plan's chunks (index, group, start, stop)."""
+        sweep plan's chunks (index, group, start, stop); `model` the measurement model
+        (``uq run --model``: a run never mixes the chunks of two models)."""
         plan = [[c.index, list(c.group), c.start, c.stop] for c in chunks]
         manifest = {"scenario": scenario.text, "seed": int(seed), "uq_version": __version__,
-                    "chunks": len(plan), "plan": plan}
+                    "chunks": len(plan), "plan": plan,
+                    **({"model": model} if model != "compiled" else {})}
         text = json.dumps(manifest, sort_keys=True)
         self.digest = hashlib.sha256(text.encode()).hexdigest()
         manifest["digest"] = self.digest
         if self.resume and (self.directory / MANIFEST).exists():
             if self._previous() != manifest:
                 raise CheckpointError(str(self.directory), MANIFEST, "the checkpoint belongs "
-                                      "to a different scenario, seed, chunk plan or uq "
-                                      "version; allowed: resume the same run, or run without "
+                                      "to a different scenario, seed, chunk plan, model "
+                                      "(--model) or uq version; allowed: resume the same run, or run without "
                                       "--resume to start afresh")
             return
         self._remove_chunks()                 # a fresh start: the folder is ours (marked)

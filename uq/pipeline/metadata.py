@@ -111,9 +111,6 @@ FLAG_MEANINGS = {"gum_valid": "not_validated validated",
 #: Units of the scenario's own unit names (docs/scenario.md) in UDUNITS, as CF wants.
 SCENARIO_UNITS = {"deg": "degree", "m s-1": "m s-1", "m": "m", "1": "1", "um": "um",
                   "mm": "mm"}
-#: Units of an error's size (``ins.<quantity>.<parameter>``), by quantity.
-#: (:mod:`uq.physics.modelinputs`).
-ERROR_UNITS = error_units()
 #: Parameters of an error distribution that are numbers without unit.
 DIMENSIONLESS_PARAMETERS = ("dof",)
 #: Statistics linked to their quantity's Monte Carlo mean and GUM value
@@ -143,7 +140,7 @@ def scenario_key_units(key):
         quantity, parameter = parts[-2], parts[-1]
         if parameter in DIMENSIONLESS_PARAMETERS:
             return "1"
-        return ERROR_UNITS.get(quantity)
+        return error_units().get(quantity)      # (:mod:`uq.physics.modelinputs`)
     found = meaning(key)
     return SCENARIO_UNITS.get(found[0]) if found else None
 

@@ -73,7 +73,7 @@ def run(scenario, progress=None, *, client=None, checkpoint=None, model="compile
         if seed is None:             # a resumed run keeps the seed its chunks were drawn with
             seed = checkpoint.seed if checkpoint and checkpoint.seed is not None else new_seed()
         if checkpoint:
-            checkpoint.start(scenario, seed, plan.chunks)
+            checkpoint.start(scenario, seed, plan.chunks, model)
         results = _compute(scenario, plan, seed, progress, client, checkpoint,
                            model == "compiled")
     dataset = _assemble(scenario, plan, results)
