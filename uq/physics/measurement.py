@@ -1,25 +1,13 @@
 """The ship-lidar measurement model: true scene -> measured radial velocities -> wind.
 
 One function, :func:`measurement_model`, is the model the Monte Carlo engine and the GUM
-propagate. Its random inputs are *errors* (deviations from the nominal scene):
-
-===========================  ===============  ========================================
-input                        shape            meaning
-===========================  ===============  ========================================
-``ins_heading``              (n, k)           INS heading error [deg]
-``ins_pitch``, ``ins_roll``  (n, k)           INS attitude errors [deg]
-``ins_sog``, ``ins_heave``   (n, k)           INS velocity errors [m s-1]
-``ins_cog``                  (n, k)           INS course error [deg]
-``lidar_half_cone``          (n,)             true minus configured half-cone [deg]
-``lidar_misalignment``       (n,)             true minus configured misalignment [deg]
-``lidar_radial_velocity``    (n, beams, gates) radial-velocity noise [m s-1]
-``lidar_height``             (n,)             true minus configured height of the lidar
-                                              above sea level [m] (draft, ballast, tide)
-``lidar_gate_length``,       (n,)             true minus configured parameters of the
-``lidar_pulse_fwhm``                          probe volume (:mod:`uq.physics.probe`):
-``lidar_wavelength``,                         [m], [m], [um], [mm]
-``lidar_beam_radius``
-===========================  ===============  ========================================
+propagate. Its random inputs are *errors* (deviations from the nominal scene), declared
+with their units and shapes in :mod:`uq.physics.modelinputs` (the rows whose models
+include ``static``): the INS errors ``ins_heading`` ... ``ins_heave`` (n, k) [deg, m s-1],
+the geometry errors ``lidar_half_cone``, ``lidar_misalignment`` (n,) [deg] and
+``lidar_height`` (n,) [m], the radial-velocity noise ``lidar_radial_velocity``
+(n, beams, gates) [m s-1], and the probe's parameters' errors ``lidar_gate_length`` ...
+(n,) in scenario units. A name the model does not implement is refused (ValueError).
 
 k = 1 when INS errors are shared by the beams of a scan (``scan``) and k = n_beams when
 each beam has its own reading (``beam``). Missing inputs are zero.

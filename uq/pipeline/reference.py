@@ -15,8 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
+from uq.physics import modelinputs
 from uq.pipeline import scenario as scenario_module
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS
+from uq.pipeline.probesection import PROBE_ERROR_KEYS
 from uq.pipeline.scenario import DEFAULTS, Checker
 
 #: A scenario that sets every optional key (values are examples, not defaults).
@@ -71,19 +73,12 @@ MEANINGS = {
     "ship.heave": ("m s-1", "heave velocity, positive up"),
     "ins.correlation": ("", "scan: one INS reading per scan, shared by all beams; beam: an "
                         "independent reading per beam (point-wise correction)"),
-    "ins.*": ("as the quantity", "error of the INS reading of heading, pitch, roll [deg], "
-              "sog [m s-1], cog [deg] or heave [m s-1] (a distribution)"),
     "lidar.height": ("m", "height of the lidar above sea level"),
     "lidar.ranges": ("m", "range-gate heights above a level lidar"),
     "lidar.half_cone": ("deg", "half-cone angle of the slanted beams, from vertical"),
     "lidar.azimuths": ("deg", "beam azimuths, clockwise from the reference beam"),
     "lidar.vertical_beam": ("", "a vertical beam besides the slanted ones"),
     "lidar.misalignment": ("deg", "angle from the bow to the reference beam, clockwise"),
-    "lidar.errors.*": ("as the quantity", "true minus configured half_cone [deg], "
-                       "misalignment [deg], radial_velocity noise per beam and gate "
-                       "[m s-1], height [m], and of the probe's gate_length, pulse_fwhm "
-                       "[m], wavelength [um], beam_radius [mm] (one draw per scan; needs "
-                       "the parameter in lidar.probe) (a distribution)"),
     "lidar.probe.kind": ("", "range weighting of each radial velocity along its beam: "
                          "point (at the gate centre; the default), pulsed (the range "
                          "gate convolved with a Gaussian pulse), cw (a focused continuous wave: a Lorentzian "
@@ -154,7 +149,6 @@ MEANINGS = {
     "ins.rate": ("Hz", "INS sampling rate (absent: a continuous INS)"),
     "ins.interpolation": ("", "reading between INS samples: nearest, or linear (the "
                           "default; attitude on the rotation group); needs ins.rate"),
-    "ins.clock_offset": ("s", "INS clock minus lidar clock (a distribution)"),
     "ins.*.correlation_time": ("s", "Gauss-Markov correlation time of an INS error "
                                "between the beams (0: independent, .inf: one per scan)"),
     "fit.profile": ("", "wind-profile model of uq fit"),
@@ -268,10 +262,31 @@ def _merge(base, overlay):
     return base
 
 
+#: The scenario's unit names of the declaration's UDUNITS names (``degree`` -> ``deg``).
+_SCENARIO_UNIT = {"degree": "deg"}
+
+
+def error_meaning(key):
+    """(unit, meaning) of the key of a declared model input's error distribution
+    (:mod:`uq.physics.modelinputs`), or None."""
+    for row in modelinputs.INPUTS:
+        if row.holds_distribution and row.key == key:
+            draw = {"reading": "one per INS reading (ins.correlation)",
+                    "scan": "one draw per scan", "beam_gate": "one draw per beam and gate"}
+            needs = " (needs the parameter in lidar.probe)" if \
+                key.rpartition(".")[2] in PROBE_ERROR_KEYS else ""
+            return (_SCENARIO_UNIT.get(row.unit, row.unit),
+                    f"{row.meaning}; {draw[row.shape]}{needs} (a distribution)")
+    return None
+
+
 def meaning(key):
     """(unit, meaning) of a dotted key, or None."""
     if key in MEANINGS:
         return MEANINGS[key]
+    declared = error_meaning(key)
+    if declared:
+        return declared
     parts = key.split(".")
     for i in range(len(parts) - 1, 0, -1):
         for pattern in (".".join(parts[:i] + ["*"] + parts[i + 1:]), ".".join(parts[:i] + ["*"])):
