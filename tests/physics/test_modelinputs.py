@@ -15,7 +15,8 @@ import pytest
 
 from uq.engine.inputs import input_set
 from uq.errors import ScenarioError
-from uq.physics import fused, fusedkernels, fusedmotion, fusedmotionkernels, modelinputs
+from uq.physics import (fused, fusedkernels, fusedmotion, fusedmotionkernels, kernelbase,
+                        modelinputs)
 from uq.physics.measurement import measurement_model
 from uq.physics.modelinputs import (INPUTS, MODELS, MOTION, MOTION_COMPILED, STATIC,
                                     STATIC_COMPILED, Correction, ModelInput)
@@ -152,8 +153,8 @@ def test_the_kernels_take_exactly_the_declared_inputs():
 def test_correction_codes_are_named_and_refuse_unknown_ones():
     assert [m.key for m in Correction] == ["none", "yaw", "tilt2d", "full", "pointwise"]
     assert Correction.of("tilt2d") == 2 and Correction.of("pointwise") == 4
-    assert fusedmotionkernels.NONE == Correction.NONE
-    assert fusedmotionkernels.POINTWISE == Correction.POINTWISE
+    assert kernelbase.NONE == Correction.NONE and kernelbase.FULL == Correction.FULL
+    assert kernelbase.POINTWISE == Correction.POINTWISE
     with pytest.raises(ValueError, match="unknown correction model 'tilt3d'.*allowed"):
         Correction.of("tilt3d")
 
@@ -271,3 +272,39 @@ def test_engine_inputs_follow_the_declaration_order():
     names = list(error_inputs(settings, 4, 2))
     declared = [row.name for row in INPUTS if row.name in names]
     assert names == declared
+
+
+def test_the_scratch_rows_of_the_compiled_motion_model_do_not_overlap():
+    """Each named block of the kernels' scratch has rows of its own, and the arrays have
+    exactly the rows the blocks need."""
+    for blocks, starts, total in (
+            (fusedmotionkernels.WORK_BLOCKS, fusedmotionkernels.WORK,
+             fusedmotionkernels.WORK_ROWS),
+            (fusedmotionkernels.STATE_BLOCKS, dict(zip(("value", "rate", "trig"), (
+                fusedmotionkernels._VALUE, fusedmotionkernels._RATE_ROW,
+                fusedmotionkernels._TRIG))), fusedmotionkernels.STATE_ROWS)):
+        assert kernelbase.overlapping(blocks, starts) == []
+        assert total == sum(rows for _, rows in blocks)
+        used = sorted(r for name, rows in blocks for r in range(starts[name],
+                                                                  starts[name] + rows))
+        assert used == list(range(total))
+    bad = (("a", 2), ("b", 1))
+    assert kernelbase.overlapping(bad, {"a": 0, "b": 1}) == [("a", "b")]
+    with pytest.raises(ValueError, match="'a': a name used twice"):
+        kernelbase.row_layout((("a", 1), ("a", 2)))
+
+
+def test_the_static_kernel_refuses_an_unknown_correction_code():
+    """A model code outside NONE..FULL (pointwise is the time-resolved model's) fails in
+    the kernel instead of running some branch."""
+    scene = scene_for("ins_heading", STATIC, None)
+    table, shapes = fused.make_scene_table(scene)
+    structure = np.array([4, 0, 2, kernelbase.POINTWISE, 1, 0, 0, 0, 0], dtype=np.int64)
+    zero = np.zeros((1, 1, 1))
+    kernels = fusedkernels.compiled(float)
+    out = np.empty((1, 2, 1))
+    with pytest.raises(ValueError, match="unknown correction model code"):
+        kernels["wind_scan"](table, shapes, structure, (zero,) * 6, zero,
+                             np.ones((4, 4, 1)), np.zeros((4, 4, 1)), np.zeros((1, 4, 3)),
+                             np.ones((1, 4, 2)), zero, 0, 1, 0, 1, False, False, out, out,
+                             out, out, np.empty((1, 1, 1, 1)), out)

@@ -39,13 +39,9 @@ import math
 import numpy as np
 from numba import njit, types
 
-from uq.constants import HYPOT_SAFE_MAX, HYPOT_SAFE_MIN, SMALL_ANGLE
-
-_DEG = math.pi / 180.0
-# Taylor coefficients (-1)^k / (2k+1)! of sin x / x and (-1)^k / (2k)! of cos x in x^2;
-# the first omitted terms at |x| = SMALL_ANGLE are below 2e-25 (see constants.py)
-_S = tuple((-1) ** k / math.factorial(2 * k + 1) for k in range(8))
-_C = tuple((-1) ** k / math.factorial(2 * k) for k in range(9))
+from uq.constants import SMALL_ANGLE
+from uq.physics.kernelbase import (COS_TAYLOR, DEG as _DEG, FULL, NONE, SIN_TAYLOR, TILT2D, YAW,
+                                   horner, hypot as _hypot)
 
 #: Columns of the scene table (:func:`uq.physics.fused.scene_table`), one row per scene:
 #: these scalars, then the cosines and the sines of TRIG, then the row of the scene's
@@ -103,11 +99,7 @@ def _signature(kind, dtype):
 def _taylor(x):
     """(cos x, sin x) of a small angle x [rad] from their Taylor polynomials."""
     x2 = x * x
-    sin_x = x * (_S[0] + x2 * (_S[1] + x2 * (_S[2] + x2 * (_S[3] + x2 * (
-        _S[4] + x2 * (_S[5] + x2 * (_S[6] + x2 * _S[7])))))))
-    cos_x = _C[0] + x2 * (_C[1] + x2 * (_C[2] + x2 * (_C[3] + x2 * (_C[4] + x2 * (
-        _C[5] + x2 * (_C[6] + x2 * (_C[7] + x2 * _C[8])))))))
-    return cos_x, sin_x
+    return horner(COS_TAYLOR, x2), x * horner(SIN_TAYLOR, x2)
 
 
 @njit(inline="always")
@@ -226,7 +218,7 @@ def fill_table(fields, index, out):
 def _attitude(table, s):
     """The scene's true body-to-earth rotation Rz(heading) Ry(pitch) Rx(roll), row-major
     (the expressions of :func:`uq.physics.rotation.attitude_matrix`)."""
-    return _rotation(3, table[s, _COS + _T_HEADING], table[s, _SIN + _T_HEADING],
+    return _rotation(FULL, table[s, _COS + _T_HEADING], table[s, _SIN + _T_HEADING],
                      table[s, _COS + _T_PITCH], table[s, _SIN + _T_PITCH],
                      table[s, _COS + _T_ROLL], table[s, _SIN + _T_ROLL], 1.0, 0.0)
 
@@ -309,23 +301,13 @@ def _rotation(model, ch, sh, cp, sp, cr, sr, cos_nominal, sin_nominal):
     """Row-major body-to-earth rotation the correction believes: Rz(heading) Ry(pitch)
     Rx(roll) of the INS reading (tilt2d, full), its heading alone (yaw) or the
     configured heading (none) (:mod:`uq.physics.rotation`)."""
-    if model == 0:
+    if model == NONE:
         ch, sh, cp, sp, cr, sr = cos_nominal, sin_nominal, 1.0, 0.0, 1.0, 0.0
-    elif model == 1:
+    elif model == YAW:
         cp, sp, cr, sr = 1.0, 0.0, 1.0, 0.0
     return (ch * cp, ch * sp * sr - sh * cr, -ch * sp * cr - sh * sr,
             sh * cp, sh * sp * sr + ch * cr, -sh * sp * cr + ch * sr,
             sp, -cp * sr, cp * cr)
-
-
-@njit(inline="always")
-def _hypot(x, y):
-    """sqrt(x^2 + y^2); for real input libm's hypot where the squares could over- or
-    underflow (as :func:`uq.complexstep.hypot`)."""
-    radius = np.sqrt(x * x + y * y)
-    if x.imag == 0.0 and y.imag == 0.0 and not HYPOT_SAFE_MIN < radius.real < HYPOT_SAFE_MAX:
-        radius = math.hypot(x.real, y.real)
-    return radius
 
 
 @njit(inline="always")
@@ -374,6 +356,32 @@ def _gate_heights(table, s, shapes, shape, beams, r, height_error, n_slanted, n_
 
 
 @njit(inline="always")
+def _true_radials(beams, profile, r, speed_ref, w, to_north, to_east, true_ship, n_beams,
+                  n_gates, truth):
+    """The true radial velocities of the truth's row r (:func:`geometry`) into truth
+    (b, g): ``U(z) (n_h . e) + n_up w - n . v_ship`` [m s-1] (Eq. 2 of [1])."""
+    for b in range(n_beams):
+        along_wind = beams[r, b, 0] * to_north + beams[r, b, 1] * to_east
+        moving = beams[r, b, 0] * true_ship[0] + beams[r, b, 1] * true_ship[1] + \
+            beams[r, b, 2] * true_ship[2]
+        for g in range(n_gates):
+            truth[b, g] = speed_ref * profile[r, b, g] * along_wind + beams[r, b, 2] * w - moving
+
+
+@njit(inline="always")
+def _store(north, east, up, s, g, i, want_speed, want_vertical, want_direction, speed,
+           vertical, from_north, from_east):
+    """The wanted outputs of one reconstructed wind (north, east, up) [m s-1]: the speed,
+    the vertical wind and the "from" vector of the direction."""
+    if want_speed:
+        speed[s, g, i] = _hypot(north, east)
+    if want_vertical:
+        vertical[s, g, i] = up
+    if want_direction:
+        from_north[s, g, i], from_east[s, g, i] = -north, -east
+
+
+@njit(inline="always")
 def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
           s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
           radial, gate_height, pointwise):
@@ -390,7 +398,8 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
     (point-wise, [2]; ``tilt2d`` then projects as Eq. 13 of [1] with the mean reading,
     as :func:`uq.physics.correction.reconstruct_wind`); otherwise Eq. 13 of [1] with one
     reading. ``from_north``, ``from_east`` get the "from" vector (the direction is then
-    taken by numpy's SIMD arctan2). Model: 0 none, 1 yaw, 2 tilt2d, 3 full.
+    taken by numpy's SIMD arctan2). Model: the codes NONE, YAW, TILT2D, FULL of
+    :class:`uq.physics.modelinputs.Correction` (any other: ValueError).
 
     `pointwise` is a constant of each of the two kernels (:func:`wind_scan`,
     :func:`wind_pointwise`), so each compiles only its own branch.
@@ -401,6 +410,8 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
     """
     n_slanted, vertical_beam, n_gates, model = structure[0], structure[1], structure[2], \
         structure[3]
+    if model != NONE and model != YAW and model != TILT2D and model != FULL:
+        raise ValueError("unknown correction model code (see uq.physics.modelinputs)")
     want_speed, want_direction, want_vertical = structure[4], structure[5], structure[6]
     want_radial, want_height = structure[7], structure[8]
     n_beams = n_slanted + vertical_beam
@@ -426,7 +437,7 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
     matrix = np.full((3, 3), zero)
     rhs = np.full(3, zero)
     one = zero + 1.0
-    mean_rot = _rotation(3, one, zero, one, zero, one, zero, 1.0, 0.0)
+    mean_rot = _rotation(FULL, one, zero, one, zero, one, zero, 1.0, 0.0)
     mean_ship = (zero, zero)
     for s in range(s0, s1):
         speed_ref, w = table[s, _SPEED], table[s, _VERTICAL]
@@ -455,13 +466,8 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                   t0, count, tr0, cos_trig, sin_trig, cos_read, sin_read)
         if not per_trial:                    # one truth for all trials: A^+ truth once
             r = s
-            for b in range(n_beams):
-                along_wind = beams[r, b, 0] * to_north + beams[r, b, 1] * to_east
-                moving = beams[r, b, 0] * true_ship[0] + beams[r, b, 1] * true_ship[1] + \
-                    beams[r, b, 2] * true_ship[2]
-                for g in range(n_gates):                          # U(z) (n_h . e) + n_up w
-                    truth[b, g] = speed_ref * profile[r, b, g] * along_wind + \
-                        beams[r, b, 2] * w - moving
+            _true_radials(beams, profile, r, speed_ref, w, to_north, to_east, true_ship,
+                          n_beams, n_gates, truth)
             for g in range(n_gates):
                 for k in range(3):
                     total = zero
@@ -477,13 +483,8 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
             noise_i = i if noise.shape[0] > 1 else 0
             if per_trial:                           # this trial's true radial velocities
                 r = (s - s0) * count + j
-                for b in range(n_beams):
-                    along_wind = beams[r, b, 0] * to_north + beams[r, b, 1] * to_east
-                    moving = (beams[r, b, 0] * true_ship[0] + beams[r, b, 1] * true_ship[1]
-                              + beams[r, b, 2] * true_ship[2])
-                    for g in range(n_gates):
-                        truth[b, g] = speed_ref * profile[r, b, g] * along_wind + \
-                            beams[r, b, 2] * w - moving
+                _true_radials(beams, profile, r, speed_ref, w, to_north, to_east, true_ship,
+                              n_beams, n_gates, truth)
                 if want_height:
                     _gate_heights(table, s, shapes, shape, beams, r, _pick(height_error, i, s, 0), n_slanted,
                                   n_gates, at_slant, heights)
@@ -492,8 +493,8 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                     gate_height[s, g, i] = heights[g]
             if not pointwise:
                 # ---- one reading per scan: Eq. 13 [1]
-                if model == 0:                       # none: the configured heading, fixed
-                    rot = _rotation(0, one, zero, one, zero, one, zero, cos_nominal,
+                if model == NONE:                    # none: the configured heading, fixed
+                    rot = _rotation(NONE, one, zero, one, zero, one, zero, cos_nominal,
                                     sin_nominal)
                     cc, sc = zero, zero
                 else:
@@ -503,9 +504,9 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                     cc, sc = cos_read[3, 0, j], sin_read[3, 0, j]
                 sog = sog0 + _pick(sog_error, i, s, 0)
                 heave = heave0 + _pick(heave_error, i, s, 0)
-                moving = model != 0
+                moving = model != NONE
                 ship = (sog * cc if moving else zero, sog * sc if moving else zero,
-                        heave if model == 3 else zero)
+                        heave if model == FULL else zero)
                 for g in range(n_gates):                 # the lidar-frame wind A^+ v
                     if per_trial:                        # v = truth + noise
                         x = y = z = zero
@@ -526,16 +527,12 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                     north = rot[0] * x + rot[1] * y + ship[0]                # Eq. 13 [1]
                     east = rot[3] * x + rot[4] * y + ship[1]
                     up = z
-                    if model == 3:
+                    if model == FULL:
                         north += rot[2] * z
                         east += rot[5] * z
                         up = rot[6] * x + rot[7] * y + rot[8] * z + ship[2]
-                    if want_speed:
-                        speed[s, g, i] = _hypot(north, east)
-                    if want_vertical:
-                        vertical[s, g, i] = up
-                    if want_direction:
-                        from_north[s, g, i], from_east[s, g, i] = -north, -east
+                    _store(north, east, up, s, g, i, want_speed, want_vertical, want_direction,
+                           speed, vertical, from_north, from_east)
                 if want_radial:        # measured + (R n_lidar) . ship: motion-free radial
                     for b in range(n_beams):
                         e0 = rot[0] * units[b, 0] + rot[1] * units[b, 1] + rot[2] * units[b, 2]
@@ -549,8 +546,9 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                 continue
             # ---- a reading per beam: point-wise correction, then least squares [2]
             for b in range(n_beams):
-                if model == 0:
-                    rot = _rotation(0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, cos_nominal, sin_nominal)
+                if model == NONE:
+                    rot = _rotation(NONE, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, cos_nominal,
+                                    sin_nominal)
                 else:
                     kh = b if heading_error.shape[2] > 1 else 0
                     kp = b if pitch_error.shape[2] > 1 else 0
@@ -561,12 +559,12 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                 for k in range(3):
                     normal[b, k] = rot[3 * k] * units[b, 0] + rot[3 * k + 1] * units[b, 1] \
                         + rot[3 * k + 2] * units[b, 2]
-                if model == 0:
+                if model == NONE:
                     along[b] = zero
                 else:
                     kc = b if cog_error.shape[2] > 1 else 0
                     sog = sog0 + _pick(sog_error, i, s, b)
-                    heave = heave0 + _pick(heave_error, i, s, b) if model == 3 else zero
+                    heave = heave0 + _pick(heave_error, i, s, b) if model == FULL else zero
                     along[b] = normal[b, 0] * (sog * cos_read[3, kc, j]) + \
                         normal[b, 1] * (sog * sin_read[3, kc, j]) + normal[b, 2] * heave
             if want_radial:
@@ -577,7 +575,7 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                         radial[s, b, g, i] = measured + along[b]
             if not (want_speed or want_direction or want_vertical):
                 continue
-            if model == 2:                           # tilt2d: the mean reading (Eq. 13 [1])
+            if model == TILT2D:                      # tilt2d: the mean reading (Eq. 13 [1])
                 mean[0] = _mean_reading(heading_error, base[0], i, s, zero)
                 mean[1] = _mean_reading(pitch_error, base[1], i, s, zero)
                 mean[2] = _mean_reading(roll_error, base[2], i, s, zero)
@@ -586,7 +584,7 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                 for k in range(sog_error.shape[2]):
                     total += sog0 + _pick(sog_error, i, s, k)
                 mean[4] = total / sog_error.shape[2]
-                mean_rot = _rotation(3, np.cos(mean[0]), np.sin(mean[0]), np.cos(mean[1]),
+                mean_rot = _rotation(FULL, np.cos(mean[0]), np.sin(mean[0]), np.cos(mean[1]),
                                      np.sin(mean[1]), np.cos(mean[2]), np.sin(mean[2]),
                                      cos_nominal, sin_nominal)
                 mean_ship = (mean[4] * np.cos(mean[3]), mean[4] * np.sin(mean[3]))
@@ -605,19 +603,15 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                         matrix[k, m] = total
                 _solve3(matrix, rhs)
                 north, east, up = rhs[0], rhs[1], rhs[2]
-                if model == 2:         # R_m^T (u - s_m), then its horizontal part rotated
+                if model == TILT2D:    # R_m^T (u - s_m), then its horizontal part rotated
                     d0, d1, d2 = north - mean_ship[0], east - mean_ship[1], up
                     x = mean_rot[0] * d0 + mean_rot[3] * d1 + mean_rot[6] * d2
                     y = mean_rot[1] * d0 + mean_rot[4] * d1 + mean_rot[7] * d2
                     up = mean_rot[2] * d0 + mean_rot[5] * d1 + mean_rot[8] * d2
                     north = mean_rot[0] * x + mean_rot[1] * y + mean_ship[0]
                     east = mean_rot[3] * x + mean_rot[4] * y + mean_ship[1]
-                if want_speed:
-                    speed[s, g, i] = _hypot(north, east)
-                if want_vertical:
-                    vertical[s, g, i] = up
-                if want_direction:
-                    from_north[s, g, i], from_east[s, g, i] = -north, -east
+                _store(north, east, up, s, g, i, want_speed, want_vertical, want_direction,
+                       speed, vertical, from_north, from_east)
 
 
 def wind_scan(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile,

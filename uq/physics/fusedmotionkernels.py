@@ -49,15 +49,15 @@ from numba import njit
 
 from uq.constants import (HALF_PI_PARTS, HYPOT_SAFE_MAX, HYPOT_SAFE_MIN,
                           SINCOS_REDUCTION_LIMIT, SLERP_SERIES_LIMIT)
+from uq.physics.kernelbase import (COS_TAYLOR, DEG as _DEG, FULL, NONE, POINTWISE, SIN_TAYLOR,
+                                   YAW, horner as _horner, row_layout)
 
-_DEG = math.pi / 180.0
 _TWO_OVER_PI = 2.0 / math.pi
 _P1, _P2, _P3 = HALF_PI_PARTS
-# Taylor coefficients in x^2: sin x / x = sum (-1)^k x^2k / (2k+1)!, cos x = sum (-1)^k
-# x^2k / (2k)!; on |x| <= pi/4 the first omitted terms, x^16/17! = 6e-17 (against
-# sin x >= 0.7 x) and x^18/18! = 2e-18, are below half an ulp [2]
-_SIN = tuple((-1) ** k / math.factorial(2 * k + 1) for k in range(8))
-_COS = tuple((-1) ** k / math.factorial(2 * k) for k in range(9))
+# the Taylor coefficients of sine and cosine (kernelbase): on |x| <= pi/4 the first
+# omitted terms, x^16/17! = 6e-17 (against sin x >= 0.7 x) and x^18/18! = 2e-18, are below
+# half an ulp [2]
+_SIN, _COS = SIN_TAYLOR, COS_TAYLOR
 # arcsin s / s = sum binom(2k, k) / (4^k (2k + 1)) s^2k [2], to s^50: the first omitted
 # term at s^2 = SLERP_SERIES_LIMIT = 0.25 is 5e-19
 _ASIN = tuple(math.comb(2 * k, k) / (4 ** k * (2 * k + 1)) for k in range(26))
@@ -78,8 +78,8 @@ HEAD = ("n_beams", "n_gates", "n_nodes", "n_slanted", "model", "ins_mode", "rate
  _ARM_BOW, _ARM_STARBOARD, _ARM_UP, _STATIC_ARM_UP, _HALF_CONE, _MISALIGNMENT, _MOVES_YAW,
  _HAS_ARM) = range(len(HEAD))
 
-#: Correction models (:data:`uq.physics.correction.CORRECTION_MODELS`) and INS modes.
-NONE, YAW, TILT2D, FULL, POINTWISE = range(5)
+#: Correction models: the codes NONE ... POINTWISE of
+#: :class:`uq.physics.modelinputs.Correction` (:mod:`uq.physics.kernelbase`); INS modes.
 CONTINUOUS, NEAREST, LINEAR = range(3)
 #: Per-trial INS inputs of :func:`reconstruct`, in the order of ``has`` (which are given).
 INPUTS = ("ins_heading", "ins_pitch", "ins_roll", "ins_sog", "ins_cog", "ins_heave",
@@ -89,17 +89,26 @@ _CLOCK, _OFFSET = 6, 7
 #: Rows of a platform state (states[i], (rows, trials)): the six degrees of freedom's
 #: values and rates (roll, pitch, yaw, surge, sway, heave) and the attitude's (cos, sin)
 #: of heading, pitch and roll.
-_VALUE, _RATE_ROW, _TRIG = 0, 6, 12
-STATE_ROWS = 18
-# rows of the block scratch ``work`` (rows, trials): temporaries, the two INS samples of
-# a linear interpolation, one INS reading and the INS errors of one reading
-_ANGLE, _SINE, _COSINE, _SHIFT, _LIDAR_Z, _BIG = 0, 1, 2, 3, 4, 5
-_CONE, _MIS, _BEAM, _ALONG, _MEASURED = 6, 8, 10, 13, 14
-_MATRIX1, _MATRIX2, _FRACTION = 15, 24, 33           # 9, 9, 1 rows
-_RATES1, _VELOCITY1 = 34, 37                          # 3, 3 rows
-_READ_TRIG, _READ_VELOCITY = 40, 46                   # 6, 3 rows
-_ERROR, _SOG, _COG, _HEAVE = 49, 52, 53, 55           # heading, pitch, roll [rad]; m s-1;
-WORK_ROWS = 56                                        # (cos, sin); m s-1
+STATE_BLOCKS = (("value", 6), ("rate", 6), ("trig", 6))
+_STATE, STATE_ROWS = row_layout(STATE_BLOCKS)
+_VALUE, _RATE_ROW, _TRIG = _STATE["value"], _STATE["rate"], _STATE["trig"]
+#: Rows of the block scratch ``work`` (rows, trials), one block after another: temporaries
+#: (an angle, its sine and cosine, the clock shift, the lidar's height, a flag), the true
+#: beam's cone and misalignment (cos, sin), the believed beam, the lidar velocity along it,
+#: the measured radial velocity, the two INS samples of a linear interpolation (matrices,
+#: fraction, rates, velocity), one INS reading (the (cos, sin) of heading, pitch, roll;
+#: velocity) and the INS errors of one reading (heading, pitch, roll [rad]; sog [m s-1];
+#: cog as (cos, sin); heave [m s-1]).
+WORK_BLOCKS = (("angle", 1), ("sine", 1), ("cosine", 1), ("shift", 1), ("lidar_z", 1),
+               ("big", 1), ("cone", 2), ("misalignment", 2), ("beam", 3), ("along", 1),
+               ("measured", 1), ("matrix1", 9), ("matrix2", 9), ("fraction", 1),
+               ("rates1", 3), ("velocity1", 3), ("read_trig", 6), ("read_velocity", 3),
+               ("error", 3), ("sog", 1), ("cog", 2), ("heave", 1))
+WORK, WORK_ROWS = row_layout(WORK_BLOCKS)
+(_ANGLE, _SINE, _COSINE, _SHIFT, _LIDAR_Z, _BIG, _CONE, _MIS, _BEAM, _ALONG, _MEASURED,
+ _MATRIX1, _MATRIX2, _FRACTION, _RATES1, _VELOCITY1, _READ_TRIG, _READ_VELOCITY, _ERROR,
+ _SOG, _COG, _HEAVE) = (WORK[name] for name, _ in WORK_BLOCKS)
+
 
 _helper = njit(cache=True, nogil=True, error_model="numpy")
 _inline = njit(inline="always", error_model="numpy")
@@ -114,14 +123,6 @@ def _head(consts):
     """The scalars of :data:`HEAD` as a tuple: values, not memory, so that loops reading
     them need no alias checks against the arrays they write."""
     return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31])
-
-
-@_inline
-def _horner(coefficients, x):
-    total = 0.0
-    for k in range(len(coefficients) - 1, -1, -1):
-        total = total * x + coefficients[k]
-    return total
 
 
 @_inline
@@ -745,6 +746,8 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
     """
     n_beams, n_gates, n_nodes = int(consts[_N_BEAMS]), int(consts[_N_GATES]), int(consts[_N_NODES])
     model, mode, speed_ref = int(consts[_MODEL]), int(consts[_INS_MODE]), consts[_WIND_SPEED]
+    if model < NONE or model > POINTWISE:             # (tilt2d is the default branch)
+        raise ValueError("unknown correction model code (see uq.physics.modelinputs)")
     at_nodes = states.shape[0] > 1
     phases = c
     if mode == CONTINUOUS and has[_CLOCK]:            # read at t + delta: turn the phases
