@@ -32,6 +32,19 @@ class Input:
     correlation : ndarray, optional
         Correlation matrix between the ``prod(shape)`` elements (C order), imposed with
         the Gaussian copula like the correlation between inputs.
+
+    Examples
+    --------
+    Three independent draws per trial of a 0.1 m/s noise, summed: the GUM gives
+    u = 0.1 sqrt(3) exactly (the model is linear):
+
+    >>> from scipy import stats
+    >>> import uq
+    >>> noise = uq.Input(stats.norm(0.0, 0.1), (3,))
+    >>> result = uq.propagate(lambda noise: noise.sum(axis=-1), {"noise": noise},
+    ...                       n=20_000, seed=1)
+    >>> round(float(result["y_gum_u"]), 6)
+    0.173205
     """
 
     distribution: object

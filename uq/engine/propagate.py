@@ -105,6 +105,22 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         independent randomisations, for lhs and sobol), ``q_mc_numerical_tolerance``
         (delta of the requested digits, JCGM 101 7.9.2); circular outputs also
         ``q_mc_circular_std``.
+
+    Examples
+    --------
+    The sum of two independent normal errors of 1 and 2: u = sqrt(5) = 2.236 by the
+    GUM (exact for a linear model), and the Monte Carlo u agrees within its own
+    standard error (0.005 at 10^5 trials):
+
+    >>> from scipy import stats
+    >>> import uq
+    >>> result = uq.propagate(lambda a, b: a + b,
+    ...                       {"a": stats.norm(0, 1), "b": stats.norm(0, 2)},
+    ...                       n=100_000, seed=2)
+    >>> round(float(result["y_gum_u"]), 4)
+    2.2361
+    >>> abs(float(result["y_mc_u"]) - 5 ** 0.5) < 5 * float(result["y_mc_u_standard_error"])
+    True
     """
     _check_arguments(n, digits, method, interval, stopping)
     if stop_when_gum_valid and n is not None:

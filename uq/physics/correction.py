@@ -105,6 +105,22 @@ def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navig
     -------
     ndarray, shape (..., 3, n_gates)
         Wind (north, east, up) [m s-1].
+
+    Examples
+    --------
+    A level four-beam DBS at rest (28 deg half-cone) in a 10 m/s wind from the north
+    measures ``n . u`` on each beam; ``full`` reconstructs the wind exactly:
+
+    >>> import numpy as np
+    >>> from uq.physics.beams import beam_unit_vectors, least_squares_operator
+    >>> beams = beam_unit_vectors(np.deg2rad(28.0), np.deg2rad([0, 90, 180, 270]), 0.0,
+    ...                           False)
+    >>> wind = np.array([-10.0, 0.0, 0.0])                  # blowing to the south
+    >>> radial = (beams @ wind)[:, None]                      # (beams, 1 gate)
+    >>> still = {k: np.zeros(1) for k in ("heading", "pitch", "roll", "sog", "cog", "heave")}
+    >>> np.round(reconstruct_wind(radial, "full", beams, least_squares_operator(beams),
+    ...                           still)[:, 0], 12) + 0.0
+    array([-10.,   0.,   0.])
     """
     nav = navigation
     rotation = correction_rotation(model, nav["heading"], nav["pitch"], nav["roll"],

@@ -32,6 +32,14 @@ def wind_components(speed, direction):
     -------
     north, east : ndarray
         [m s-1]. Eqs. 4-5 [1].
+
+    Examples
+    --------
+    A 10 m/s wind from the west (270 deg) blows to the east:
+
+    >>> north, east = wind_components(10.0, 270.0)
+    >>> round(float(north), 12), round(float(east), 12)
+    (0.0, 10.0)
     """
     direction_rad = complexstep.radians(direction)
     return -speed * np.cos(direction_rad), -speed * np.sin(direction_rad)
@@ -48,6 +56,17 @@ def wind_direction(north, east):
     Inverse of :func:`wind_components`: ``atan2(-east, -north)``. (Eq. 18 of [1],
     ``atan(v/u)``, gives the direction the wind blows *to*, modulo 180 deg; this is the
     corrected form.) Undefined (returned as 0) for zero wind.
+
+    Examples
+    --------
+    Wind blowing to the south comes from the north; to the east, from the west:
+
+    >>> float(wind_direction(-5.0, 0.0)), float(wind_direction(0.0, 5.0))
+    (0.0, 270.0)
+    >>> import numpy as np
+    >>> north, east = wind_components(8.0, np.array([10.0, 200.0, 359.0]))
+    >>> np.round(wind_direction(north, east), 9)
+    array([ 10., 200., 359.])
     """
     angle = complexstep.degrees(complexstep.arctan2(-east, -north))
     return complexstep.mod(angle, FULL_CIRCLE_DEG)
