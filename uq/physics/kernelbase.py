@@ -41,6 +41,20 @@ def horner(coefficients, x):
 
 
 @njit(inline="always")
+def taylor_cos_sin(x):
+    """(cos x, sin x) of a small angle x [rad] from their Taylor polynomials, written out
+    with constant indices (the static model's form; :func:`horner` gives the same
+    numbers)."""
+    s, c = SIN_TAYLOR, COS_TAYLOR
+    x2 = x * x
+    sin_x = x * (s[0] + x2 * (s[1] + x2 * (s[2] + x2 * (s[3] + x2 * (
+        s[4] + x2 * (s[5] + x2 * (s[6] + x2 * s[7])))))))
+    cos_x = c[0] + x2 * (c[1] + x2 * (c[2] + x2 * (c[3] + x2 * (c[4] + x2 * (
+        c[5] + x2 * (c[6] + x2 * (c[7] + x2 * c[8])))))))
+    return cos_x, sin_x
+
+
+@njit(inline="always")
 def hypot(x, y):
     """sqrt(x^2 + y^2); for real input libm's hypot where the squares could over- or
     underflow (as :func:`uq.complexstep.hypot`; complex input: the complex step)."""
