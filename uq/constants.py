@@ -211,6 +211,22 @@ MAX_WAVE_COMPONENTS = 256
 #: ~50 MB of CSV; a longer record adds nothing a scan of seconds can use.
 MAX_SERIES_BYTES = 64 << 20
 
+#: Most rows of a motion record [1], counted before it is parsed: a day of 20 Hz samples
+#: is 1.7 million; a longer record adds nothing a scan of seconds can use.
+MAX_SERIES_ROWS = 2_000_000
+
+#: Largest fit table (``uq fit`` of a CSV) read [bytes]: its rows are bounded by
+#: ``MAX_FIT_POINTS`` (10^4 rows of a few numbers, well under 1 MiB); the byte limit only
+#: keeps the row count cheap to take.
+MAX_FIT_TABLE_BYTES = 64 << 20
+
+#: Largest table of 10-min records read by ``uq golden`` (CSV or netCDF) [bytes]: ten years
+#: of records with a dozen columns at five heights are ~100 MiB of CSV.
+MAX_RECORD_BYTES = 256 << 20
+
+#: Most rows of a table of 10-min records [1], counted before it is parsed: 19 years.
+MAX_RECORD_ROWS = 1_000_000
+
 # --- probe volume (issue 19) -------------------------------------------------------------
 
 #: Relative error allowed in a probe-weighted wind speed by the quadrature along the beam

@@ -32,7 +32,6 @@ validated settings unless given).
     correction: pointwise
 """
 import functools
-import io
 import math
 from pathlib import Path
 
@@ -45,13 +44,15 @@ from uq.errors import ScenarioError
 from uq.physics.series import WindowStart, series_components
 from uq.physics.timing import TIMESTAMPS, ScanTiming
 from uq.physics.waves import jonswap_components
-from uq.constants import MAX_SERIES_BYTES, MAX_WAVE_COMPONENTS
+from uq.constants import MAX_SERIES_BYTES, MAX_SERIES_ROWS, MAX_WAVE_COMPONENTS
 
 HARMONIC_KEYS = ("amplitude", "period", "phase")
 SPECTRUM_KEYS = ("kind", "hs", "tp", "gamma", "components", "band")
 SPECTRUM_KINDS = ("jonswap",)
 RESPONSE_KEYS = ("factor", "lag")
 SERIES_KEYS = ("file", "time", "columns", "components")
+#: What a motion record is, in messages about the file.
+SERIES_KIND = "a CSV motion record"
 #: Fewest samples of a motion record [1]: a Fourier series of fewer says little.
 MIN_SERIES_SAMPLES = 16
 #: Largest relative spread of a record's sampling intervals [1]: the Fourier series
@@ -129,18 +130,10 @@ def read_series(file, time, columns, source="<mapping>"):
 
 @functools.lru_cache(maxsize=8)
 def _read_series(file, version, time, columns):
-    import pandas as pd
     from uq.errors import DataFileError
-    from uq.pipeline.yamlfile import read_text
-    try:
-        text = read_text(Path(file), limit=MAX_SERIES_BYTES)
-    except ScenarioError as error:
-        raise DataFileError(str(file), "motion.series.file", error.problem) from None
-    try:
-        table = pd.read_csv(io.StringIO(text))
-    except (ValueError, pd.errors.ParserError, pd.errors.EmptyDataError) as error:
-        raise DataFileError(str(file), "motion.series.file", f"cannot read it as CSV "
-                            f"({str(error).splitlines()[0][:100]})") from None
+    from uq.pipeline.inputfile import read_csv
+    table = read_csv(Path(file), MAX_SERIES_BYTES, MAX_SERIES_ROWS, SERIES_KIND,
+                     DataFileError, "motion.series.file")
     wanted = [time] + [c for _, c in columns]
     missing = [c for c in wanted if c not in table.columns]
     if missing:

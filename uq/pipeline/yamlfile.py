@@ -10,52 +10,29 @@ an :class:`~uq.errors.ScenarioError` naming the file, the line and what is allow
 * a file that is not UTF-8 text (binary data, Latin-1, UTF-16);
 * a key given twice in one mapping (YAML would silently keep the last: a repeated ``ins``
   section would drop the first one's errors);
-* a folder, a device or an endless stream where a file was expected.
+* a folder, a device, a named pipe or an endless stream where a file was expected
+  (:mod:`uq.pipeline.inputfile`).
 """
-import stat
 from pathlib import Path
 
 import yaml
 
 from uq.constants import MAX_CONFIG_BYTES, MAX_CONFIG_DEPTH, MAX_CONFIG_NODES
 from uq.errors import ScenarioError
+from uq.pipeline.inputfile import decode, read_bytes
 
 
-def read_yaml(path):
-    """The YAML document in the file at `path` (plain Python objects)."""
+def read_yaml(path, kind="a YAML file"):
+    """The YAML document in the file at `path` (plain Python objects); `kind` names the
+    file in messages (``"a YAML scenario"``)."""
     path = Path(path)
-    return parse_yaml(read_text(path), str(path))
+    return parse_yaml(read_text(path, kind=kind), str(path))
 
 
-def read_text(path, limit=MAX_CONFIG_BYTES):
-    """The text of a small configuration file, read with a size limit."""
-    try:
-        info = path.stat()
-        if stat.S_ISDIR(info.st_mode):
-            raise ScenarioError(str(path), "", "is a folder; allowed: a YAML file")
-        with open(path, "rb") as stream:
-            data = stream.read(limit + 1)
-    except OSError as error:
-        raise ScenarioError(str(path), "", f"cannot read the file ({error.strerror or error})"
-                            ) from None
-    if len(data) > limit:
-        raise ScenarioError(str(path), "", f"larger than {limit // 1024} KiB (or endless); "
-                            f"allowed: a YAML file of at most {limit // 1024} KiB")
-    return decode(data, str(path))
-
-
-def decode(data, source):
-    """UTF-8 text of `data` (a byte-order mark is allowed), or ScenarioError."""
-    if b"\x00" in data:
-        raise ScenarioError(source, "", "holds NUL bytes (binary data or UTF-16 text); "
-                            "allowed: UTF-8 text")
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as error:
-        line = data[:error.start].count(b"\n") + 1
-        raise ScenarioError(source, "", f"not UTF-8 text (byte {data[error.start]:#04x} at "
-                            f"line {line}; Latin-1 or another encoding?); allowed: UTF-8 "
-                            "text") from None
+def read_text(path, limit=MAX_CONFIG_BYTES, kind="a YAML file"):
+    """The UTF-8 text of a small configuration file: a regular file, read without
+    blocking and with a size limit (:func:`uq.pipeline.inputfile.read_bytes`)."""
+    return decode(read_bytes(path, limit, kind), str(path))
 
 
 def parse_yaml(text, source):
