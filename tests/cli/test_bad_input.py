@@ -508,9 +508,11 @@ def _(d):
 def golden_config(d, name="campaign", files=None):
     files = files or {"flsa": "flsa.csv", "mast": "mast.csv"}
     config = {"golden": {"name": name, "instruments": {
-        key: {"file": file, "heights": {80: {"speed": "ws", "direction": "wd"}}}
+        key: {"file": file, "time": "timestamp",
+              "heights": {80: {"speed": "ws", "direction": "wd"}}}
         for key, file in files.items()},
-        "comparisons": [{"unit": "flsa", "reference": "mast"}]}}
+        "comparisons": [{"unit": "flsa", "reference": "mast"}],
+        "classification": {"route": "class_number"}}}
     if "mast" in files:
         config["golden"]["instruments"]["mast"]["calibration"] = {"absolute": 0.05,
                                                                   "relative": 0.005}
