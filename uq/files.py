@@ -32,7 +32,7 @@ import threading
 from pathlib import Path
 
 from uq._version import __version__
-from uq.errors import OutputError
+from uq.errors import OutputError, Terminated
 
 #: Text that marks a file as written by uq (in reports and figure metadata).
 SIGNATURE = "written by uq"
@@ -160,7 +160,8 @@ def atomic_file(path, source="-o"):
 
 @contextlib.contextmanager
 def deferred_interrupt():
-    """Hold Ctrl-C (SIGINT) back until the block is done, then raise KeyboardInterrupt.
+    """Hold Ctrl-C (SIGINT) and SIGTERM back until the block is done, then raise
+    KeyboardInterrupt (:class:`~uq.errors.Terminated` for SIGTERM).
 
     A KeyboardInterrupt in the middle of a netCDF write can leave the writer's internal
     (non-reentrant) lock held, and its clean-up then waits on it forever; a write takes
@@ -171,11 +172,15 @@ def deferred_interrupt():
         yield
         return
     received = []
-    previous = signal.signal(signal.SIGINT, lambda number, frame: received.append(number))
+    previous = {number: signal.signal(number, lambda got, frame: received.append(got))
+                for number in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+    if signal.SIGTERM in received:
+        raise Terminated
     if received:
         raise KeyboardInterrupt
 

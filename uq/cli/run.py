@@ -6,7 +6,7 @@ import signal
 import sys
 from pathlib import Path
 
-from uq.cli.common import EXIT_INTERRUPTED, EXIT_OK, parse_overrides, say
+from uq.cli.common import EXIT_OK, EXIT_TERMINATED, interrupted_status, parse_overrides, say
 from uq.errors import ScenarioError
 
 
@@ -54,10 +54,12 @@ def command(args):
             dataset = run(scenario, progress=progress, client=client, checkpoint=checkpoint)
         write_netcdf(dataset, output)
         checkpoint.clear()                   # still locked: no other run can be in it
-    except KeyboardInterrupt:
-        print(f"\nuq: interrupted; finished chunks are kept in {checkpoint.directory}; "
+    except KeyboardInterrupt as stop:
+        status = interrupted_status(stop)
+        print(f"\nuq: {'terminated' if status == EXIT_TERMINATED else 'interrupted'}; "
+              f"finished chunks are kept in {checkpoint.directory}; "
               "run the same command with --resume to continue", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return status
     except Exception:
         if checkpoint.is_empty():            # nothing to resume: leave nothing behind
             checkpoint.clear()

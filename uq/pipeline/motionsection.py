@@ -44,7 +44,8 @@ from uq.errors import ScenarioError
 from uq.physics.series import WindowStart, series_components
 from uq.physics.timing import TIMESTAMPS, ScanTiming
 from uq.physics.waves import jonswap_components
-from uq.constants import MAX_SERIES_BYTES, MAX_SERIES_ROWS, MAX_WAVE_COMPONENTS
+from uq.constants import (MAX_MAGNITUDE, MAX_SERIES_BYTES, MAX_SERIES_ROWS,
+                          MAX_WAVE_COMPONENTS)
 
 HARMONIC_KEYS = ("amplitude", "period", "phase")
 SPECTRUM_KEYS = ("kind", "hs", "tp", "gamma", "components", "band")
@@ -166,8 +167,15 @@ def _spectrum(check, value):
     check.keys(value, key, SPECTRUM_KEYS)
     check.required(value, key, ("hs", "tp"), "a spectrum needs hs [m] and tp [s]")
     tp = check.number(value["tp"], f"{key}.tp", low=0.0, low_open=True)
-    band = value.get("band", [SPECTRUM_BAND[0] / tp, SPECTRUM_BAND[1] / tp])
-    band = check.number_list(band, f"{key}.band", low=0.0, low_open=True)
+    if "band" in value:
+        band = check.number_list(value["band"], f"{key}.band", low=0.0, low_open=True)
+    else:
+        band = [SPECTRUM_BAND[0] / tp, SPECTRUM_BAND[1] / tp]
+        if not all(0.0 < f <= MAX_MAGNITUDE for f in band):
+            check.fail(f"{key}.tp", f"{tp:g} s gives the default band {SPECTRUM_BAND[0]:g}/tp "
+                       f"to {SPECTRUM_BAND[1]:g}/tp = [{band[0]:g}, {band[1]:g}] Hz, beyond "
+                       f"the numbers allowed (at most {MAX_MAGNITUDE:g}); allowed: a peak "
+                       "period in seconds, or an explicit band")
     if len(band) != 2 or not band[0] < band[1]:
         check.fail(f"{key}.band", "allowed: [lowest, highest] frequency in Hz, lowest first")
     return {"kind": check.choice(value.get("kind", "jonswap"), f"{key}.kind", SPECTRUM_KINDS),
@@ -202,6 +210,9 @@ def _harmonic(check, value, key, angular):
                    "a harmonic needs amplitude and period (phase defaults to random)")
     high = MAX_ANGULAR_AMPLITUDE_DEG if angular else None
     phase = value.get("phase", "random")
+    if isinstance(phase, str) and phase != "random":
+        check.fail(f"{key}.phase", f"{phase!r} is not allowed; allowed: a number of degrees "
+                   "in [-360, 360], or random")
     return {"amplitude": check.number(value["amplitude"], f"{key}.amplitude", low=0.0,
                                       high=high),
             "period": check.number(value["period"], f"{key}.period", low=0.0, low_open=True),
