@@ -240,6 +240,10 @@ MAX_SERIES_BYTES = 64 << 20
 #: is 1.7 million; a longer record adds nothing a scan of seconds can use.
 MAX_SERIES_ROWS = 2_000_000
 
+#: Largest results file read whole by ``uq plot``, ``uq report`` and ``uq fit`` [bytes]:
+#: it is loaded into memory; 10^4 scenes of the full model's outputs are ~100 MiB.
+MAX_RESULTS_BYTES = 4 << 30
+
 #: Largest fit table (``uq fit`` of a CSV) read [bytes]: its rows are bounded by
 #: ``MAX_FIT_POINTS`` (10^4 rows of a few numbers, well under 1 MiB); the byte limit only
 #: keeps the row count cheap to take.
