@@ -617,6 +617,14 @@ def with_series(d, file):
         "file": str(file), "time": "t", "columns": {"heave": "heave"}}}), "m.yaml")
 
 
+def fit_config(d, content, *names):
+    """`uq fit` of a good table with the configuration `content` (-c) must be refused
+    with a message naming the configuration file and `names`."""
+    config = scenario(d, content, "fit.yaml")
+    return [(["fit", str(fit_table(d)), "-c", str(config), "-o", str(d / "f.nc")],
+             (str(config),) + names)]
+
+
 def refused_by_both(path, record, *names):
     """`uq check` and `uq run` of the scenario at `path` must refuse its motion record
     (the message names the record, not the scenario)."""
@@ -706,54 +714,43 @@ def _(d):
 
 @case("fit -c of binary garbage")
 def _(d):
-    config = scenario(d, bytes(range(256)) * 16, "fit.yaml")
-    return [(["fit", str(fit_table(d)), "-c", str(config), "-o", str(d / "f.nc")],
-             (str(config), "UTF-8"))]
+    return fit_config(d, bytes(range(256)) * 16, "UTF-8")
 
 
 @case("fit -c of an alias bomb")
 def _(d):
     lines = ["a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
     lines += [f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 10) + "]" for i in range(1, 9)]
-    config = scenario(d, "\n".join(lines) + "\nfit: {walkers: *a8}\n", "fit.yaml")
-    return [(["fit", str(fit_table(d)), "-c", str(config), "-o", str(d / "f.nc")],
-             (str(config), "a4", "expands to more than"))]
+    return fit_config(d, "\n".join(lines) + "\nfit: {walkers: *a8}\n",
+                      "a4", "expands to more than")
 
 
 @case("fit -c with a python tag")
 def _(d):
-    config = scenario(d, "fit: {seed: !!python/object/apply:os.getcwd []}\n", "fit.yaml")
-    return [(["fit", str(fit_table(d)), "-c", str(config), "-o", str(d / "f.nc")],
-             (str(config), "fit.seed", "!!python/object/apply:os.getcwd", "allowed"))]
+    return fit_config(d, "fit: {seed: !!python/object/apply:os.getcwd []}\n",
+                      "fit.seed", "!!python/object/apply:os.getcwd", "allowed")
 
 
 @case("fit -c with a key given twice")
 def _(d):
-    config = scenario(d, "fit:\n  walkers: 32\n  seed: 1\n  walkers: 64\n", "fit.yaml")
-    return [(["fit", str(fit_table(d)), "-c", str(config), "-o", str(d / "f.nc")],
-             (str(config), "fit.walkers", "lines 2 and 4"))]
+    return fit_config(d, "fit:\n  walkers: 32\n  seed: 1\n  walkers: 64\n",
+                      "fit.walkers", "lines 2 and 4")
 
 
 @case("fit -c walkers 10^9")
 def _(d):
-    config = scenario(d, "fit: {walkers: 1000000000}\n", "fit.yaml")
-    return [(["fit", str(fit_table(d)), "-c", str(config), "-o", str(d / "f.nc")],
-             (str(config), "fit.walkers", "1024"))]
+    return fit_config(d, "fit: {walkers: 1000000000}\n", "fit.walkers", "1024")
 
 
 @case("fit -c ensembles 10^6")
 def _(d):
-    config = scenario(d, "fit: {ensembles: 1000000}\n", "fit.yaml")
-    return [(["fit", str(fit_table(d)), "-c", str(config), "-o", str(d / "f.nc")],
-             (str(config), "fit.ensembles", "64"))]
+    return fit_config(d, "fit: {ensembles: 1000000}\n", "fit.ensembles", "64")
 
 
 @case("fit -c more draws than memory holds")
 def _(d):
-    config = scenario(d, "fit: {walkers: 1024, ensembles: 64, max_steps: 1000000}\n",
-                      "fit.yaml")
-    return [(["fit", str(fit_table(d)), "-c", str(config), "-o", str(d / "f.nc")],
-             (str(config), "fit.max_steps", "draws"))]
+    return fit_config(d, "fit: {walkers: 1024, ensembles: 64, max_steps: 1000000}\n",
+                      "fit.max_steps", "draws")
 
 
 @case("fit --set of a bad prior")
@@ -764,9 +761,7 @@ def _(d):
 
 @case("fit -c without a fit section")
 def _(d):
-    config = scenario(d, "walkers: 32\n", "fit.yaml")
-    return [(["fit", str(fit_table(d)), "-c", str(config), "-o", str(d / "f.nc")],
-             (str(config), "fit", "'fit' section"))]
+    return fit_config(d, "walkers: 32\n", "fit", "'fit' section")
 
 
 def golden_with(d, **bins):
