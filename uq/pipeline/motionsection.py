@@ -131,6 +131,7 @@ def read_series(file, time, columns, source="<mapping>"):
 
 @functools.lru_cache(maxsize=8)
 def _read_series(file, version, time, columns):
+    import pandas as pd
     from uq.errors import DataFileError
     from uq.pipeline.inputfile import read_csv
     table = read_csv(Path(file), MAX_SERIES_BYTES, MAX_SERIES_ROWS, SERIES_KIND,
@@ -167,15 +168,14 @@ def _spectrum(check, value):
     check.keys(value, key, SPECTRUM_KEYS)
     check.required(value, key, ("hs", "tp"), "a spectrum needs hs [m] and tp [s]")
     tp = check.number(value["tp"], f"{key}.tp", low=0.0, low_open=True)
-    if "band" in value:
-        band = check.number_list(value["band"], f"{key}.band", low=0.0, low_open=True)
-    else:
-        band = [SPECTRUM_BAND[0] / tp, SPECTRUM_BAND[1] / tp]
+    band = value.get("band", [SPECTRUM_BAND[0] / tp, SPECTRUM_BAND[1] / tp])
+    if "band" not in value:                  # the default band: a problem is tp's
         if not all(0.0 < f <= MAX_MAGNITUDE for f in band):
             check.fail(f"{key}.tp", f"{tp:g} s gives the default band {SPECTRUM_BAND[0]:g}/tp "
                        f"to {SPECTRUM_BAND[1]:g}/tp = [{band[0]:g}, {band[1]:g}] Hz, beyond "
                        f"the numbers allowed (at most {MAX_MAGNITUDE:g}); allowed: a peak "
                        "period in seconds, or an explicit band")
+    band = check.number_list(band, f"{key}.band", low=0.0, low_open=True)
     if len(band) != 2 or not band[0] < band[1]:
         check.fail(f"{key}.band", "allowed: [lowest, highest] frequency in Hz, lowest first")
     return {"kind": check.choice(value.get("kind", "jonswap"), f"{key}.kind", SPECTRUM_KINDS),
