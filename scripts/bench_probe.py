@@ -29,7 +29,8 @@ import uq
 from uq.constants import (WINDCUBE_GATE_LENGTH, WINDCUBE_PULSE_FWHM, ZEPHIR_BEAM_RADIUS_MM,
                           ZEPHIR_TRUNCATION, ZEPHIR_WAVELENGTH_UM)
 from uq.physics import probe as probe_volume
-from uq.physics.measurement import COMPILED_OUTPUTS, measurement_model
+from uq.physics.measurement import measurement_model
+from uq.physics.scene import COMPILED_OUTPUTS
 from uq.pipeline.modelsetup import error_inputs, scene_from_settings
 from uq.pipeline.scenario import load_scenario
 from uq.pipeline.shipped import shipped_path

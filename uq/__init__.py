@@ -9,12 +9,15 @@ The package face is lazy: ``import uq`` loads none of numpy's heavier companions
 The layers, lowest first: :mod:`uq.physics` and :mod:`uq.engine` (independent of each
 other), :mod:`uq.pipeline`, :mod:`uq.outputs`, the wings :mod:`uq.fit`,
 :mod:`uq.golden` and :mod:`uq.bench`, and the command line :mod:`uq.cli`; below them
-all the base modules :mod:`uq.constants`, :mod:`uq.errors`, :mod:`uq.files` and
-:mod:`uq.complexstep`. No module imports this face.
+all the base modules :mod:`uq.constants`, :mod:`uq.errors`, :mod:`uq.files`,
+:mod:`uq.numbacache` and :mod:`uq.complexstep`. No module imports this face.
 """
 import importlib
 
+from uq import numbacache
 from uq._version import __version__
+
+numbacache.configure()          # before any kernel is compiled (a read-only install)
 
 #: Public name -> (module, attribute); attribute None means the module itself.
 _PUBLIC = {

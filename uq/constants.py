@@ -68,6 +68,22 @@ VON_KARMAN = 0.40
 #: affine-invariant ensemble needs more than twice the parameters (here <= 3).
 MIN_WALKERS = 32
 
+#: Most emcee walkers of a profile fit [1]: 32 times the fewest; more walkers of three
+#: parameters only slow each step.
+MAX_WALKERS = 1024
+
+#: Most independent ensembles of a profile fit [1]: the R-hat of 4 (the default) is
+#: already reliable (Vehtari et al. 2021); each costs a full chain.
+MAX_ENSEMBLES = 64
+
+#: Most steps per ensemble of a profile fit (``fit.max_steps``) [1].
+MAX_FIT_STEPS = 1_000_000
+
+#: Most draws (walkers x ensembles x max_steps) a fit may keep [1]: the chains are held in
+#: memory (8 bytes x 3-4 parameters each, then a converted copy): 10^7 draws are ~0.7 GB
+#: at most, 1.6 times the default 32 x 4 x 50000.
+MAX_FIT_DRAWS = 10_000_000
+
 # --- golden-lidar verification (uq.golden) -------------------------------------------
 
 #: Width of the reference-wind-speed bins [m s-1]; bins are centred on multiples of it.
@@ -80,6 +96,15 @@ GOLDEN_REQUIRED_RANGE = (4.0, 16.0)
 
 #: Fewest 10-min records a bin in the required range needs [1] (issue 6).
 GOLDEN_MIN_RECORDS = 6
+
+#: Largest plausible 10-min mean wind speed [m s-1]: above the strongest recorded 10-min
+#: means (tropical cyclones, ~80 m/s); a larger value is a missing-value code or a unit
+#: mistake. Bounds the records and ``golden.bins.required``.
+GOLDEN_MAX_SPEED = 100.0
+
+#: Most reference-speed bins of a campaign [1]: 0 to GOLDEN_MAX_SPEED in 0.1 m/s bins;
+#: the bins are built before any record is counted (memory and time follow their number).
+GOLDEN_MAX_BINS = 1000
 
 #: Level of the two-sided t-test on a sensitivity slope [1]: a slope is significant when
 #: its p-value is below this (the conventional 5 %).
@@ -210,6 +235,26 @@ MAX_WAVE_COMPONENTS = 256
 #: Largest motion record read [bytes]: a day of 10 Hz samples of six degrees of freedom is
 #: ~50 MB of CSV; a longer record adds nothing a scan of seconds can use.
 MAX_SERIES_BYTES = 64 << 20
+
+#: Most rows of a motion record [1], counted before it is parsed: a day of 20 Hz samples
+#: is 1.7 million; a longer record adds nothing a scan of seconds can use.
+MAX_SERIES_ROWS = 2_000_000
+
+#: Largest results file read whole by ``uq plot``, ``uq report`` and ``uq fit`` [bytes]:
+#: it is loaded into memory; 10^4 scenes of the full model's outputs are ~100 MiB.
+MAX_RESULTS_BYTES = 4 << 30
+
+#: Largest fit table (``uq fit`` of a CSV) read [bytes]: its rows are bounded by
+#: ``MAX_FIT_POINTS`` (10^4 rows of a few numbers, well under 1 MiB); the byte limit only
+#: keeps the row count cheap to take.
+MAX_FIT_TABLE_BYTES = 64 << 20
+
+#: Largest table of 10-min records read by ``uq golden`` (CSV or netCDF) [bytes]: ten years
+#: of records with a dozen columns at five heights are ~100 MiB of CSV.
+MAX_RECORD_BYTES = 256 << 20
+
+#: Most rows of a table of 10-min records [1], counted before it is parsed: 19 years.
+MAX_RECORD_ROWS = 1_000_000
 
 # --- probe volume (issue 19) -------------------------------------------------------------
 

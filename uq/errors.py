@@ -12,8 +12,14 @@ exits with status 2 (no traceback, no output file). Its subclasses say what was 
   target it did not create, a folder it cannot write).
 
 Each names the source (file or option), the key (dotted scenario key, column, path) and
-what is allowed.
+what is allowed. :class:`Terminated` (not bad input) is a KeyboardInterrupt raised on
+SIGTERM, so that a batch system's stop cleans up as Ctrl-C does.
 """
+
+
+class Terminated(KeyboardInterrupt):
+    """The process was asked to stop (SIGTERM: a batch system's time limit, ``timeout``,
+    ``kill``): handled like Ctrl-C (every clean-up of an interrupt runs), exit 143."""
 
 
 class InputError(ValueError):

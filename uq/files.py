@@ -32,7 +32,7 @@ import threading
 from pathlib import Path
 
 from uq._version import __version__
-from uq.errors import OutputError
+from uq.errors import OutputError, Terminated
 
 #: Text that marks a file as written by uq (in reports and figure metadata).
 SIGNATURE = "written by uq"
@@ -41,6 +41,12 @@ MARKER = ".uq-output"
 #: Bytes read from each end of a file when looking for :data:`SIGNATURE`.
 _SIGNATURE_WINDOW = 1 << 16
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
+#: How the netCDF library's errors begin (a RuntimeError): a write that fails with one is a
+#: failed write (a full disk: "NetCDF: HDF error"), not a bug.
+NETCDF_ERROR = "NetCDF:"
+#: Free space [bytes] below which a failed write is reported as a full file system: less
+#: than one chunk of results (~50 KiB to a few MiB).
+FULL_DISK_BYTES = 4 << 20
 
 
 def file_mode():
@@ -148,11 +154,15 @@ def atomic_file(path, source="-o"):
             yield Path(temporary)
             os.chmod(temporary, file_mode())
             os.replace(temporary, path)
-    except OSError as error:                 # a full disk, a quota, a read-only mount
+    except (OSError, RuntimeError) as error:     # a full disk, a quota, a read-only mount
+        if isinstance(error, RuntimeError) and not str(error).startswith(NETCDF_ERROR):
+            Path(temporary).unlink(missing_ok=True)
+            raise
+        reason = (getattr(error, "strerror", None) or str(error)) + _full_disk(path.parent)
         Path(temporary).unlink(missing_ok=True)
-        raise OutputError(source, str(path), f"cannot write it ({error.strerror or error}); "
-                          "nothing was written; allowed: a folder with space and write "
-                          "permission") from None
+        raise OutputError(source, str(path), f"cannot write it ({reason}); nothing was "
+                          "written; allowed: a folder with space and write permission"
+                          ) from None
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
@@ -160,7 +170,8 @@ def atomic_file(path, source="-o"):
 
 @contextlib.contextmanager
 def deferred_interrupt():
-    """Hold Ctrl-C (SIGINT) back until the block is done, then raise KeyboardInterrupt.
+    """Hold Ctrl-C (SIGINT) and SIGTERM back until the block is done, then raise
+    KeyboardInterrupt (:class:`~uq.errors.Terminated` for SIGTERM).
 
     A KeyboardInterrupt in the middle of a netCDF write can leave the writer's internal
     (non-reentrant) lock held, and its clean-up then waits on it forever; a write takes
@@ -171,13 +182,30 @@ def deferred_interrupt():
         yield
         return
     received = []
-    previous = signal.signal(signal.SIGINT, lambda number, frame: received.append(number))
+    previous = {number: signal.signal(number, lambda got, frame: received.append(got))
+                for number in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+    if signal.SIGTERM in received:
+        raise Terminated
     if received:
         raise KeyboardInterrupt
+
+
+def _full_disk(folder):
+    """'; the file system is full (N KiB free)' when it has less than FULL_DISK_BYTES
+    free for the user, else ''. The netCDF library reports a full disk as 'NetCDF: HDF
+    error' (HDF5 loses the errno); the free space tells what it was."""
+    try:
+        info = os.statvfs(folder)
+    except OSError:
+        return ""
+    free = info.f_bavail * info.f_frsize
+    return f"; the file system is full ({free // 1024} KiB free)" if free < FULL_DISK_BYTES \
+        else ""
 
 
 def _make_folder(folder, source):

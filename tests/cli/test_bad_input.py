@@ -10,6 +10,7 @@ import hashlib
 import json
 import os
 import resource
+import signal
 import subprocess
 import sys
 import textwrap
@@ -508,9 +509,11 @@ def _(d):
 def golden_config(d, name="campaign", files=None):
     files = files or {"flsa": "flsa.csv", "mast": "mast.csv"}
     config = {"golden": {"name": name, "instruments": {
-        key: {"file": file, "heights": {80: {"speed": "ws", "direction": "wd"}}}
+        key: {"file": file, "time": "timestamp",
+              "heights": {80: {"speed": "ws", "direction": "wd"}}}
         for key, file in files.items()},
-        "comparisons": [{"unit": "flsa", "reference": "mast"}]}}
+        "comparisons": [{"unit": "flsa", "reference": "mast"}],
+        "classification": {"route": "class_number"}}}
     if "mast" in files:
         config["golden"]["instruments"]["mast"]["calibration"] = {"absolute": 0.05,
                                                                   "relative": 0.005}
@@ -580,6 +583,323 @@ def _(d):
 @case("golden name with a slash")
 def _(d):
     return [(["golden", str(golden_config(d, name="a/b"))], ("golden.name",))]
+
+
+# --- issue 28: every input file bounded, non-blocking, refused in one line ------------
+#: A 2 GiB file that costs nothing on disk (sparse): refused from its size, never read.
+SPARSE_BYTES = 2 * 1024**3
+#: The good motion record of the cases below: 64 samples at 2 Hz.
+RECORD = "t,heave\n" + "".join(f"{0.5 * i},{np.sin(i / 3):.4f}\n" for i in range(64))
+
+
+def hostile(path, kind):
+    """Put at `path` what the case names: a FIFO with no writer (opening it for reading
+    blocks forever unless done without blocking), a link to /dev/zero (endless), or a
+    2 GiB sparse file."""
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "/dev/zero":
+        path.symlink_to("/dev/zero")
+    else:
+        with open(path, "wb") as stream:
+            stream.truncate(SPARSE_BYTES)
+    return path
+
+
+#: The words each hostile kind must put in the message (besides the file and the kind of
+#: input expected).
+HOSTILE_WORDS = {"fifo": "named pipe", "/dev/zero": "character device",
+                 "sparse": str(SPARSE_BYTES)}
+
+
+def with_series(d, file):
+    return scenario(d, with_good(name="m", motion={"series": {
+        "file": str(file), "time": "t", "columns": {"heave": "heave"}}}), "m.yaml")
+
+
+def fit_config(d, content, *names):
+    """`uq fit` of a good table with the configuration `content` (-c) must be refused
+    with a message naming the configuration file and `names`."""
+    config = scenario(d, content, "fit.yaml")
+    return [(["fit", str(fit_table(d)), "-c", str(config), "-o", str(d / "f.nc")],
+             (str(config),) + names)]
+
+
+def refused_by_both(path, record, *names):
+    """`uq check` and `uq run` of the scenario at `path` must refuse its motion record
+    (the message names the record, not the scenario)."""
+    return [(argv, (str(record),) + names) for argv, _ in check_and_run(path)]
+
+
+def fit_table(d):
+    return scenario(d, "height,speed\n40,5\n60,6\n80,7\n", "table.csv")
+
+
+for _kind in ("fifo", "/dev/zero", "sparse"):
+    def _register(kind=_kind):
+        words = HOSTILE_WORDS[kind]
+
+        @case(f"scenario that is a {kind}")
+        def _(d):
+            return check_and_run(hostile(d / "s.yaml", kind), words, "YAML scenario")
+
+        @case(f"motion record that is a {kind}")
+        def _(d):
+            record = hostile(d / "rec.csv", kind)
+            return refused_by_both(with_series(d, record), record, words,
+                                   "motion.series.file", "CSV motion record")
+
+        @case(f"fit configuration that is a {kind}")
+        def _(d):
+            config = hostile(d / "fit.yaml", kind)
+            return [(["fit", str(fit_table(d)), "-c", str(config), "-o", str(d / "f.nc")],
+                     (str(config), words, "YAML fit configuration"))]
+
+        @case(f"fit table that is a {kind}")
+        def _(d):
+            table = hostile(d / "table.csv", kind)
+            return [(["fit", str(table), "-o", str(d / "f.nc")],
+                     (str(table), words, "CSV table"))]
+
+        @case(f"golden configuration that is a {kind}")
+        def _(d):
+            config = hostile(d / "g.yaml", kind)
+            return [(["golden", str(config), "-o", str(d / "g")],
+                     (str(config), words, "YAML golden configuration"))]
+
+        @case(f"golden table that is a {kind}")
+        def _(d):
+            good_records(d / "mast.csv")
+            table = hostile(d / "flsa.csv", kind)
+            return [(["golden", str(golden_config(d)), "-o", str(d / "g")],
+                     (str(table), words, "instruments.flsa.file", "CSV file of 10-min"))]
+    _register()
+
+
+@case("golden netCDF table that is a fifo")
+def _(d):
+    good_records(d / "mast.csv")
+    hostile(d / "flsa.nc", "fifo")
+    return [(["golden", str(golden_config(d, files={"flsa": "flsa.nc", "mast": "mast.csv"})),
+              "-o", str(d / "g")], ("flsa.nc", "named pipe", "netCDF"))]
+
+
+@case("plot of a fifo")
+def _(d):
+    path = hostile(d / "r.nc", "fifo")
+    return [(["plot", str(path), "-o", str(d / "figs")], (str(path), "named pipe"))]
+
+
+@case("motion record that is a folder")
+def _(d):
+    (d / "rec.csv").mkdir()
+    return refused_by_both(with_series(d, d / "rec.csv"), d / "rec.csv", "folder",
+                           "CSV motion record")
+
+
+@case("motion record larger than its limit")
+def _(d):
+    record = d / "rec.csv"
+    with open(record, "wb") as stream:
+        stream.truncate(65 << 20)                 # 65 MiB of zeros (sparse)
+    return refused_by_both(with_series(d, record), record, "64 MiB", "CSV motion record")
+
+
+@case("motion record with more rows than its limit")
+def _(d):
+    (d / "rec.csv").write_text("t,heave\n" + "1,0\n" * 2_000_001)
+    return refused_by_both(with_series(d, d / "rec.csv"), d / "rec.csv", "2000001 rows",
+                           "CSV motion record")
+
+
+@case("fit -c of binary garbage")
+def _(d):
+    return fit_config(d, bytes(range(256)) * 16, "UTF-8")
+
+
+@case("fit -c of an alias bomb")
+def _(d):
+    lines = ["a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
+    lines += [f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 10) + "]" for i in range(1, 9)]
+    return fit_config(d, "\n".join(lines) + "\nfit: {walkers: *a8}\n",
+                      "a4", "expands to more than")
+
+
+@case("fit -c with a python tag")
+def _(d):
+    return fit_config(d, "fit: {seed: !!python/object/apply:os.getcwd []}\n",
+                      "fit.seed", "!!python/object/apply:os.getcwd", "allowed")
+
+
+@case("fit -c with a key given twice")
+def _(d):
+    return fit_config(d, "fit:\n  walkers: 32\n  seed: 1\n  walkers: 64\n",
+                      "fit.walkers", "lines 2 and 4")
+
+
+@case("fit -c walkers 10^9")
+def _(d):
+    return fit_config(d, "fit: {walkers: 1000000000}\n", "fit.walkers", "1024")
+
+
+@case("fit -c ensembles 10^6")
+def _(d):
+    return fit_config(d, "fit: {ensembles: 1000000}\n", "fit.ensembles", "64")
+
+
+@case("fit -c more draws than memory holds")
+def _(d):
+    return fit_config(d, "fit: {walkers: 1024, ensembles: 64, max_steps: 1000000}\n",
+                      "fit.max_steps", "draws")
+
+
+@case("fit --set of a bad prior")
+def _(d):
+    return [(["fit", str(fit_table(d)), "--set", "fit.priors.shear.dist=flat", "-o",
+              str(d / "f.nc")], ("--set", "fit.priors.shear.dist", "uniform"))]
+
+
+@case("fit -c without a fit section")
+def _(d):
+    return fit_config(d, "walkers: 32\n", "fit", "'fit' section")
+
+
+def golden_with(d, **bins):
+    config = yaml.safe_load(golden_config(d).read_text())
+    config["golden"]["bins"] = bins
+    good_records(d / "mast.csv")
+    good_records(d / "flsa.csv")
+    return scenario(d, config, "golden.yaml")
+
+
+@case("golden bins width 1e-300")
+def _(d):
+    return [(["golden", str(golden_with(d, width=1e-300)), "-o", str(d / "g")],
+             ("golden.yaml", "golden.bins.width", "at least"))]
+
+
+@case("golden bins width 1e-5")
+def _(d):
+    return [(["golden", str(golden_with(d, width=1e-5)), "-o", str(d / "g")],
+             ("golden.yaml", "golden.bins.width", "1000 bins"))]
+
+
+@case("golden bins required up to 1e30")
+def _(d):
+    return [(["golden", str(golden_with(d, required=[0, 1e30])), "-o", str(d / "g")],
+             ("golden.yaml", "golden.bins.required"))]
+
+
+@case("golden with time zones in one file only")
+def _(d):
+    good_records(d / "mast.csv", zone="+00:00")
+    good_records(d / "flsa.csv")
+    return [(["golden", str(golden_config(d)), "-o", str(d / "g")],
+             ("flsa.csv", "time zone"))]
+
+
+HEIGHTS = (40, 80, 120)
+
+
+def three_heights(path, speed=lambda h, v: v, direction=lambda h, v: v):
+    """Records at three heights (columns ws40 ... wd120); `speed` and `direction` may
+    change the values of one height (a unit mistake)."""
+    head = "timestamp," + ",".join(f"ws{h},wd{h}" for h in HEIGHTS)
+    rows = [head]
+    for i in range(144):
+        v, wd = 5 + (i % 10), (17 * i) % 360 - 180
+        rows.append(f"2016-06-01T{i // 6:02d}:{10 * (i % 6):02d}:00," + ",".join(
+            f"{speed(h, v * (h / 80) ** 0.14):.3f},{direction(h, wd):.4f}" for h in HEIGHTS))
+    path.write_text("\n".join(rows) + "\n")
+
+
+def golden_three(d):
+    config = {"golden": {"name": "c", "classification": {"route": "class_number"},
+                         "comparisons": [{"unit": "flsa", "reference": "mast"}],
+                         "instruments": {key: {"file": f"{key}.csv", "time": "timestamp",
+                                               "heights": {h: {"speed": f"ws{h}",
+                                                               "direction": f"wd{h}"}
+                                                           for h in HEIGHTS}}
+                                         for key in ("flsa", "mast")}}}
+    config["golden"]["instruments"]["mast"].update(
+        calibration={"absolute": 0.05, "relative": 0.005}, class_number=1.0)
+    return scenario(d, config, "golden.yaml")
+
+
+@case("golden speeds in km/h at one height of three")
+def _(d):
+    three_heights(d / "mast.csv")
+    three_heights(d / "flsa.csv", speed=lambda h, v: 3.6 * v if h == 120 else v)
+    return [(["golden", str(golden_three(d)), "-o", str(d / "g")],
+             ("flsa.csv", "instruments.flsa.heights.120.speed", "ws120", "km/h"))]
+
+
+@case("golden speeds in km/h in every column")
+def _(d):
+    three_heights(d / "mast.csv", speed=lambda h, v: v / 2.5)          # a calm site: the
+    three_heights(d / "flsa.csv", speed=lambda h, v: 3.6 * v / 2.5)    # median is < 25
+    return [(["golden", str(golden_three(d)), "-o", str(d / "g")],
+             ("flsa.csv", "speed", "km/h"))]
+
+
+@case("golden directions in radians at one height of three")
+def _(d):
+    three_heights(d / "mast.csv")
+    three_heights(d / "flsa.csv", direction=lambda h, v: np.radians(v) if h == 40 else v)
+    return [(["golden", str(golden_three(d)), "-o", str(d / "g")],
+             ("flsa.csv", "instruments.flsa.heights.40.direction", "wd40", "radians"))]
+
+
+@case("golden directions in radians in every column")
+def _(d):
+    three_heights(d / "mast.csv", direction=lambda h, v: np.radians(v))
+    three_heights(d / "flsa.csv")
+    return [(["golden", str(golden_three(d)), "-o", str(d / "g")],
+             ("mast.csv", "direction", "radians"))]
+
+
+@case("golden speed with a missing-value code")
+def _(d):
+    three_heights(d / "mast.csv")
+    three_heights(d / "flsa.csv")
+    text = (d / "flsa.csv").read_text().splitlines()
+    text[9] = text[9].replace(text[9].split(",")[1], "9999", 1)
+    (d / "flsa.csv").write_text("\n".join(text) + "\n")
+    return [(["golden", str(golden_three(d)), "-o", str(d / "g")],
+             ("flsa.csv", "heights.40.speed", "9999"))]
+
+
+# --- messages (issue 28) ---------------------------------------------------------------
+@case("a key given twice on one line")
+def _(d):
+    return check_and_run(scenario(d, "name: tiny\nwind: {speed: 5, speed: 7}\n"),
+                         "wind.speed", "line 2, columns")
+
+
+@case("alias bomb under a key")
+def _(d):
+    lines = ["wind:", "  a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
+    lines += [f"  a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 10) + "]" for i in range(1, 9)]
+    return check_and_run(scenario(d, "\n".join(lines) + "\n"), "wind.a4", "expands")
+
+
+@case("a python tag in a scenario")
+def _(d):
+    return check_and_run(scenario(d, "wind: {speed: !!python/name:os.system ''}\n"),
+                         "wind.speed", "!!python/name:os.system")
+
+
+@case("motion phase randm")
+def _(d):
+    return check_and_run(scenario(d, with_good(motion={"roll": {
+        "amplitude": 1, "period": 5, "phase": "randm"}})), "motion.roll.phase", "random")
+
+
+@case("motion spectrum tp 1e-300")
+def _(d):
+    return check_and_run(scenario(d, with_good(motion={
+        "spectrum": {"hs": 1.0, "tp": 1e-300}, "response": {"heave": {"factor": 1.0}}})),
+        "motion.spectrum.tp", "band")
 
 
 # --- outputs -------------------------------------------------------------------------
@@ -667,22 +987,46 @@ def _(d):
 
 
 # --- the harness ---------------------------------------------------------------------
+#: Files above this size [bytes] are compared by size and time, not read.
+LARGE = 64 << 20
+
+
 def snapshot(folder):
     """Every path below `folder` -> digest of its content (folders: None)."""
     out = {}
     for path in sorted(folder.rglob("*")):
         if path.is_symlink() or not (path.is_file() or path.is_dir()):
             continue
-        out[str(path)] = None if path.is_dir() else hashlib.sha256(path.read_bytes()).hexdigest()
+        if path.is_dir():
+            out[str(path)] = None
+        elif path.stat().st_size > LARGE:          # (a 2 GiB sparse file: not read)
+            out[str(path)] = (path.stat().st_size, path.stat().st_mtime_ns)
+        else:
+            out[str(path)] = hashlib.sha256(path.read_bytes()).hexdigest()
     return out
+
+
+#: Seconds after which a case is taken to hang [s]: a guard that turns a regression (a
+#: FIFO opened blocking) into a failure instead of a stuck suite; no case is timed by it
+#: (each takes well under a second of work).
+HANG_GUARD = 120
+
+
+def _hung(number, frame):
+    raise TimeoutError("the command hangs")
 
 
 def run_in_process(argv, cwd, capsys, monkeypatch):
     monkeypatch.chdir(cwd)
+    previous = signal.signal(signal.SIGALRM, _hung)
+    signal.alarm(HANG_GUARD)
     try:
         status = main(list(argv))
     except SystemExit as stop:
         status = stop.code
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
     captured = capsys.readouterr()
     return status, captured.err
 
@@ -705,7 +1049,7 @@ def test_bad_input_is_refused_cleanly(name, tmp_path, capsys, monkeypatch):
 
 
 def test_the_corpus_is_large():
-    assert len(CASES) >= 60
+    assert len(CASES) >= 133          # 93 before issue 28, which asks for 40 more
 
 
 BOUNDED = textwrap.dedent("""
@@ -753,3 +1097,50 @@ def test_no_input_costs_more_than_2_gb_or_10_s():
                             timeout=600, cwd=ROOT)
     assert result.returncode == 0, result.stderr[-2000:]
     assert json.loads(result.stdout.strip().splitlines()[-1]) == []
+
+
+HOSTILE = textwrap.dedent("""
+    import json, resource, sys, io, contextlib, tempfile, pathlib, time
+    resource.setrlimit(resource.RLIMIT_AS, ({memory}, {memory}))
+    resource.setrlimit(resource.RLIMIT_CPU, ({total_cpu}, {total_cpu}))
+    sys.path.insert(0, {tests!r})
+    import test_bad_input as corpus
+    from uq.cli import main
+    results = []
+    for name in {names!r}:
+        folder = pathlib.Path(tempfile.mkdtemp())
+        for argv, _ in corpus.CASES[name](folder):
+            start = time.process_time()
+            try:
+                with contextlib.redirect_stderr(io.StringIO()), \\
+                        contextlib.redirect_stdout(io.StringIO()):
+                    status = main(argv)
+            except MemoryError:
+                status = "memory"
+            results.append((name, argv[0], status, time.process_time() - start))
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    print(json.dumps({{"results": results, "peak": peak}}))
+""")
+
+#: Limits of issue 28 for a hostile input file: refused within 10 s of CPU [s] and under
+#: 1 GiB [bytes] (address space, so that not even a failed allocation gets further).
+HOSTILE_CPU, HOSTILE_MEMORY = 10.0, 1 << 30
+
+
+def test_every_input_kind_refuses_a_fifo_dev_zero_and_a_sparse_file_cheaply():
+    """Scenario, motion record, fit configuration and table, golden configuration and
+    table (and a results file): a FIFO with no writer, /dev/zero and a 2 GiB sparse file
+    are each refused (exit 2) within 10 s of CPU, in one child process whose address space
+    is limited to 1 GiB and whose whole CPU time is bounded (a hang that burns no CPU is
+    caught by the subprocess's limit, not timed)."""
+    names = [name for name in CASES if " that is a " in name]
+    assert len(names) >= 18
+    code = HOSTILE.format(tests=str(Path(__file__).parent), names=names,
+                          memory=HOSTILE_MEMORY, total_cpu=int(HOSTILE_CPU * len(names)))
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            timeout=1800, cwd=ROOT)
+    assert result.returncode == 0, result.stderr[-2000:]
+    report = json.loads(result.stdout.strip().splitlines()[-1])
+    for name, command, status, cpu in report["results"]:
+        assert status == 2 and cpu < HOSTILE_CPU, (name, command, status, cpu)
+    assert report["peak"] < HOSTILE_MEMORY

@@ -1,5 +1,6 @@
 """Ctrl-C, as a terminal sends it (SIGINT to the whole process group): exit 130 with one
-message, no traceback from any process, no results file."""
+message, no traceback from any process, no results file. SIGTERM, as a batch system's time
+limit or ``timeout`` sends it: the same clean-up, exit 143."""
 import os
 import signal
 import subprocess
@@ -9,7 +10,7 @@ import time
 import pytest
 
 
-def interrupt(args, cwd, after, wait_for=None):
+def interrupt(args, cwd, after, wait_for=None, number=signal.SIGINT):
     child = subprocess.Popen([sys.executable, "-m", "uq.cli", *args], cwd=cwd, text=True,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                              start_new_session=True)
@@ -19,7 +20,7 @@ def interrupt(args, cwd, after, wait_for=None):
             assert time.monotonic() < deadline and child.poll() is None
             time.sleep(0.05)
         time.sleep(after)
-        os.killpg(child.pid, signal.SIGINT)
+        os.killpg(child.pid, number)
         _, err = child.communicate(timeout=60)
         return child.returncode, err
     finally:                                   # never leave a process group behind
@@ -55,3 +56,41 @@ def test_ctrl_c_with_two_workers_is_one_message(tmp_path, after):
                                         "out.nc.partial; run the same command with --resume "
                                         "to continue"]
     assert not (tmp_path / "out.nc").exists() and any(partial.glob("chunk-*.nc"))
+
+
+def test_sigterm_while_golden_writes_leaves_nothing(tmp_path):
+    """The hidden .NAME.partial folder of uq golden is removed, no output folder made."""
+    status, err = interrupt(["golden", "golden_campaign", "-o", "out"], tmp_path, after=0.5,
+                            wait_for=lambda: any(tmp_path.glob(".out.*.partial/data")),
+                            number=signal.SIGTERM)
+    assert status == 143, err
+    assert err.strip().splitlines() == ["uq: terminated"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_sigterm_during_a_run_keeps_the_checkpoint_and_exits_143(tmp_path):
+    partial = tmp_path / "out.nc.partial"
+    status, err = interrupt(["run", "rubio2022_misalignment", "--quiet", "-o", "out.nc"],
+                            tmp_path, after=0.0,
+                            wait_for=lambda: any(partial.glob("chunk-*.sha256")),
+                            number=signal.SIGTERM)
+    assert status == 143, err
+    assert err.strip().splitlines() == ["uq: terminated; finished chunks are kept in "
+                                        "out.nc.partial; run the same command with --resume "
+                                        "to continue"]
+    assert not (tmp_path / "out.nc").exists()
+
+
+def test_timeout_of_golden_leaves_nothing(tmp_path):
+    """`timeout` (coreutils) sends SIGTERM when its time is up: nothing stays behind,
+    whenever it lands (before, during or after the partial folder exists)."""
+    for seconds in ("1", "3", "5"):
+        done = subprocess.run(["timeout", seconds, sys.executable, "-m", "uq.cli", "golden",
+                               "golden_campaign", "-o", "out"], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=300)
+        assert "Traceback" not in done.stderr, done.stderr
+        if done.returncode == 0:                 # finished within the time: its folder
+            assert [p.name for p in tmp_path.iterdir()] == ["out"]
+            break
+        assert done.returncode == 124, done.stderr      # timeout's code after its SIGTERM
+        assert list(tmp_path.iterdir()) == [], seconds

@@ -16,7 +16,8 @@ from conftest import make_scene
 from uq.physics import fused
 from uq.engine.gum import complex_step_jacobian
 from uq.engine.inputs import Input, input_set
-from uq.physics.measurement import OUTPUTS, measurement_model
+from uq.physics.measurement import measurement_model
+from uq.physics.scene import OUTPUTS
 
 WIND = ("wind_speed", "wind_direction", "vertical_wind")
 EVERY = OUTPUTS

@@ -184,6 +184,46 @@ def test_a_full_disk_is_survived(tmp_path, one_scene_per_chunk, monkeypatch, cap
         same(ds.load(), run(one_scene_per_chunk))
 
 
+@pytest.fixture
+def small_disk(tmp_path):
+    """A real 2 MiB file system (tmpfs), so that the netCDF library fails as it does on a
+    full disk ('NetCDF: HDF error', not the ENOSPC an injected fault raises). Skipped,
+    saying why, only where no such file system can be mounted."""
+    folder = tmp_path / "disk"
+    folder.mkdir()
+    if os.geteuid() != 0:
+        pytest.skip("mounting a 2 MiB tmpfs needs root (no other small file system here)")
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(folder)],
+                          capture_output=True, text=True)
+    if done.returncode:
+        pytest.skip(f"cannot mount a 2 MiB tmpfs here: {done.stderr.strip()}")
+    try:
+        yield folder
+    finally:
+        subprocess.run(["umount", str(folder)], capture_output=True)
+
+
+def test_a_real_full_disk_is_one_line_and_resumable(small_disk, tmp_path, monkeypatch,
+                                                    capsys):
+    """rubio2022_misalignment (chunks of ~50 KiB each) on 2 MiB: exit 2 with one line naming
+    the chunk and the full file system, no temporary file; with space added, --resume
+    completes to the result of a run on a roomy disk."""
+    monkeypatch.chdir(tmp_path)
+    output = small_disk / "r.nc"
+    assert main(["run", "rubio2022_misalignment", "--quiet", "-o", str(output)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "Traceback" not in err[0], err
+    assert "chunk-" in err[0] and "file system is full" in err[0] and "--resume" in err[0]
+    assert not output.exists() and not list(small_disk.rglob("*.part"))
+    subprocess.run(["mount", "-o", "remount,size=64m", str(small_disk)], check=True)
+    assert main(["run", "rubio2022_misalignment", "--quiet", "-o", str(output),
+                 "--resume"]) == 0
+    assert main(["run", "rubio2022_misalignment", "--quiet", "-o", "roomy.nc"]) == 0
+    with xr.open_dataset(output) as resumed, xr.open_dataset("roomy.nc") as roomy:
+        same(resumed.load(), roomy.load())
+    assert sorted(p.name for p in small_disk.iterdir()) == ["r.nc"]
+
+
 def test_a_foreign_folder_is_never_removed(tmp_path):
     directory = tmp_path / "out.nc.partial"
     directory.mkdir()

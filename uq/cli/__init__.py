@@ -6,14 +6,16 @@ parser and imports what it needs only when it runs, so ``uq --help`` and ``uq --
 load neither scipy, xarray, pandas, matplotlib nor numba.
 
 Exit status: 0 success; 2 bad input (one line naming the file, the key and what is
-allowed; no traceback; no output file); 1 anything else; 130 interrupted (Ctrl-C).
+allowed; no traceback; no output file); 1 anything else; 130 interrupted (Ctrl-C);
+143 terminated (SIGTERM: a batch system's time limit), cleaned up as after Ctrl-C.
 """
 import sys
 
 from uq._version import __version__
 from uq.cli import bench, check, fit, golden, plot, report, run
 from uq.cli.common import (EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK,  # noqa: F401
-                           Parser, add_common_options, configure_logging, parse_overrides)
+                           EXIT_TERMINATED, Parser, add_common_options, configure_logging,
+                           interrupted_status, parse_overrides, stop_on_sigterm)
 from uq.errors import InputError
 
 SUBCOMMANDS = (run, check, plot, report, bench, fit, golden)
@@ -23,7 +25,8 @@ def build_parser():
     parser = Parser(prog="uq", description="Uncertainty of ship-based and floating "
                     "Doppler wind lidar: Monte Carlo beside the GUM.",
                     epilog="Run 'uq COMMAND --help' for a command's options. "
-                    "Exit status: 0 success, 1 failure, 2 bad input, 130 interrupted.")
+                    "Exit status: 0 success, 1 failure, 2 bad input, 130 interrupted, "
+                    "143 terminated.")
     parser.add_argument("--version", action="version", version=f"uq {__version__}")
     commands = parser.add_subparsers(dest="command", parser_class=Parser,
                                      metavar="COMMAND", title="commands")
@@ -40,13 +43,16 @@ def main(argv=None):
             parser.print_help(sys.stderr)
             return EXIT_BAD_INPUT
         configure_logging(args)
-        return args.handler(args)
+        with stop_on_sigterm():
+            return args.handler(args)
     except InputError as error:
         print(f"uq: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
-        print("\nuq: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as stop:
+        status = interrupted_status(stop)
+        print(f"\nuq: {'terminated' if status == EXIT_TERMINATED else 'interrupted'}",
+              file=sys.stderr)
+        return status
 
 
 if __name__ == "__main__":

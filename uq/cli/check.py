@@ -13,11 +13,11 @@ def add_parser(commands):
 
 
 def command(args):
-    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.scenario import SCENARIO_KIND, load_scenario
     from uq.pipeline.yamlfile import read_yaml
     from uq.pipeline.shipped import scenario_path
     path = scenario_path(args.scenario)
-    raw = read_yaml(path)
+    raw = read_yaml(path, kind=SCENARIO_KIND)
     if isinstance(raw, dict) and "golden" in raw:
         from uq.golden.config import load_golden_config
         config = load_golden_config(path)

@@ -1,6 +1,7 @@
 """What every subcommand shares: exit codes, the parser that reports usage errors as bad
 input, and ``--set`` overrides. Imports nothing heavy (``uq --help`` stays fast)."""
 import argparse
+import contextlib
 import logging
 import sys
 
@@ -8,6 +9,36 @@ from uq.errors import ScenarioError
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_INTERRUPTED = 130          # the shell's code for SIGINT
+EXIT_TERMINATED = 143           # the shell's code for SIGTERM (128 + 15)
+
+
+@contextlib.contextmanager
+def stop_on_sigterm():
+    """Within the block, SIGTERM (a batch system's time limit, ``timeout``) raises
+    :class:`uq.errors.Terminated`, a KeyboardInterrupt: every command cleans up after it
+    as after Ctrl-C. The earlier handler is restored afterwards (``main`` may run inside
+    another program). Main thread only (where signals are delivered)."""
+    import signal
+    import threading
+    from uq.errors import Terminated
+
+    def terminate(number, frame):
+        raise Terminated
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def interrupted_status(error):
+    """The exit status after an interrupt: 143 for SIGTERM, 130 for Ctrl-C."""
+    from uq.errors import Terminated
+    return EXIT_TERMINATED if isinstance(error, Terminated) else EXIT_INTERRUPTED
 
 
 class Parser(argparse.ArgumentParser):

@@ -7,8 +7,8 @@ import signal
 import sys
 from pathlib import Path
 
-from uq.cli.common import EXIT_INTERRUPTED, EXIT_OK, parse_overrides, say
-from uq.errors import ScenarioError
+from uq.cli.common import EXIT_OK, EXIT_TERMINATED, interrupted_status, parse_overrides, say
+from uq.errors import OutputError, ScenarioError
 
 
 def add_parser(commands):
@@ -60,10 +60,20 @@ def command(args):
                           model=args.model)
         write_netcdf(dataset, output)
         checkpoint.clear()                   # still locked: no other run can be in it
-    except KeyboardInterrupt:
-        print(f"\nuq: interrupted; finished chunks are kept in {checkpoint.directory}; "
+    except KeyboardInterrupt as stop:
+        status = interrupted_status(stop)
+        print(f"\nuq: {'terminated' if status == EXIT_TERMINATED else 'interrupted'}; "
+              f"finished chunks are kept in {checkpoint.directory}; "
               "run the same command with --resume to continue", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return status
+    except OutputError as error:             # a full disk: finished chunks are kept
+        if checkpoint.is_empty():
+            checkpoint.clear()
+            remove_if_empty(new_folders)
+            raise
+        raise OutputError(error.source, error.key, f"{error.problem}; the finished chunks "
+                          f"are kept in {checkpoint.directory}: free space and run the same "
+                          "command with --resume (or remove that folder)") from None
     except Exception:
         if checkpoint.is_empty():            # nothing to resume: leave nothing behind
             checkpoint.clear()

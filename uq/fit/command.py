@@ -9,14 +9,21 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from uq.fit.bayesfit import NotConverged
+from uq.constants import MAX_FIT_TABLE_BYTES
 from uq.errors import DataFileError, ScenarioError
-from uq.fit.fitting import (combine_fits, fit_profile, profile_from_results, profile_from_table,
-                      true_parameters)
+from uq.fit.bayesfit import NotConverged
+from uq.fit.fitting import (MAX_FIT_POINTS, combine_fits, fit_profile, profile_from_results,
+                            profile_from_table, true_parameters)
 from uq.files import check_target, save_figure, write_netcdf
+from uq.pipeline.inputfile import read_csv
 from uq.pipeline.metadata import history
 from uq.pipeline.results import open_results
-from uq.pipeline.scenario import assign_dotted, load_fit_settings
+from uq.pipeline.scenario import assign_dotted, load_fit_settings, read_yaml
+
+#: What a fit configuration (-c) is, in messages about the file.
+FIT_CONFIG_KIND = "a YAML fit configuration"
+#: What a fit table is, in messages about the file.
+FIT_TABLE_KIND = "a CSV table of heights and wind speeds"
 
 EXIT_OK, EXIT_FAILURE = 0, 1
 log = logging.getLogger(__name__)
@@ -67,14 +74,12 @@ def _scenario_of(results, path):
 
 def fit_settings(config_path, scenario, overrides):
     """FitConfig from -c FILE's fit section, else the results' scenario's (a mapping),
-    then --set."""
+    then --set. The file is read like a scenario (bounded, strict YAML); an error in a
+    value given with --set names --set."""
     source, raw = "defaults", {}
     if config_path:
         source = str(config_path)
-        try:
-            document = yaml.safe_load(Path(config_path).read_text()) or {}
-        except (OSError, yaml.YAMLError) as error:
-            raise ScenarioError(source, "", f"cannot read it as YAML ({error})") from None
+        document = read_yaml(config_path, kind=FIT_CONFIG_KIND)
         if not isinstance(document, dict) or "fit" not in document:
             raise ScenarioError(source, "fit", "no 'fit' section; allowed: a YAML mapping "
                                 "with a top-level 'fit' key")
@@ -82,24 +87,31 @@ def fit_settings(config_path, scenario, overrides):
     elif scenario is not None:
         source = "scenario of the results"
         raw = scenario.get("fit") or {}
+    if not isinstance(raw, dict):
+        raise ScenarioError(source, "fit", "allowed: a mapping of fit settings")
     raw = {"fit": dict(raw)}
     for key, value in overrides.items():
         if not key.startswith("fit."):
             raise ScenarioError("--set", key, "allowed: fit.<key>=<value>")
         assign_dotted(raw, key, value, "--set")
-    return load_fit_settings(raw["fit"], source)
+    try:
+        return load_fit_settings(raw["fit"], source)
+    except ScenarioError as error:
+        if any(_related(error.key, key) for key in overrides):
+            raise ScenarioError("--set", error.key, error.problem) from None
+        raise
+
+
+def _related(key, given):
+    """Does the checked `key` lie at or below (or above) the dotted key `given`?"""
+    return any(a == b or a.startswith(b + ".") or a.startswith(b + "[")
+               for a, b in ((key, given), (given, key)))
 
 
 def _fit_input(path, results, scenario, config):
     if results is None:
-        import pandas
-        try:
-            table = pandas.read_csv(path, encoding="utf-8")
-        except (OSError, ValueError, pandas.errors.ParserError,
-                pandas.errors.EmptyDataError) as error:
-            reason = str(error).splitlines()[0][:120] if str(error) else type(error).__name__
-            raise DataFileError(str(path), "", f"cannot read it as CSV ({reason}); allowed: "
-                                "a UTF-8 CSV table with a header row") from None
+        table = read_csv(path, MAX_FIT_TABLE_BYTES, MAX_FIT_POINTS, FIT_TABLE_KIND,
+                         DataFileError)
         data, dropped = profile_from_table(table, config.columns, source=str(path))
         dataset = combine_fits({"data": fit_profile(data, config)})
         dataset.attrs["rows_dropped_not_finite"] = dropped

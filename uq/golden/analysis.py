@@ -105,7 +105,7 @@ def _height_tables(config, unit, reference, centres, smc):
     fits = _sensitivities(config, unit, reference)
     data.update({SENSITIVITY_NAMES[name]: ("variable", np.array([getattr(f, name)
                                                                  for f in fits]))
-                 for name in SENSITIVITY_NAMES} if fits else {})
+                 for name in SENSITIVITY_NAMES})          # (no variable: empty tables)
     # only significant slopes enter Eq. 1 and the class number (seed: "sensitive variables")
     slopes = np.array([f.slope if f.significant else 0.0 for f in fits])
     data.update(_classification(config, centres, reference, smc, slopes))
@@ -143,11 +143,12 @@ def _classification(config, centres, reference, smc, slopes):
     out = {}
     ver = np.array([_bin_means(reference[v].values, reference["speed"].values, centres,
                                config.bin_width) for v in config.variables])
-    out["verification_mean"] = (("variable", "bin"), ver.reshape(len(config.variables), -1))
+    ver = ver.reshape(len(config.variables), len(centres))     # (0 variables: empty)
+    out["verification_mean"] = (("variable", "bin"), ver)
     if smc is not None:
         smc_means = np.array([_bin_means(smc[v].values, smc["speed"].values, centres,
                                          config.bin_width) for v in config.variables])
-        smc_means = smc_means.reshape(len(config.variables), -1)
+        smc_means = smc_means.reshape(len(config.variables), len(centres))
         out["smc_mean"] = (("variable", "bin"), smc_means)
         out["smc_n_records"] = ("bin", binning.bin_statistics(
             smc["speed"].values, smc["speed"].values, centres, config.bin_width)["n_records"])

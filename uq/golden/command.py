@@ -82,6 +82,8 @@ def _write(ds, folder, name):
                               "deviation against the environmental variables"),
                 "uncertainty_terms": (plots.plot_uncertainty_terms, "Calibration-"
                                       "uncertainty terms per bin (seed Fig. 3)")}
+    if not ds.sizes.get("variable"):            # no environmental variable to plot against
+        del drawings["deviation"]
     for stem, (draw, caption) in drawings.items():
         fig = draw(ds, height)
         path = folder / "figures" / f"{stem}.png"

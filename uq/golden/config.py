@@ -10,8 +10,9 @@ and what is allowed.
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from uq.constants import (GOLDEN_BIN_WIDTH, GOLDEN_MIN_RECORDS, GOLDEN_REQUIRED_RANGE,
-                         GOLDEN_SIGNIFICANCE, KPI_AVAILABILITY)
+from uq.constants import (GOLDEN_BIN_WIDTH, GOLDEN_MAX_BINS, GOLDEN_MAX_SPEED,
+                          GOLDEN_MIN_RECORDS, GOLDEN_REQUIRED_RANGE, GOLDEN_SIGNIFICANCE,
+                          KPI_AVAILABILITY)
 from uq.errors import ScenarioError
 from uq.files import check_name
 from uq.pipeline.scenario import Checker
@@ -70,7 +71,7 @@ class GoldenConfig:
 def load_golden_config(path):
     """Read and validate a ``uq golden`` configuration file."""
     path = Path(path)
-    raw = read_yaml(path)
+    raw = read_yaml(path, kind="a YAML golden configuration")
     check = Checker(str(path))
     if not isinstance(raw, dict) or "golden" not in raw:
         check.fail("golden", "missing; allowed: a mapping under the top-level key 'golden'")
@@ -207,12 +208,16 @@ def _bins(check, raw):
     check.mapping(raw, "golden.bins")
     check.keys(raw, "golden.bins", ("width", "required", "minimum_records"))
     required = check.number_list(raw.get("required", list(GOLDEN_REQUIRED_RANGE)),
-                                 "golden.bins.required", low=0.0)
+                                 "golden.bins.required", low=0.0, high=GOLDEN_MAX_SPEED)
     if len(required) != 2 or required[0] > required[1]:
         check.fail("golden.bins.required", "allowed: [low, high] bin centres, low <= high")
-    return {"bin_width": check.number(raw.get("width", GOLDEN_BIN_WIDTH), "golden.bins.width",
-                                      low=0.0, low_open=True),
-            "required": tuple(required),
+    width = check.number(raw.get("width", GOLDEN_BIN_WIDTH), "golden.bins.width", low=0.0,
+                         low_open=True, high=GOLDEN_MAX_SPEED)
+    if GOLDEN_MAX_SPEED / width > GOLDEN_MAX_BINS:
+        check.fail("golden.bins.width", f"{width:g} m/s makes more than {GOLDEN_MAX_BINS} "
+                   f"bins from 0 to {GOLDEN_MAX_SPEED:g} m/s; allowed: at least "
+                   f"{GOLDEN_MAX_SPEED / GOLDEN_MAX_BINS:g} m/s")
+    return {"bin_width": width, "required": tuple(required),
             "minimum_records": check.integer(raw.get("minimum_records", GOLDEN_MIN_RECORDS),
                                              "golden.bins.minimum_records", low=1)}
 

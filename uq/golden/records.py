@@ -17,56 +17,89 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from uq.constants import FULL_CIRCLE_DEG
+from uq.constants import (FULL_CIRCLE_DEG, GOLDEN_MAX_SPEED, MAX_RECORD_BYTES,
+                          MAX_RECORD_ROWS)
 from uq.errors import DataFileError
+from uq.pipeline.inputfile import check_regular, read_csv
 
 RECORD_MINUTES = 10
+#: What a table of records is, in messages about the file.
+RECORDS_KIND = "a UTF-8 CSV file of 10-min records"
 #: Largest plausible median 10-min wind speed [m s-1]: a median above this is a unit
 #: mistake (km/h is 3.6 times m/s, knots 1.94 times; 25 m/s is a gale's mean).
 MAX_MEDIAN_SPEED = 25.0
-#: Directions all within [0, 2 pi] with at least this spread [deg-or-rad] are radians.
+#: Directions all within [-2 pi, 2 pi] with at least this spread [deg-or-rad] are radians.
 RADIAN_SPREAD = 1.0
+#: Largest ratio of a column's median speed to that of an instrument's other heights taken
+#: as the same unit [1]: shear between measured heights stays below 2 (power law, exponent
+#: 0.4 over a factor 5 in height: 1.9); km/h is 3.6 times m/s.
+HEIGHT_RATIO = 2.5
+#: Largest ratio of the concurrent speeds of two instruments at one height taken as the
+#: same unit [1]: they agree within a few per cent; knots are 1.94 times m/s, km/h 3.6.
+UNIT_RATIO = 1.5
 
 
 def read_table(instrument):
     """The file's table (pandas) with a DatetimeIndex named ``time``."""
     path, source = instrument.file, str(instrument.file)
-    if not path.exists():
-        raise DataFileError(source, f"instruments.{instrument.name}.file",
-                            "no such file; allowed: a CSV or netCDF file of 10-min records")
-    if path.is_dir():
-        raise DataFileError(source, f"instruments.{instrument.name}.file", "is a folder; "
-                            "allowed: a CSV or netCDF file of 10-min records")
     table = _read(path, source, instrument.name)
     key = f"instruments.{instrument.name}.time"
     if instrument.time not in table.columns:
         raise DataFileError(source, key, f"no column {instrument.time!r}; allowed: "
                             f"{_listing(table.columns)}")
-    with warnings.catch_warnings():      # pandas warns when it parses element by element
-        warnings.simplefilter("ignore", UserWarning)
-        time = pd.to_datetime(table[instrument.time], errors="coerce")
-    if time.isna().any():
-        row = int(np.flatnonzero(time.isna())[0])
-        raise DataFileError(source, key, f"timestamp {table[instrument.time].iloc[row]!r} "
-                            f"(row {row + 1}) is not a date and time")
-    table.index = pd.DatetimeIndex(time, name="time")
+    if table.empty:
+        raise DataFileError(source, f"instruments.{instrument.name}.file", "no records (a "
+                            f"header only); allowed: {RECORDS_KIND}")
+    time = _times(table[instrument.time], source, key)
+    table.attrs["zoned"] = int(time.dt.tz is not None)
+    table.index = pd.DatetimeIndex(time.dt.tz_convert(None) if table.attrs["zoned"] else time,
+                                   name="time")
     _check_times(table.index, source, key)
     return table
 
 
+def _times(column, source, key):
+    """The timestamps of `column` (all with a time zone, or all without)."""
+    with warnings.catch_warnings():      # pandas warns when it parses element by element
+        warnings.simplefilter("ignore", UserWarning)
+        try:
+            time = pd.to_datetime(column, errors="coerce")
+        except ValueError:               # "Mixed timezones detected"
+            raise DataFileError(source, key, f"timestamps in different time zones "
+                                f"({_zones(column)}); allowed: one time zone per file"
+                                ) from None
+    if time.isna().any():
+        row = int(np.flatnonzero(time.isna())[0])
+        raise DataFileError(source, key, f"timestamp {column.iloc[row]!r} (row {row + 1}) is "
+                            "not a date and time, or not in the time zone of the first one; "
+                            "allowed: dates and times, all in one time zone")
+    return time
+
+
+def _zones(column):
+    """The first two different time-zone suffixes of `column` and their rows, as text."""
+    zones = column.astype(str).str.extract(r"(Z|[+-]\d\d:?\d\d)\s*$")[0].fillna("none")
+    first = zones.iloc[0]
+    other = int(np.flatnonzero(zones.to_numpy() != first)[0])
+    return f"{first} in row 1, {zones.iloc[other]} in row {other + 1}"
+
+
 def _read(path, source, name):
-    """The file as a pandas table; DataFileError if it is not CSV (or netCDF) text."""
+    """The file as a pandas table; DataFileError if it is not a regular CSV (or netCDF)
+    file within the bounds."""
+    key = f"instruments.{name}.file"
+    if path.suffix != ".nc":
+        return read_csv(path, MAX_RECORD_BYTES, MAX_RECORD_ROWS, RECORDS_KIND, DataFileError,
+                        key)
+    check_regular(path, MAX_RECORD_BYTES, "a netCDF file of 10-min records", DataFileError,
+                  key)
     try:
-        if path.suffix == ".nc":
-            with xr.open_dataset(path) as ds:
-                return ds.to_dataframe().reset_index()
-        return pd.read_csv(path, encoding="utf-8")
-    except (OSError, ValueError, UnicodeDecodeError, pd.errors.ParserError,
-            pd.errors.EmptyDataError) as error:
+        with xr.open_dataset(path) as ds:
+            return ds.to_dataframe().reset_index()
+    except (OSError, ValueError) as error:
         reason = str(error).splitlines()[0][:120] if str(error) else type(error).__name__
-        raise DataFileError(source, f"instruments.{name}.file", f"cannot read it as "
-                            f"{'netCDF' if path.suffix == '.nc' else 'CSV'} ({reason}); "
-                            "allowed: a UTF-8 CSV or a netCDF file of 10-min records") from None
+        raise DataFileError(source, key, f"cannot read it as netCDF ({reason}); allowed: a "
+                            "netCDF file of 10-min records") from None
 
 
 def load_records(instrument):
@@ -87,9 +120,12 @@ def load_records(instrument):
             columns.append(values)
         data[name] = (("time", "height"), np.stack(columns, axis=-1))
     ds = xr.Dataset(data, coords={"time": table.index.values, "height": heights})
-    _check_speed(ds["speed"].values, source, prefix)
-    ds["direction"] = _checked_direction(ds["direction"].values, source, prefix)
-    ds.attrs.update(instrument=instrument.name, file=source, n_invalid=invalid)
+    keys = {name: [_column_key(instrument, h, name) for h in heights]
+            for name in ("speed", "direction")}
+    _check_speed(ds["speed"].values, source, keys["speed"])
+    ds["direction"] = _checked_direction(ds["direction"].values, source, keys["direction"])
+    ds.attrs.update(instrument=instrument.name, file=source, n_invalid=invalid,
+                    zoned=table.attrs["zoned"])
     return ds
 
 
@@ -100,6 +136,12 @@ def align(unit, reference):
     times = np.intersect1d(unit["time"].values, reference["time"].values)
     heights = np.intersect1d(unit["height"].values, reference["height"].values)
     names = f"{unit.attrs['instrument']} and {reference.attrs['instrument']}"
+    if unit.attrs.get("zoned") != reference.attrs.get("zoned"):
+        zoned = unit if unit.attrs.get("zoned") else reference
+        raise DataFileError(unit.attrs["file"], "time", f"{names}: only "
+                            f"{zoned.attrs['instrument']} gives its timestamps a time zone; "
+                            "allowed: both with a time zone (compared in UTC) or both "
+                            "without")
     if len(heights) == 0:
         raise DataFileError(unit.attrs["file"], "heights", f"{names} share no height "
                             f"({_heights(unit)} against {_heights(reference)})")
@@ -110,7 +152,9 @@ def align(unit, reference):
     counts = {"only_unit": unit.sizes["time"] - len(times),
               "only_reference": reference.sizes["time"] - len(times)}
     pick = {"time": times, "height": heights}
-    return unit.sel(pick), reference.sel(pick), counts
+    unit, reference = unit.sel(pick), reference.sel(pick)
+    check_same_units(unit, reference)
+    return unit, reference, counts
 
 
 def _variables(instrument):
@@ -150,27 +194,72 @@ def _check_times(index, source, key):
                                 "(median); allowed: 10-min records")
 
 
-def _check_speed(speed, source, key):
-    finite = speed[np.isfinite(speed)]
-    if finite.size and finite.min() < 0:
-        raise DataFileError(source, key, f"negative wind speed {finite.min():g}; allowed: "
-                            "speeds >= 0 [m s-1]")
-    if finite.size and np.median(finite) > MAX_MEDIAN_SPEED:
-        raise DataFileError(source, key, f"median wind speed {np.median(finite):.1f} looks "
-                            "like km/h or knots; allowed: m s-1")
+def _column_key(instrument, height, name):
+    """``instruments.NAME.heights.H.speed (column 'ws')``: the key and the column."""
+    return (f"instruments.{instrument.name}.heights.{height:g}.{name} (column "
+            f"{_column_name(instrument, height, name)!r})")
 
 
-def _checked_direction(direction, source, key):
-    finite = direction[np.isfinite(direction)]
-    outside = finite[np.abs(finite) > FULL_CIRCLE_DEG]
-    if outside.size:
-        raise DataFileError(source, key, f"direction {outside[0]:g} is out of range; "
-                            "allowed: degrees in [-360, 360]")
-    if finite.size > 1 and finite.min() >= 0 and finite.max() <= 2 * np.pi \
-            and np.ptp(finite) > RADIAN_SPREAD:
-        raise DataFileError(source, key, f"directions span {finite.min():.2f}-"
-                            f"{finite.max():.2f}: radians? allowed: degrees")
+def _check_speed(speed, source, keys):
+    """Each column of `speed` (time, height) [m s-1] must look like m/s: not negative, a
+    plausible median, no value above GOLDEN_MAX_SPEED, and not 3.6 times the other columns."""
+    medians = []
+    for column, key in zip(speed.T, keys):
+        finite = column[np.isfinite(column)]
+        if finite.size and finite.min() < 0:
+            raise DataFileError(source, key, f"negative wind speed {finite.min():g}; allowed: "
+                                "speeds >= 0 [m s-1]")
+        if finite.size and finite.max() > GOLDEN_MAX_SPEED:
+            raise DataFileError(source, key, f"wind speed {finite.max():g} (a code for a "
+                                f"missing value?); allowed: m s-1, at most {GOLDEN_MAX_SPEED:g} "
+                                "(leave a missing value empty)")
+        medians.append(np.median(finite) if finite.size else np.nan)
+        if finite.size and medians[-1] > MAX_MEDIAN_SPEED:
+            raise DataFileError(source, key, f"median wind speed {medians[-1]:.1f} looks "
+                                "like km/h or knots; allowed: m s-1")
+    for i, key in enumerate(keys):
+        others = np.delete(np.asarray(medians), i)
+        others = others[np.isfinite(others) & (others > 0)]
+        if others.size and medians[i] > HEIGHT_RATIO * np.median(others):
+            raise DataFileError(source, key, f"median wind speed {medians[i]:.1f} is "
+                                f"{medians[i] / np.median(others):.1f} times that of the "
+                                "other heights: km/h (3.6 times m/s)? allowed: m s-1 in "
+                                "every column")
+
+
+def _checked_direction(direction, source, keys):
+    """Directions (time, height) [deg] checked column by column, wrapped into [0, 360)."""
+    for column, key in zip(direction.T, keys):
+        finite = column[np.isfinite(column)]
+        outside = finite[np.abs(finite) > FULL_CIRCLE_DEG]
+        if outside.size:
+            raise DataFileError(source, key, f"direction {outside[0]:g} is out of range; "
+                                "allowed: degrees in [-360, 360]")
+        if finite.size > 1 and np.abs(finite).max() <= 2 * np.pi \
+                and np.ptp(finite) > RADIAN_SPREAD:
+            raise DataFileError(source, key, f"directions span {finite.min():.2f} to "
+                                f"{finite.max():.2f}: radians? allowed: degrees")
     return (("time", "height"), np.mod(direction, FULL_CIRCLE_DEG))
+
+
+def check_same_units(unit, reference):
+    """Refuse a pair whose concurrent speeds differ by a unit factor at a height: the
+    median ratio outside [1/UNIT_RATIO, UNIT_RATIO] (km/h is 3.6 times m/s, knots 1.94;
+    two instruments at one height agree within a few per cent)."""
+    for h in unit["height"].values:
+        a, b = unit["speed"].sel(height=h).values, reference["speed"].sel(height=h).values
+        both = np.isfinite(a) & np.isfinite(b) & (a > 0) & (b > 0)
+        if not both.any():
+            continue
+        ratio = float(np.median(a[both] / b[both]))
+        if 1 / UNIT_RATIO <= ratio <= UNIT_RATIO:
+            continue
+        big, small = (unit, reference) if ratio > 1 else (reference, unit)
+        raise DataFileError(big.attrs["file"], f"instruments.{big.attrs['instrument']}."
+                            f"heights.{h:g}.speed", f"concurrent speeds are "
+                            f"{max(ratio, 1 / ratio):.2f} times those of "
+                            f"{small.attrs['instrument']} at {h:g} m (median ratio): km/h "
+                            "(3.6) or knots (1.94)? allowed: m s-1 in every file")
 
 
 def _listing(columns):

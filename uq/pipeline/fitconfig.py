@@ -10,16 +10,18 @@
         shear: {dist: uniform, low: -0.5, high: 1.0}
         roughness_length: {dist: log_uniform, low: 1.0e-6, high: 1.0}
         reference_speed: {dist: normal, mean: 9.0, u: 2.0}
-      walkers: 32                 # >= 32
-      ensembles: 4                # independent ensembles for R-hat, >= 2
-      max_steps: 50000            # per ensemble; not converged by then -> error
+      walkers: 32                 # 32 to 1024
+      ensembles: 4                # independent ensembles for R-hat, 2 to 64
+      max_steps: 50000            # per ensemble (100 to 10^6); not converged -> error
+                                  # walkers x ensembles x max_steps <= 10^7
       seed: 1                     # emcee State random_state; same seed, same chains
       columns: {height: height, speed: speed}   # CSV input: column names
                                                 # (optional: speed_u, height_u)
 """
 from dataclasses import dataclass, field
 
-from uq.constants import MIN_WALKERS
+from uq.constants import (MAX_ENSEMBLES, MAX_FIT_DRAWS, MAX_FIT_STEPS, MAX_WALKERS,
+                          MIN_WALKERS)
 from uq.physics.profiles import PROFILES
 
 PRIOR_KINDS = ("uniform", "log_uniform", "normal")
@@ -73,15 +75,23 @@ def validate_fit(check, value):
     columns = value.get("columns") or {}
     check.mapping(columns, "fit.columns")
     check.keys(columns, "fit.columns", COLUMN_KEYS)
+    walkers = check.integer(value.get("walkers", MIN_WALKERS), "fit.walkers", low=MIN_WALKERS,
+                            high=MAX_WALKERS)
+    ensembles = check.integer(value.get("ensembles", 4), "fit.ensembles", low=2,
+                              high=MAX_ENSEMBLES)
+    max_steps = check.integer(value.get("max_steps", 50_000), "fit.max_steps", low=100,
+                              high=MAX_FIT_STEPS)
+    if walkers * ensembles * max_steps > MAX_FIT_DRAWS:
+        check.fail("fit.max_steps", f"walkers x ensembles x max_steps = {walkers} x "
+                   f"{ensembles} x {max_steps} draws; allowed: at most {MAX_FIT_DRAWS} (the "
+                   "chains are kept in memory)")
     return FitConfig(
         profile=profile,
         reference_height=check.number(value.get("reference_height", 100.0),
                                       "fit.reference_height", low=0.0, low_open=True),
         scatter=check.boolean(value.get("scatter", True), "fit.scatter"),
         priors={name: _prior(check, spec, f"fit.priors.{name}") for name, spec in priors.items()},
-        walkers=check.integer(value.get("walkers", MIN_WALKERS), "fit.walkers", low=MIN_WALKERS),
-        ensembles=check.integer(value.get("ensembles", 4), "fit.ensembles", low=2),
-        max_steps=check.integer(value.get("max_steps", 50_000), "fit.max_steps", low=100),
+        walkers=walkers, ensembles=ensembles, max_steps=max_steps,
         seed=check.integer(value.get("seed", 1), "fit.seed", low=0),
         columns={**DEFAULT_COLUMNS, **{k: check.text(v, f"fit.columns.{k}")
                                        for k, v in columns.items()}})

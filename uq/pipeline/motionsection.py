@@ -32,7 +32,6 @@ validated settings unless given).
     correction: pointwise
 """
 import functools
-import io
 import math
 from pathlib import Path
 
@@ -45,13 +44,16 @@ from uq.errors import ScenarioError
 from uq.physics.series import WindowStart, series_components
 from uq.physics.timing import TIMESTAMPS, ScanTiming
 from uq.physics.waves import jonswap_components
-from uq.constants import MAX_SERIES_BYTES, MAX_WAVE_COMPONENTS
+from uq.constants import (MAX_MAGNITUDE, MAX_SERIES_BYTES, MAX_SERIES_ROWS,
+                          MAX_WAVE_COMPONENTS)
 
 HARMONIC_KEYS = ("amplitude", "period", "phase")
 SPECTRUM_KEYS = ("kind", "hs", "tp", "gamma", "components", "band")
 SPECTRUM_KINDS = ("jonswap",)
 RESPONSE_KEYS = ("factor", "lag")
 SERIES_KEYS = ("file", "time", "columns", "components")
+#: What a motion record is, in messages about the file.
+SERIES_KIND = "a CSV motion record"
 #: Fewest samples of a motion record [1]: a Fourier series of fewer says little.
 MIN_SERIES_SAMPLES = 16
 #: Largest relative spread of a record's sampling intervals [1]: the Fourier series
@@ -131,16 +133,9 @@ def read_series(file, time, columns, source="<mapping>"):
 def _read_series(file, version, time, columns):
     import pandas as pd
     from uq.errors import DataFileError
-    from uq.pipeline.yamlfile import read_text
-    try:
-        text = read_text(Path(file), limit=MAX_SERIES_BYTES)
-    except ScenarioError as error:
-        raise DataFileError(str(file), "motion.series.file", error.problem) from None
-    try:
-        table = pd.read_csv(io.StringIO(text))
-    except (ValueError, pd.errors.ParserError, pd.errors.EmptyDataError) as error:
-        raise DataFileError(str(file), "motion.series.file", f"cannot read it as CSV "
-                            f"({str(error).splitlines()[0][:100]})") from None
+    from uq.pipeline.inputfile import read_csv
+    table = read_csv(Path(file), MAX_SERIES_BYTES, MAX_SERIES_ROWS, SERIES_KIND,
+                     DataFileError, "motion.series.file")
     wanted = [time] + [c for _, c in columns]
     missing = [c for c in wanted if c not in table.columns]
     if missing:
@@ -174,6 +169,12 @@ def _spectrum(check, value):
     check.required(value, key, ("hs", "tp"), "a spectrum needs hs [m] and tp [s]")
     tp = check.number(value["tp"], f"{key}.tp", low=0.0, low_open=True)
     band = value.get("band", [SPECTRUM_BAND[0] / tp, SPECTRUM_BAND[1] / tp])
+    if "band" not in value:                  # the default band: a problem is tp's
+        if not all(0.0 < f <= MAX_MAGNITUDE for f in band):
+            check.fail(f"{key}.tp", f"{tp:g} s gives the default band {SPECTRUM_BAND[0]:g}/tp "
+                       f"to {SPECTRUM_BAND[1]:g}/tp = [{band[0]:g}, {band[1]:g}] Hz, beyond "
+                       f"the numbers allowed (at most {MAX_MAGNITUDE:g}); allowed: a peak "
+                       "period in seconds, or an explicit band")
     band = check.number_list(band, f"{key}.band", low=0.0, low_open=True)
     if len(band) != 2 or not band[0] < band[1]:
         check.fail(f"{key}.band", "allowed: [lowest, highest] frequency in Hz, lowest first")
@@ -209,6 +210,9 @@ def _harmonic(check, value, key, angular):
                    "a harmonic needs amplitude and period (phase defaults to random)")
     high = MAX_ANGULAR_AMPLITUDE_DEG if angular else None
     phase = value.get("phase", "random")
+    if isinstance(phase, str) and phase != "random":
+        check.fail(f"{key}.phase", f"{phase!r} is not allowed; allowed: a number of degrees "
+                   "in [-360, 360], or random")
     return {"amplitude": check.number(value["amplitude"], f"{key}.amplitude", low=0.0,
                                       high=high),
             "period": check.number(value["period"], f"{key}.period", low=0.0, low_open=True),

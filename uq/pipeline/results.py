@@ -1,7 +1,9 @@
 """Reading results files (netCDF4). No physics here; writing is :mod:`uq.files`."""
 import xarray as xr
 
+from uq.constants import MAX_RESULTS_BYTES
 from uq.errors import DataFileError
+from uq.pipeline.inputfile import check_regular
 
 
 def read_results(path):
@@ -11,7 +13,11 @@ def read_results(path):
 
 
 def open_results(path):
-    """Results of ``uq run`` at `path`, or DataFileError (bad input: exit 2) naming it."""
+    """Results of ``uq run`` at `path`, or DataFileError (bad input: exit 2) naming it.
+    A path that is not a regular file (a FIFO would block the netCDF library) or larger
+    than MAX_RESULTS_BYTES is refused unopened."""
+    check_regular(path, MAX_RESULTS_BYTES, "a results file of uq run (netCDF)",
+                  DataFileError)
     try:
         dataset = read_results(path)
     except (OSError, ValueError) as error:

@@ -38,6 +38,9 @@ from uq.engine.stopping import STOPPING_RULES
 from uq.pipeline.sweep import VECTOR_KEYS
 from uq.pipeline.yamlfile import read_yaml
 
+#: What a scenario file is, in messages about the file itself.
+SCENARIO_KIND = "a YAML scenario"
+
 INS_CORRELATIONS = ("scan", "beam")
 #: The errors of the INS readings (``ins.<key>``) and of the lidar (``lidar.errors.<key>``,
 #: the probe's parameters' apart), as :mod:`uq.physics.modelinputs` declares them.
@@ -170,7 +173,7 @@ def load_scenario(path_or_mapping, overrides=None):
         raw, source = copy.deepcopy(path_or_mapping), "<mapping>"
     else:
         source = str(path_or_mapping)
-        raw = read_yaml(Path(path_or_mapping))
+        raw = read_yaml(Path(path_or_mapping), kind=SCENARIO_KIND)
         if isinstance(raw, dict):
             raw.setdefault("name", Path(path_or_mapping).stem)
     if not isinstance(raw, dict):

@@ -10,52 +10,29 @@ an :class:`~uq.errors.ScenarioError` naming the file, the line and what is allow
 * a file that is not UTF-8 text (binary data, Latin-1, UTF-16);
 * a key given twice in one mapping (YAML would silently keep the last: a repeated ``ins``
   section would drop the first one's errors);
-* a folder, a device or an endless stream where a file was expected.
+* a folder, a device, a named pipe or an endless stream where a file was expected
+  (:mod:`uq.pipeline.inputfile`).
 """
-import stat
 from pathlib import Path
 
 import yaml
 
 from uq.constants import MAX_CONFIG_BYTES, MAX_CONFIG_DEPTH, MAX_CONFIG_NODES
 from uq.errors import ScenarioError
+from uq.pipeline.inputfile import decode, read_bytes
 
 
-def read_yaml(path):
-    """The YAML document in the file at `path` (plain Python objects)."""
+def read_yaml(path, kind="a YAML file"):
+    """The YAML document in the file at `path` (plain Python objects); `kind` names the
+    file in messages (``"a YAML scenario"``)."""
     path = Path(path)
-    return parse_yaml(read_text(path), str(path))
+    return parse_yaml(read_text(path, kind=kind), str(path))
 
 
-def read_text(path, limit=MAX_CONFIG_BYTES):
-    """The text of a small configuration file, read with a size limit."""
-    try:
-        info = path.stat()
-        if stat.S_ISDIR(info.st_mode):
-            raise ScenarioError(str(path), "", "is a folder; allowed: a YAML file")
-        with open(path, "rb") as stream:
-            data = stream.read(limit + 1)
-    except OSError as error:
-        raise ScenarioError(str(path), "", f"cannot read the file ({error.strerror or error})"
-                            ) from None
-    if len(data) > limit:
-        raise ScenarioError(str(path), "", f"larger than {limit // 1024} KiB (or endless); "
-                            f"allowed: a YAML file of at most {limit // 1024} KiB")
-    return decode(data, str(path))
-
-
-def decode(data, source):
-    """UTF-8 text of `data` (a byte-order mark is allowed), or ScenarioError."""
-    if b"\x00" in data:
-        raise ScenarioError(source, "", "holds NUL bytes (binary data or UTF-16 text); "
-                            "allowed: UTF-8 text")
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as error:
-        line = data[:error.start].count(b"\n") + 1
-        raise ScenarioError(source, "", f"not UTF-8 text (byte {data[error.start]:#04x} at "
-                            f"line {line}; Latin-1 or another encoding?); allowed: UTF-8 "
-                            "text") from None
+def read_text(path, limit=MAX_CONFIG_BYTES, kind="a YAML file"):
+    """The UTF-8 text of a small configuration file: a regular file, read without
+    blocking and with a size limit (:func:`uq.pipeline.inputfile.read_bytes`)."""
+    return decode(read_bytes(path, limit, kind), str(path))
 
 
 def parse_yaml(text, source):
@@ -66,7 +43,7 @@ def parse_yaml(text, source):
         node = loader.get_single_node()
         if node is None:
             return None
-        _check_expansion(node, source)
+        _check_nodes(node, source)
         return loader.construct_document(node)
     except ScenarioError:
         raise
@@ -85,7 +62,7 @@ def parse_yaml(text, source):
 
 
 class _Loader(yaml.SafeLoader):
-    """SafeLoader that bounds nesting and refuses repeated keys."""
+    """SafeLoader that bounds nesting (repeated keys, tags and aliases: _check_nodes)."""
 
     depth = 0
 
@@ -101,44 +78,73 @@ class _Loader(yaml.SafeLoader):
         finally:
             self.depth -= 1
 
-    def construct_mapping(self, node, deep=False):
-        seen = {}
-        for key_node, _ in node.value:
-            key = self.construct_object(key_node, deep=True)
-            try:
-                first = seen.get(key)
-            except TypeError:                  # an unhashable key: YAML's own message
-                continue
-            if first is not None:
-                raise ScenarioError(self.source, str(key), f"given twice (lines {first} and "
-                                    f"{key_node.start_mark.line + 1}); allowed: each key "
-                                    "once in a mapping")
-            seen[key] = key_node.start_mark.line + 1
-        return super().construct_mapping(node, deep)
 
-
-def _check_expansion(root, source):
-    """Refuse a document whose aliases expand to more than MAX_CONFIG_NODES values."""
+def _check_nodes(root, source):
+    """Check the composed document before anything is built: every key once per mapping,
+    only plain YAML tags, and at most MAX_CONFIG_NODES values once aliases are expanded.
+    Each problem names the dotted key where it sits (shared nodes are visited once)."""
     sizes, open_nodes = {}, set()
 
-    def size(node):
+    def size(node, path):
         if id(node) in open_nodes:
-            raise ScenarioError(source, "", f"a YAML alias refers to itself (line "
-                                f"{node.start_mark.line + 1}); allowed: aliases of "
-                                "finished values")
+            _fail(source, path, f"a YAML alias refers to itself (line "
+                  f"{node.start_mark.line + 1}); allowed: aliases of finished values")
         if id(node) in sizes:
             return sizes[id(node)]
         open_nodes.add(id(node))
+        _check_tag(node, path, source)
         if isinstance(node, yaml.SequenceNode):
-            total = 1 + sum(size(child) for child in node.value)
+            total = 1 + sum(size(child, f"{path}[{i}]") for i, child in enumerate(node.value))
         elif isinstance(node, yaml.MappingNode):
-            total = 1 + sum(size(k) + size(v) for k, v in node.value)
+            _check_repeats(node, path, source)
+            total = 1 + sum(size(k, path) + size(v, _join(path, k)) for k, v in node.value)
         else:
             total = 1
         open_nodes.discard(id(node))
-        sizes[id(node)] = min(total, MAX_CONFIG_NODES + 1)
-        return sizes[id(node)]
+        if total > MAX_CONFIG_NODES:
+            _fail(source, path, f"expands to more than {MAX_CONFIG_NODES} values (YAML "
+                  "aliases or a long list); allowed: a scenario's few hundred values")
+        sizes[id(node)] = total
+        return total
 
-    if size(root) > MAX_CONFIG_NODES:
-        raise ScenarioError(source, "", f"expands to more than {MAX_CONFIG_NODES} values "
-                            "(YAML aliases); allowed: a scenario's few hundred values")
+    size(root, "")
+
+
+def _join(path, key_node):
+    """The dotted key of a mapping's value (a key that is not text is shown as YAML)."""
+    key = key_node.value if isinstance(key_node, yaml.ScalarNode) else "?"
+    return f"{path}.{key}" if path else str(key)
+
+
+def _check_repeats(node, path, source):
+    """Refuse a key given twice in one mapping (YAML would keep the last silently)."""
+    seen = {}
+    for key_node, _ in node.value:
+        if not isinstance(key_node, yaml.ScalarNode):
+            continue
+        mark = key_node.start_mark
+        first = seen.setdefault((key_node.tag, key_node.value), mark)
+        if first is mark:
+            continue
+        where = f"lines {first.line + 1} and {mark.line + 1}" if first.line != mark.line \
+            else f"line {mark.line + 1}, columns {first.column + 1} and {mark.column + 1}"
+        _fail(source, _join(path, key_node), f"given twice ({where}); allowed: each key "
+              "once in a mapping")
+
+
+def _check_tag(node, path, source):
+    """Refuse an explicit tag PyYAML's safe loader cannot build (``!!python/...``)."""
+    if node.tag not in _Loader.yaml_constructors and node.tag != _MERGE:
+        tag = node.tag.replace(_STANDARD, "!!")
+        _fail(source, path, f"the YAML tag {tag!r} (line {node.start_mark.line + 1}) is "
+              "not allowed; allowed: plain values (numbers, text, true/false, lists, "
+              "mappings)")
+
+
+#: Prefix of YAML's standard tags (written ``!!`` in a file), and the merge key ``<<``.
+_STANDARD = "tag:yaml.org,2002:"
+_MERGE = _STANDARD + "merge"
+
+
+def _fail(source, path, problem):
+    raise ScenarioError(source, path or "", problem)
