@@ -312,6 +312,24 @@ def random_phase_count(settings):
     return harmonics + (motion["spectrum"]["components"] if "spectrum" in motion else 0)
 
 
+#: Scenario keys whose value is a file the run reads (relative to the scenario's folder).
+FILE_KEYS = ("motion.series.file",)
+
+
+def input_files(scenario):
+    """The files a scenario reads, as ``(dotted key, path)`` in a fixed order: the motion
+    record of the settings and every swept value of :data:`FILE_KEYS` (so that a
+    checkpoint can cover their content, :mod:`uq.pipeline.checkpoint`)."""
+    found = []
+    series = (scenario.settings.get("motion") or {}).get("series")
+    if series:
+        found.append((FILE_KEYS[0], str(series["file"])))
+    for key, values in scenario.sweep:
+        if key in FILE_KEYS:
+            found += [(key, str(_beside(scenario.source, value))) for value in values]
+    return list(dict.fromkeys(found))
+
+
 def beam_stamps(settings, n_beams):
     """Time stamps of the beams [s] (for the Gauss-Markov correlation of INS errors)."""
     scan = {**SCAN_DEFAULTS, **settings["lidar"].get("scan", {})}
