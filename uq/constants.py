@@ -190,10 +190,18 @@ MAX_CHUNK_SIZE = 2**22
 #: ~2e-9 m/s of radial velocity at 10 m/s: far below any other error of the model.
 DWELL_QUADRATURE_TOLERANCE = 1e-9
 
-#: Most Gauss-Legendre nodes per dwell [1]: 32 nodes average a sinusoid over a dwell of up
-#: to ~10 of its radians to 1e-9 (a 1 s dwell of a 0.6 s motion period); a conical scan's
-#: dwell of 20 ms needs 2-4.
+#: Most Gauss-Legendre nodes per panel of a dwell [1]: 32 nodes average a sinusoid over
+#: up to ~71 of its radians (11 periods) to 1e-9 (:data:`uq.physics.timing.PANEL_SPAN`);
+#: a conical scan's dwell of 20 ms needs 2-4. A longer dwell is cut into panels.
 MAX_DWELL_NODES = 32
+
+#: Most Gauss-Legendre nodes per dwell, over all its panels [1]
+#: (:func:`uq.physics.timing.dwell_rule`): 16 panels of 32 nodes average a dwell of up to
+#: ~1130 radians (180 periods) of the integrand's highest frequency to 1e-9. It bounds
+#: memory: the numpy model holds (trials, beams, nodes, 3, 3) attitudes, 190 MB for a
+#: slice of 2^10 trials of a 5-beam scan at 512 nodes. A lidar's dwell (0.02-2 s) of a
+#: platform's motion (periods of 1 s and more) needs at most a few dozen.
+MAX_DWELL_TOTAL_NODES = 512
 
 #: Size [the output's unit: m s-1 or deg] under which a figure or a report takes a
 #: deterministic number (an uncertainty, the correction's systematic error) for zero: far

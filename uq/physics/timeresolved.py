@@ -54,6 +54,7 @@ from uq.physics.rotation import (attitude_from_matrix_analytic, attitude_matrix,
                                  attitude_matrix_rate, interpolate_rotation,
                                  rotation_about_vertical)
 from uq.physics.scene import ANGULAR_NAVIGATION, NAVIGATION, sample_count
+from uq.physics.timing import dwell_frequency
 
 TIME_RESOLVED_INPUTS = ("motion_phases", "motion_window", "ins_clock_offset",
                         "ins_sample_offset")
@@ -155,7 +156,7 @@ def _measure(scene, resolved, phases, err, n):
     """True radial velocities plus noise, (n, b, g), and the gate heights (n, b, g)."""
     timing, motion = resolved.timing, resolved.motion
     n_beams = scene.n_beams
-    fastest = max((c.angular_frequency for c in motion.components), default=0.0)
+    fastest = dwell_frequency(motion.components)
     times, weights = timing.nodes(n_beams, fastest)                      # (b, q), (q,)
     kin = platform_kinematics(scene, motion, phases, times[None])         # (n', b, q, ...)
     half_cone = scene.half_cone + complexstep.radians(err["lidar_half_cone"])

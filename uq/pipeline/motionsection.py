@@ -43,9 +43,10 @@ from uq.physics.motion import DEGREES_OF_FREEDOM, Motion, MotionComponent
 from uq.physics.scene import TimeResolved
 from uq.errors import ScenarioError
 from uq.physics.series import WindowStart, series_components
-from uq.physics.timing import TIMESTAMPS, ScanTiming
+from uq.physics.timing import (TIMESTAMPS, DwellTooLong, ScanTiming, dwell_frequency,
+                               dwell_rule)
 from uq.physics.waves import jonswap_components
-from uq.constants import MAX_SERIES_BYTES, MAX_WAVE_COMPONENTS
+from uq.constants import MAX_DWELL_TOTAL_NODES, MAX_SERIES_BYTES, MAX_WAVE_COMPONENTS
 
 HARMONIC_KEYS = ("amplitude", "period", "phase")
 SPECTRUM_KEYS = ("kind", "hs", "tp", "gamma", "components", "band")
@@ -242,6 +243,25 @@ def validate_ins_timing(check, value, out):
     if "interpolation" in value:
         out["interpolation"] = check.choice(value["interpolation"], "ins.interpolation",
                                             INTERPOLATIONS)
+
+
+def check_dwell(check, settings):
+    """Refuse a dwell average whose quadrature would need more nodes than
+    :data:`~uq.constants.MAX_DWELL_TOTAL_NODES` (:func:`uq.physics.timing.dwell_rule`),
+    before anything is allocated: a dwell of more cycles of the motion than a lidar has."""
+    scan = settings["lidar"].get("scan") or {}
+    if not scan.get("dwell_average") or not is_time_resolved(settings):
+        return
+    frequency = dwell_frequency(time_resolved(settings).motion.components)
+    try:
+        dwell_rule(frequency * scan["beam_duration"])
+    except DwellTooLong as error:
+        check.fail("lidar.scan.beam_duration", f"{scan['beam_duration']:g} s averaged over "
+                   f"the motion (harmonics of the integrand up to "
+                   f"{frequency / (2 * math.pi):.3g} Hz) needs {error.nodes:.3g} quadrature "
+                   f"nodes per dwell; allowed: at most {MAX_DWELL_TOTAL_NODES} (a "
+                   f"beam_duration up to {error.longest_span / frequency:.3g} s), or "
+                   "lidar.scan.dwell_average: false")
 
 
 def is_time_resolved(settings):

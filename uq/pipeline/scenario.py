@@ -27,7 +27,7 @@ from uq.physics.beams import beam_unit_vectors
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS, validate_error
 from uq.errors import ScenarioError
 from uq.pipeline.fitconfig import validate_fit
-from uq.pipeline.motionsection import (validate_ins_timing, validate_lever_arm, validate_motion,
+from uq.pipeline.motionsection import (check_dwell, validate_ins_timing, validate_lever_arm, validate_motion,
                                        validate_scan)
 from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
 from uq.physics.measurement import OUTPUTS
@@ -344,6 +344,7 @@ def _check_time_resolved(check, settings):
     if DERIVED_OUTPUTS[0] in settings["outputs"] and not settings.get("motion"):
         check.fail("outputs", f"{DERIVED_OUTPUTS[0]} needs a motion section; allowed: the "
                    "other outputs")
+    check_dwell(check, settings)
 
 
 def _check_beams_determine_wind(check, lidar):
