@@ -210,6 +210,14 @@ MAX_DWELL_TOTAL_NODES = 512
 #: far below anything a lidar resolves (~1e-2 m s-1) or a report prints (4 digits of u).
 NUMERICAL_ZERO = 1e-9
 
+#: Shortest period of a platform motion [s] (harmonics, a spectrum's peak period; a
+#: spectrum's band reaches at most 1 / this in Hz): an INS reports attitude and velocity at
+#: up to 100-200 Hz, so a faster "motion" is vibration that no INS resolves and no
+#: motion correction uses; and the phase w t of a faster one over a scan of minutes keeps
+#: too few digits to mean anything (a period of 1e-300 s gave non-finite statistics with no
+#: invalid trial counted).
+MIN_MOTION_PERIOD = 0.01
+
 #: Most components of a wave spectrum [1]: each is a Monte Carlo input (a random phase)
 #: and a column of the GUM Jacobian; 256 resolve a JONSWAP peak (gamma 3.3, relative width
 #: ~0.1) with ~20 bins across it over a band of 0.5-4 fp.

@@ -57,7 +57,8 @@ def jonswap_components(hs, tp, gamma, components, band, response):
     frequencies = low + width * (np.arange(components) + 0.5)
     shape = np.asarray(jonswap(frequencies, fp=1.0 / tp, gamma=gamma, hs=hs).values,
                        dtype=float)
-    density = shape * (hs / 4.0) ** 2 / np.sum(shape * width)  # sum S df = m0 exactly
+    density = np.zeros(components) if hs == 0 else \
+        shape * (hs / 4.0) ** 2 / np.sum(shape * width)  # sum S df = m0 exactly; calm: 0
     amplitudes = np.sqrt(2.0 * density * width)
     out = []
     for frequency, amplitude in zip(frequencies, amplitudes):

@@ -46,7 +46,8 @@ from uq.physics.series import WindowStart, series_components
 from uq.physics.timing import (TIMESTAMPS, DwellTooLong, ScanTiming, dwell_frequency,
                                dwell_rule)
 from uq.physics.waves import jonswap_components
-from uq.constants import MAX_DWELL_TOTAL_NODES, MAX_SERIES_BYTES, MAX_WAVE_COMPONENTS
+from uq.constants import (MAX_DWELL_TOTAL_NODES, MAX_SERIES_BYTES, MAX_WAVE_COMPONENTS,
+                          MIN_MOTION_PERIOD)
 
 HARMONIC_KEYS = ("amplitude", "period", "phase")
 SPECTRUM_KEYS = ("kind", "hs", "tp", "gamma", "components", "band")
@@ -173,9 +174,10 @@ def _spectrum(check, value):
     check.mapping(value, key)
     check.keys(value, key, SPECTRUM_KEYS)
     check.required(value, key, ("hs", "tp"), "a spectrum needs hs [m] and tp [s]")
-    tp = check.number(value["tp"], f"{key}.tp", low=0.0, low_open=True)
+    tp = _period(check, value["tp"], f"{key}.tp")
     band = value.get("band", [SPECTRUM_BAND[0] / tp, SPECTRUM_BAND[1] / tp])
-    band = check.number_list(band, f"{key}.band", low=0.0, low_open=True)
+    band = check.number_list(band, f"{key}.band", low=0.0, low_open=True,
+                             high=1.0 / MIN_MOTION_PERIOD)
     if len(band) != 2 or not band[0] < band[1]:
         check.fail(f"{key}.band", "allowed: [lowest, highest] frequency in Hz, lowest first")
     return {"kind": check.choice(value.get("kind", "jonswap"), f"{key}.kind", SPECTRUM_KINDS),
@@ -212,9 +214,19 @@ def _harmonic(check, value, key, angular):
     phase = value.get("phase", "random")
     return {"amplitude": check.number(value["amplitude"], f"{key}.amplitude", low=0.0,
                                       high=high),
-            "period": check.number(value["period"], f"{key}.period", low=0.0, low_open=True),
+            "period": _period(check, value["period"], f"{key}.period"),
             "phase": "random" if phase == "random" else check.number(
                 phase, f"{key}.phase", low=-360.0, high=360.0)}
+
+
+def _period(check, value, key):
+    """A motion period [s]: at least :data:`~uq.constants.MIN_MOTION_PERIOD`."""
+    period = check.number(value, key, low=0.0, low_open=True)
+    if period < MIN_MOTION_PERIOD:
+        check.fail(key, f"{period:g} s is shorter than any platform motion; allowed: at "
+                   f"least {MIN_MOTION_PERIOD:g} s (faster is vibration, which no INS "
+                   "resolves)")
+    return period
 
 
 def validate_lever_arm(check, value):
