@@ -30,6 +30,13 @@ DEFAULT_BLOCKS_PER_CHUNK = 1
 #: Largest number of Monte Carlo trials adaptive sampling (``digits``) may use [1].
 ADAPTIVE_MAX_SAMPLES = 2**24
 
+#: Most negative eigenvalue, per row, of a correlation matrix taken as positive
+#: semidefinite [1] (:func:`uq.engine.inputs.semidefinite_root`): a correlation matrix
+#: computed in double precision carries errors of ~1e-16 per element, which move its
+#: eigenvalues by at most n x that (Weyl); 1e-12 leaves a margin of 1e4, while
+#: inconsistent correlations give negative eigenvalues of the order of the coefficients.
+SEMIDEFINITE_TOLERANCE = 1e-12
+
 #: Complex-step size, relative to max(1, |x|) [1]. Complex-step differentiation has no
 #: subtractive cancellation, so any step far below sqrt(machine epsilon) times the
 #: curvature scale gives the derivative to machine precision (Squire & Trapp 1998);

@@ -392,3 +392,24 @@ def test_a_calm_sea_is_the_static_answer():
     # no motion: its TI is 0 to the rounding of the trials' speeds (~1e-15 relative)
     assert abs(float(calm["wind_speed_motion_ti"])) < 1e-12
     assert float(calm["wind_speed_motion_ti_gum"]) == 0
+
+
+@pytest.mark.parametrize("changes", [{"ins.heading.correlation_time": 1e20},
+                                     {"ins.heading.correlation_time": 1.0,
+                                      "lidar.scan.beam_duration": 1e-300}])
+def test_gauss_markov_errors_in_their_fully_correlated_limit(changes):
+    """tau = 1e20 s, or beams 1e-300 s apart: the correlation is all ones to rounding
+    (it was 'not positive definite'); the run is the limit, one error per scan (tau =
+    inf). GUM: the same linearisation and correlation (to rounding): 1e-12 relative.
+    Monte Carlo, 2e4 trials with other draws: u within 5 relative standard errors,
+    1/sqrt(2 N) = 0.5 % each, of the two estimates (5 sqrt(2) x 0.5 %)."""
+    base = {"wind": {"speed": 8.0, "direction": 30.0}, "sampling": {"n": 20_000, "seed": 3},
+            "ins": {"heading": {"dist": "normal", "u": 0.5, "correlation_time": 1.0},
+                    "pitch": {"dist": "normal", "u": 0.5}},
+            "lidar": {"scan": {"beam_duration": 1.0}}}
+    limit = uq.run(uq.load_scenario(base, {"ins.heading.correlation_time": np.inf}))
+    near = uq.run(uq.load_scenario(base, changes))
+    for q in ("wind_speed", "wind_direction", "vertical_wind"):
+        assert float(near[f"{q}_gum_u"]) == pytest.approx(float(limit[f"{q}_gum_u"]), rel=1e-12)
+        assert float(near[f"{q}_mc_u"]) == pytest.approx(
+            float(limit[f"{q}_mc_u"]), rel=5 * np.sqrt(2) / np.sqrt(2 * 20_000))

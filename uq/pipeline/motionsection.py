@@ -100,6 +100,9 @@ def _series(check, value):
     columns = value["columns"]
     check.mapping(columns, f"{key}.columns")
     check.keys(columns, f"{key}.columns", DEGREES_OF_FREEDOM)
+    if not columns:
+        check.fail(f"{key}.columns", "empty; allowed: the column of at least one degree of "
+                   f"freedom ({', '.join(DEGREES_OF_FREEDOM)})")
     out = {"file": str(_beside(check.source, path)),
            "time": check.text(value.get("time", "time"), f"{key}.time"),
            "columns": {dof: check.text(c, f"{key}.columns.{dof}") for dof, c in

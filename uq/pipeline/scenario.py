@@ -27,8 +27,8 @@ from uq.physics.beams import beam_unit_vectors
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS, validate_error
 from uq.errors import ScenarioError
 from uq.pipeline.fitconfig import validate_fit
-from uq.pipeline.motionsection import (check_dwell, validate_ins_timing, validate_lever_arm, validate_motion,
-                                       validate_scan)
+from uq.pipeline.motionsection import (check_dwell, random_phase_count, validate_ins_timing,
+                                       validate_lever_arm, validate_motion, validate_scan)
 from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
 from uq.physics.measurement import OUTPUTS
 from uq.engine.sampling import PROPAGATION_METHODS
@@ -433,10 +433,16 @@ def _validate_sweep(value, settings, source):
                                 f"({', '.join(VECTOR_KEYS)}) or pairs of other keys")
         swept[follower] = swept[leader]
     for key, values in swept.items():
+        random = set()
         for item in _values_to_validate(key, values, source):
             raw = copy.deepcopy(settings)     # each value must make a valid scenario
             assign_dotted(raw, key, item, source)
-            _validate(raw, source)
+            random.add(random_phase_count(_validate(raw, source)) > 0)
+        if len(random) > 1:                   # the model's inputs would differ by value
+            raise ScenarioError(source, f"sweep.{key}", "some values give the motion random "
+                                "phases and others none (different Monte Carlo inputs "
+                                "cannot share one sweep); allowed: all values with "
+                                "random phases, or none (e.g. phases in degrees only)")
     return tuple(sweep), tuple(links)
 
 
