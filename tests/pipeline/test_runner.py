@@ -413,3 +413,19 @@ def test_gauss_markov_errors_in_their_fully_correlated_limit(changes):
         assert float(near[f"{q}_gum_u"]) == pytest.approx(float(limit[f"{q}_gum_u"]), rel=1e-12)
         assert float(near[f"{q}_mc_u"]) == pytest.approx(
             float(limit[f"{q}_mc_u"]), rel=5 * np.sqrt(2) / np.sqrt(2 * 20_000))
+
+
+@pytest.mark.parametrize("correction", ["pointwise", "full"])
+def test_every_results_file_has_gum_valid(correction):
+    """sampling.method none (the GUM alone): q_gum_valid is in the file (the contract's
+    variables), False: without Monte Carlo the GUM is not validated; and the summary
+    says 'nan' for the verdict, as before (no Monte Carlo)."""
+    from uq.outputs.summary import summary_table
+    ds = uq.run({"ins": {"heading": {"dist": "normal", "u": 0.1}}, "correction": correction,
+                 "motion": {"roll": {"amplitude": 3.0, "period": 6.0}},
+                 "sampling": {"method": "none"}})
+    for q in ("wind_speed", "wind_direction", "vertical_wind"):
+        assert ds[f"{q}_gum_valid"].dtype == bool and not ds[f"{q}_gum_valid"].any()
+        assert not ds[f"{q}_gum_validation_conclusive"].any()
+        assert ds[f"{q}_gum_valid"].attrs["flag_meanings"] == "not_validated validated"
+    assert "0/1" not in summary_table(ds)
