@@ -59,6 +59,15 @@ MIN_SERIES_SAMPLES = 16
 #: Largest relative spread of a record's sampling intervals [1]: the Fourier series
 #: assumes equal spacing; clock jitter of 1 % of the interval is tolerated.
 SERIES_SPACING_TOLERANCE = 0.01
+#: Widest sampling interval of a motion record [s]: a record must resolve the
+#: wave-driven motion of a platform (periods down to ~2 s: 1 s is its Nyquist interval).
+#: A wider one is most likely a time column in milliseconds (100 at 10 Hz).
+MAX_SERIES_STEP = 1.0
+#: Longest period [s] of the strongest roll, pitch or heave in a record that passes
+#: without a warning: wave-driven motion has periods of 2-30 s (swell up to ~25 s);
+#: longer is a drift, or a time column in milliseconds.
+MAX_WAVE_PERIOD = 30.0
+WAVE_DOFS = ("roll", "pitch", "heave")
 #: Default band of a spectrum, in multiples of its peak frequency 1/tp [1]: the JONSWAP
 #: (gamma 3.3) energy outside [0.5, 4] fp is below 1e-3 of the total (the f^-5 tail).
 SPECTRUM_BAND = (0.5, 4.0)
@@ -167,9 +176,33 @@ def _read_series(file, version, time, columns):
         raise DataFileError(str(file), time, f"{len(times)} samples; allowed: at least "
                             f"{MIN_SERIES_SAMPLES}, increasing and equally spaced (within "
                             f"{100 * SERIES_SPACING_TOLERANCE:g} %)")
+    step = float(np.mean(steps))
+    if step > MAX_SERIES_STEP:
+        raise DataFileError(str(file), time, f"samples {step:g} apart; allowed: the time in "
+                            f"seconds, samples at most {MAX_SERIES_STEP:g} s apart (a motion "
+                            "record resolves wave motion; is the time in milliseconds?)")
+    _warn_slow_motion(file, data, columns, len(times) * step)
     values = {dof: np.radians(data[c]) if dof in ANGULAR_DOFS else data[c]
               for dof, c in columns}
     return times, values
+
+
+def _warn_slow_motion(file, data, columns, length):
+    """Warn where the strongest roll, pitch or heave of a record is slower than wave
+    motion (:data:`MAX_WAVE_PERIOD`): a time column in milliseconds, or a drift."""
+    import logging
+    for dof, column in columns:
+        if dof not in WAVE_DOFS:
+            continue
+        power = np.abs(np.fft.rfft(data[column] - np.mean(data[column]))[1:])
+        if not power.size or not np.any(power > 0):
+            continue
+        period = length / (int(np.argmax(power)) + 1)
+        if period > MAX_WAVE_PERIOD:
+            logging.getLogger(__name__).warning(
+                "%s: column %s (%s): its strongest motion has a period of %.4g s; expected "
+                "wave motion, periods of 2-%g s (is the time in milliseconds?)", file, column,
+                dof, period, MAX_WAVE_PERIOD)
 
 
 def _spectrum(check, value):
@@ -258,6 +291,23 @@ def validate_ins_timing(check, value, out):
     if "interpolation" in value:
         out["interpolation"] = check.choice(value["interpolation"], "ins.interpolation",
                                             INTERPOLATIONS)
+
+
+def check_record(settings, n_beams):
+    """Refuse a motion record shorter than one scan (``n_beams`` beams of
+    ``lidar.scan.beam_duration``): its Fourier series would repeat it within the scan."""
+    from uq.errors import DataFileError
+    series = (settings.get("motion") or {}).get("series")
+    if not series:
+        return
+    times, _ = read_series(series["file"], series["time"], tuple(series["columns"].items()))
+    length = (times[-1] - times[0]) * len(times) / (len(times) - 1)
+    duration = {**SCAN_DEFAULTS, **settings["lidar"].get("scan", {})}["beam_duration"]
+    if length < n_beams * duration * (1 - SERIES_SPACING_TOLERANCE):   # (its clock jitter)
+        raise DataFileError(series["file"], series["time"], f"the record lasts {length:g} s, "
+                            f"shorter than one scan ({n_beams} beams of {duration:g} s): it "
+                            "would repeat within the scan; allowed: a record at least as "
+                            "long as a scan, the time in seconds")
 
 
 def check_dwell(check, settings):

@@ -27,8 +27,9 @@ from uq.physics.beams import beam_unit_vectors
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS, validate_error
 from uq.errors import ScenarioError
 from uq.pipeline.fitconfig import validate_fit
-from uq.pipeline.motionsection import (check_dwell, random_phase_count, validate_ins_timing,
-                                       validate_lever_arm, validate_motion, validate_scan)
+from uq.pipeline.motionsection import (check_dwell, check_record, random_phase_count,
+                                       validate_ins_timing, validate_lever_arm, validate_motion,
+                                       validate_scan)
 from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
 from uq.physics.measurement import OUTPUTS
 from uq.engine.sampling import PROPAGATION_METHODS
@@ -345,6 +346,8 @@ def _check_time_resolved(check, settings):
         check.fail("outputs", f"{DERIVED_OUTPUTS[0]} needs a motion section; allowed: the "
                    "other outputs")
     check_dwell(check, settings)
+    lidar = settings["lidar"]
+    check_record(settings, len(lidar["azimuths"]) + int(lidar["vertical_beam"]))
 
 
 def _check_beams_determine_wind(check, lidar):
