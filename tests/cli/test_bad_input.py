@@ -461,6 +461,14 @@ def _(d):
     return check_and_run(scenario(d, with_good(motion=sea)), "motion.spectrum.band[1]")
 
 
+@case("spectrum band far below its peak")
+def _(d):
+    sea = {"spectrum": {"hs": 2.0, "tp": 8.0, "band": [1e-4, 2e-4]},
+           "response": {"heave": {"factor": 1.0}}}
+    return check_and_run(scenario(d, with_good(motion=sea)), "motion.spectrum.band",
+                         "none of the energy")
+
+
 @case("a sweep of random and fixed phases")
 def _(d):
     return check_and_run(scenario(d, with_good(motion=ROLL, sweep={

@@ -71,6 +71,22 @@ def jonswap_components(hs, tp, gamma, components, band, response):
     return tuple(out)
 
 
+def band_energy(tp, gamma, components, band):
+    """The sum ``S(f_j) df`` over the bins of :func:`jonswap_components` of a JONSWAP
+    spectrum of unit significant height [m2]: 0 (or not finite) where the band holds
+    none of its energy in double precision (a band far below the peak, where
+    ``exp(-1.25 (fp / f)^4)`` underflows), so that no significant height can be given
+    to its components."""
+    from wavespectra.construct.frequency import jonswap
+    low, high = band
+    width = (high - low) / components
+    frequencies = low + width * (np.arange(components) + 0.5)
+    with np.errstate(all="ignore"):
+        shape = np.asarray(jonswap(frequencies, fp=1.0 / tp, gamma=gamma, hs=1.0).values,
+                           dtype=float)
+        return float(np.sum(shape * width))
+
+
 def significant_height(components, dof):
     """4 sqrt(sum A^2 / 2) of one degree of freedom over the components: the significant
     height (wave: m) or significant double amplitude of its motion."""

@@ -45,7 +45,7 @@ from uq.errors import ScenarioError
 from uq.physics.series import WindowStart, series_components
 from uq.physics.timing import (TIMESTAMPS, DwellTooLong, ScanTiming, dwell_frequency,
                                dwell_rule)
-from uq.physics.waves import jonswap_components
+from uq.physics.waves import band_energy, jonswap_components
 from uq.constants import (MAX_DWELL_TOTAL_NODES, MAX_SERIES_BYTES, MAX_WAVE_COMPONENTS,
                           MIN_MOTION_PERIOD)
 
@@ -216,13 +216,20 @@ def _spectrum(check, value):
                              high=1.0 / MIN_MOTION_PERIOD)
     if len(band) != 2 or not band[0] < band[1]:
         check.fail(f"{key}.band", "allowed: [lowest, highest] frequency in Hz, lowest first")
-    return {"kind": check.choice(value.get("kind", "jonswap"), f"{key}.kind", SPECTRUM_KINDS),
-            "hs": check.number(value["hs"], f"{key}.hs", low=0.0),
-            "tp": tp,
-            "gamma": check.number(value.get("gamma", 3.3), f"{key}.gamma", low=1.0, high=10.0),
-            "components": check.integer(value.get("components", 32), f"{key}.components",
-                                        low=1, high=MAX_WAVE_COMPONENTS),
-            "band": band}
+    out = {"kind": check.choice(value.get("kind", "jonswap"), f"{key}.kind", SPECTRUM_KINDS),
+           "hs": check.number(value["hs"], f"{key}.hs", low=0.0),
+           "tp": tp,
+           "gamma": check.number(value.get("gamma", 3.3), f"{key}.gamma", low=1.0, high=10.0),
+           "components": check.integer(value.get("components", 32), f"{key}.components",
+                                       low=1, high=MAX_WAVE_COMPONENTS),
+           "band": band}
+    energy = band_energy(tp, out["gamma"], out["components"], tuple(band)) if out["hs"] else 1
+    if not 0 < energy < math.inf:
+        check.fail(f"{key}.band", f"[{band[0]:g}, {band[1]:g}] Hz holds none of the energy "
+                   f"of a spectrum peaked at {1 / tp:g} Hz (it underflows); allowed: a band "
+                   f"around the peak, e.g. the default [{SPECTRUM_BAND[0] / tp:g}, "
+                   f"{SPECTRUM_BAND[1] / tp:g}] Hz")
+    return out
 
 
 def _response(check, value):
