@@ -73,7 +73,7 @@ def jonswap_components(hs, tp, gamma, components, band, response):
 
 def band_energy(tp, gamma, components, band):
     """The sum ``S(f_j) df`` over the bins of :func:`jonswap_components` of a JONSWAP
-    spectrum of unit significant height [m2]: 0 (or not finite) where the band holds
+    spectrum of unit significant height [m2]: 0 or NaN where the band holds
     none of its energy in double precision (a band far below the peak, where
     ``exp(-1.25 (fp / f)^4)`` underflows), so that no significant height can be given
     to its components."""
