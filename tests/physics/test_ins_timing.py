@@ -1,5 +1,7 @@
 """The INS as a sampled series (interpolation errors against their closed forms), the
 Gauss-Markov correlation, and the dwell quadrature (its stated bound)."""
+import time
+
 import numpy as np
 import pytest
 
@@ -129,6 +131,11 @@ def test_a_dwell_beyond_the_node_bound_is_refused_before_allocating():
         ScanTiming(beam_duration=1e9, dwell_average=True).nodes(5, fastest=2 * np.pi)
     with pytest.raises(ValueError):
         dwell_rule(np.inf)
+    started = time.process_time()
+    for span in (1e300, 1e16, 1134.5):          # spans where panels + 1 == panels in floats
+        with pytest.raises(DwellTooLong):
+            dwell_rule(span)
+    assert time.process_time() - started < 1.0  # CPU s: a few arithmetic steps, no loop
     # (kB) nothing of the size of the rule's ~3e9 nodes was allocated: 10 MB of slack
     assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 10_000
 

@@ -101,7 +101,7 @@ class DwellTooLong(ValueError):
 
     def __init__(self, nodes, longest_span):
         self.nodes, self.longest_span = nodes, longest_span
-        super().__init__(f"the dwell average needs {nodes} nodes per dwell; at most "
+        super().__init__(f"the dwell average needs {nodes:.3g} nodes per dwell; at most "
                          f"{MAX_DWELL_TOTAL_NODES} (a phase span of {longest_span:.4g} rad)")
 
 
@@ -146,10 +146,15 @@ def _log_bound(phase_span, q):
             - 3 * math.lgamma(2 * q + 1))
 
 
-#: The largest phase span [rad] one panel of MAX_DWELL_NODES nodes averages to the
-#: tolerance (the bound of :func:`dwell_node_count` solved for the span).
-PANEL_SPAN = math.exp((math.log(DWELL_QUADRATURE_TOLERANCE) - _log_bound(1.0, MAX_DWELL_NODES))
-                      / (2 * MAX_DWELL_NODES))
+def panel_span(tolerance=DWELL_QUADRATURE_TOLERANCE):
+    """The largest phase span [rad] one panel of MAX_DWELL_NODES nodes averages to
+    `tolerance` (the bound of :func:`dwell_node_count` solved for the span)."""
+    return math.exp((math.log(tolerance) - _log_bound(1.0, MAX_DWELL_NODES))
+                    / (2 * MAX_DWELL_NODES))
+
+
+#: :func:`panel_span` at the model's tolerance: ~71 rad (11 periods).
+PANEL_SPAN = panel_span()
 
 
 def dwell_rule(phase_span, tolerance=DWELL_QUADRATURE_TOLERANCE):
@@ -172,16 +177,15 @@ def dwell_rule(phase_span, tolerance=DWELL_QUADRATURE_TOLERANCE):
     """
     if not phase_span >= 0 or not math.isfinite(phase_span):
         raise ValueError(f"phase span {phase_span!r} [rad]; allowed: a finite number >= 0")
-    span = PANEL_SPAN if tolerance == DWELL_QUADRATURE_TOLERANCE else \
-        math.exp((math.log(tolerance) - _log_bound(1.0, MAX_DWELL_NODES)) / (2 * MAX_DWELL_NODES))
-    longest = span * MAX_DWELL_TOTAL_NODES // MAX_DWELL_NODES
+    span = PANEL_SPAN if tolerance == DWELL_QUADRATURE_TOLERANCE else panel_span(tolerance)
     if phase_span <= span:
         return 1, dwell_node_count(phase_span, tolerance)
+    most = MAX_DWELL_TOTAL_NODES // MAX_DWELL_NODES
     panels = math.ceil(phase_span / span)
-    if panels * MAX_DWELL_NODES > MAX_DWELL_TOTAL_NODES:
-        raise DwellTooLong(panels * MAX_DWELL_NODES, longest)
-    while _log_bound(phase_span / panels, MAX_DWELL_NODES) > math.log(tolerance):
+    if panels <= most and _log_bound(phase_span / panels, MAX_DWELL_NODES) > math.log(tolerance):
         panels += 1                                     # (rounding at the edge of a panel)
+    if panels > most:
+        raise DwellTooLong(panels * MAX_DWELL_NODES, span * most)
     return panels, dwell_node_count(phase_span / panels, tolerance)
 
 
