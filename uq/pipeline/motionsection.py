@@ -264,12 +264,12 @@ def _harmonic(check, value, key, angular):
 
 def _period(check, value, key):
     """A motion period [s]: at least :data:`~uq.constants.MIN_MOTION_PERIOD`."""
-    period = check.number(value, key, low=0.0, low_open=True)
-    if period < MIN_MOTION_PERIOD:
-        check.fail(key, f"{period:g} s is shorter than any platform motion; allowed: at "
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and \
+            0 < value < MIN_MOTION_PERIOD:
+        check.fail(key, f"{value:g} s is shorter than any platform motion; allowed: at "
                    f"least {MIN_MOTION_PERIOD:g} s (faster is vibration, which no INS "
                    "resolves)")
-    return period
+    return check.number(value, key, low=MIN_MOTION_PERIOD)
 
 
 def validate_lever_arm(check, value):
