@@ -98,21 +98,40 @@ def test_a_checkpoint_has_one_owner(tmp_path):
 
 def test_a_second_command_on_the_same_output_is_refused(tmp_path):
     """Two `uq run` on one output: the second is refused at once (exit 2), the first
-    finishes with the uninterrupted result."""
+    finishes. The first holds its first chunk until the second has answered (a file
+    'go'), so the two overlap however busy the machine is."""
     path = tmp_path / "s.yaml"
-    # long enough (~2 s of sampling) that the second starts (~1 s) while the first runs
-    path.write_text(yaml.safe_dump({**SWEEP, "sampling": {"n": 1_500_000, "seed": 7}}))
-    first = subprocess.Popen([sys.executable, "-m", "uq.cli", "run", str(path), "--quiet",
-                              "-o", "out.nc"], cwd=tmp_path, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 60
-    while not (tmp_path / "out.nc.partial" / "manifest.json").exists():
-        assert time.monotonic() < deadline and first.poll() is None
-        time.sleep(0.05)
-    second = subprocess.run([sys.executable, "-m", "uq.cli", "run", str(path), "--quiet",
-                             "-o", "out.nc"], cwd=tmp_path, capture_output=True, text=True)
+    path.write_text(yaml.safe_dump({**SWEEP, "sampling": {"n": 3000, "seed": 7}}))
+    first = subprocess.Popen([sys.executable, "-c", HELD, str(path)], cwd=tmp_path,
+                             stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 300           # (a safeguard: a hung child fails)
+        while not (tmp_path / "out.nc.partial" / "manifest.json").exists():
+            assert time.monotonic() < deadline and first.poll() is None
+            time.sleep(0.05)
+        second = subprocess.run([sys.executable, "-m", "uq.cli", "run", str(path), "--quiet",
+                                 "-o", "out.nc"], cwd=tmp_path, capture_output=True, text=True)
+        assert first.poll() is None                 # still holding its first chunk
+    finally:
+        (tmp_path / "go").write_text("")
     assert first.wait(timeout=300) == 0, first.stderr.read()
     assert second.returncode == 2 and "in use by another run" in second.stderr
     assert len(second.stderr.strip().splitlines()) == 1
+
+
+#: `uq run -o out.nc` whose first chunk waits for a file 'go' before it is kept.
+HELD = """
+import pathlib, sys, time
+import uq.pipeline.checkpoint as checkpoint
+save = checkpoint.Checkpoint.save
+def held(self, index, dataset):
+    while not pathlib.Path("go").exists():
+        time.sleep(0.02)
+    return save(self, index, dataset)
+checkpoint.Checkpoint.save = held
+from uq.cli import main
+sys.exit(main(["run", sys.argv[1], "--quiet", "-o", "out.nc"]))
+"""
 
 
 def test_kill_9_then_resume_is_bit_identical(tmp_path):
