@@ -30,6 +30,13 @@ DEFAULT_BLOCKS_PER_CHUNK = 1
 #: Largest number of Monte Carlo trials adaptive sampling (``digits``) may use [1].
 ADAPTIVE_MAX_SAMPLES = 2**24
 
+#: Most negative eigenvalue, per row, of a correlation matrix taken as positive
+#: semidefinite [1] (:func:`uq.engine.inputs.semidefinite_root`): a correlation matrix
+#: computed in double precision carries errors of ~1e-16 per element, which move its
+#: eigenvalues by at most n x that (Weyl); 1e-12 leaves a margin of 1e4, while
+#: inconsistent correlations give negative eigenvalues of the order of the coefficients.
+SEMIDEFINITE_TOLERANCE = 1e-12
+
 #: Complex-step size, relative to max(1, |x|) [1]. Complex-step differentiation has no
 #: subtractive cancellation, so any step far below sqrt(machine epsilon) times the
 #: curvature scale gives the derivative to machine precision (Squire & Trapp 1998);
@@ -215,10 +222,18 @@ MAX_CHUNK_SIZE = 2**22
 #: ~2e-9 m/s of radial velocity at 10 m/s: far below any other error of the model.
 DWELL_QUADRATURE_TOLERANCE = 1e-9
 
-#: Most Gauss-Legendre nodes per dwell [1]: 32 nodes average a sinusoid over a dwell of up
-#: to ~10 of its radians to 1e-9 (a 1 s dwell of a 0.6 s motion period); a conical scan's
-#: dwell of 20 ms needs 2-4.
+#: Most Gauss-Legendre nodes per panel of a dwell [1]: 32 nodes average a sinusoid over
+#: up to ~71 of its radians (11 periods) to 1e-9 (:data:`uq.physics.timing.PANEL_SPAN`);
+#: a conical scan's dwell of 20 ms needs 2-4. A longer dwell is cut into panels.
 MAX_DWELL_NODES = 32
+
+#: Most Gauss-Legendre nodes per dwell, over all its panels [1]
+#: (:func:`uq.physics.timing.dwell_rule`): 16 panels of 32 nodes average a dwell of up to
+#: ~1130 radians (180 periods) of the integrand's highest frequency to 1e-9. It bounds
+#: memory: the numpy model holds (trials, beams, nodes, 3, 3) attitudes, 190 MB for a
+#: slice of 2^10 trials of a 5-beam scan at 512 nodes. A lidar's dwell (0.02-2 s) of a
+#: platform's motion (periods of 1 s and more) needs at most a few dozen.
+MAX_DWELL_TOTAL_NODES = 512
 
 #: Size [the output's unit: m s-1 or deg] under which a figure or a report takes a
 #: deterministic number (an uncertainty, the correction's systematic error) for zero: far
@@ -226,6 +241,14 @@ MAX_DWELL_NODES = 32
 #: of ~1e-15, ~1e-13 after a few dozen operations; a vanishing u comes out at ~1e-29) and
 #: far below anything a lidar resolves (~1e-2 m s-1) or a report prints (4 digits of u).
 NUMERICAL_ZERO = 1e-9
+
+#: Shortest period of a platform motion [s] (harmonics, a spectrum's peak period; a
+#: spectrum's band reaches at most 1 / this in Hz): an INS reports attitude and velocity at
+#: up to 100-200 Hz, so a faster "motion" is vibration that no INS resolves and no
+#: motion correction uses; and the phase w t of a faster one over a scan of minutes keeps
+#: too few digits to mean anything (a period of 1e-300 s gave non-finite statistics with no
+#: invalid trial counted).
+MIN_MOTION_PERIOD = 0.01
 
 #: Most components of a wave spectrum [1]: each is a Monte Carlo input (a random phase)
 #: and a column of the GUM Jacobian; 256 resolve a JONSWAP peak (gamma 3.3, relative width

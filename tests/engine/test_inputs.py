@@ -64,3 +64,21 @@ def test_an_input_with_a_correlation_between_its_elements():
     np.testing.assert_allclose(np.corrcoef(values.T), rho, atol=0.007)
     with pytest.raises(ValueError, match="unit diagonal"):
         input_set({"e": Input(st.norm(), (2,), correlation=np.array([[1, 2], [2, 1.0]]) * 0.5)})
+
+
+def test_a_singular_correlation_is_its_fully_correlated_limit():
+    """A Gauss-Markov correlation whose time constant dwarfs the beam spacing rounds to
+    all ones (singular: Cholesky refuses it); the square root of the semidefinite matrix
+    draws every element with the same score (L L^T = the matrix to rounding, 1e-15);
+    an indefinite matrix (inconsistent correlations) is still refused."""
+    from uq.engine.inputs import semidefinite_root
+    from uq.physics.ins import gauss_markov_correlation
+    ones = gauss_markov_correlation(np.arange(4.0), 1e20)
+    assert np.array_equal(ones, np.ones((4, 4)))
+    root = semidefinite_root(ones)
+    np.testing.assert_allclose(root @ root.T, ones, atol=1e-15)
+    laid = input_set({"x": Input(st.norm(0, 1), (4,), correlation=ones)})
+    draws = laid.values(np.random.default_rng(1).standard_normal((1000, 4)))["x"]
+    np.testing.assert_allclose(draws, draws[:, :1] * np.ones((1, 4)), atol=1e-12)
+    with pytest.raises(ValueError, match="not positive semidefinite"):
+        semidefinite_root(np.array([[1.0, 0.9, -0.9], [0.9, 1.0, 0.9], [-0.9, 0.9, 1.0]]))

@@ -94,6 +94,8 @@ CASES = {
                                     "ins.sog.correlation_time": 2.0},
     "pointwise, beam INS": {"ins.correlation": "beam"},
     "pointwise, dwell average": {"lidar.scan.dwell_average": True},
+    "pointwise, dwell average over panels": {"lidar.scan.dwell_average": True,
+                                             "lidar.scan.beam_duration": 20.0},
     "pointwise, end stamps": {"lidar.scan.timestamp": "end"},
     "full (one reading per scan)": {"correction": "full"},
     "yaw": {"correction": "yaw"},

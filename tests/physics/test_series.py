@@ -86,3 +86,46 @@ def test_bad_records(tmp_path, content, key):
     with pytest.raises(DataFileError, match=key):
         uq.load_scenario({"motion": {"series": {"file": str(tmp_path / "rec.csv"),
                                                 "time": "t", "columns": {"roll": "r"}}}})
+
+
+def write_csv(path, times, values):
+    path.write_text("t,r\n" + "".join(f"{t:.12g},{v:.12g}\n" for t, v in zip(times, values)))
+
+
+def test_a_record_in_milliseconds_is_refused(tmp_path):
+    """10 Hz samples with the time in ms (100 apart): refused, naming the time column and
+    asking for seconds."""
+    write_csv(tmp_path / "rec.csv", TIMES * 1000, 4 * np.sin(2 * np.pi * TIMES / 5))
+    with pytest.raises(DataFileError, match=r"rec.csv: t: samples 100 apart.*seconds"):
+        uq.load_scenario({"motion": {"series": {"file": str(tmp_path / "rec.csv"),
+                                                "time": "t", "columns": {"roll": "r"}}}})
+
+
+def test_a_record_of_slow_roll_is_warned_about(tmp_path, caplog):
+    """1 kHz samples with the time in ms (1 apart, as if 1 Hz in s): a 5 s roll looks like
+    a 5000 s one, far slower than waves: a warning names the column and what was
+    expected; a record of a 5 s roll in seconds passes without one."""
+    import logging
+    times = np.arange(4000.0)
+    write_csv(tmp_path / "ms.csv", times, 4 * np.sin(2 * np.pi * times / 5000))
+    write_csv(tmp_path / "s.csv", TIMES, 4 * np.sin(2 * np.pi * TIMES / 5))
+    with caplog.at_level(logging.WARNING, logger="uq.pipeline.motionsection"):
+        for name in ("ms.csv", "s.csv"):
+            uq.load_scenario({"motion": {"series": {"file": str(tmp_path / name),
+                                                    "time": "t", "columns": {"roll": "r"}}}})
+    assert len(caplog.records) == 1
+    assert "ms.csv: column r (roll)" in caplog.text and "milliseconds" in caplog.text
+
+
+def test_a_record_shorter_than_a_scan_is_refused(tmp_path):
+    """20 s of record under a scan of 4 beams of 10 s (40 s): it would repeat within the
+    scan; refused naming the time column. 40 s of record is accepted."""
+    times = np.arange(200) * 0.1
+    write_csv(tmp_path / "rec.csv", times, 4 * np.sin(2 * np.pi * times / 5))
+    spec = {"motion": {"series": {"file": str(tmp_path / "rec.csv"), "time": "t",
+                                  "columns": {"roll": "r"}}},
+            "lidar": {"scan": {"beam_duration": 10.0}}}
+    with pytest.raises(DataFileError, match=r"rec.csv: t: the record lasts 20 s, shorter "
+                                            r"than one scan \(4 beams of 10 s\)"):
+        uq.load_scenario(spec)
+    uq.load_scenario({**spec, "lidar": {"scan": {"beam_duration": 5.0}}})

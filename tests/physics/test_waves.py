@@ -63,3 +63,14 @@ def test_a_sea_in_a_scenario():
 def test_bad_motion_sections(motion, key):
     with pytest.raises(ScenarioError, match=key.replace(".", r"\.")):
         uq.load_scenario({"motion": motion})
+
+
+def test_band_energy_is_zero_only_where_the_spectrum_underflows():
+    """The default band [0.5, 4] / tp holds nearly all of the energy of a unit-height sea
+    (m0 = (Hs / 4)^2 = 1/16 m2, to 1 %: the f^-5 tail beyond 4 fp holds < 1e-3 of it, and
+    the 256 midpoint bins of the peak (gamma 3.3) miss ~0.3 %); a band at 1/1000 of the
+    peak frequency holds none (exp(-1.25 (fp/f)^4) underflows), which validation
+    refuses."""
+    from uq.physics.waves import band_energy
+    assert band_energy(8.0, 3.3, 256, (0.5 / 8, 4 / 8)) == pytest.approx(1 / 16, rel=1e-2)
+    assert not band_energy(8.0, 3.3, 32, (1e-4, 2e-4)) > 0        # 0 or NaN (0 / 0)

@@ -98,21 +98,40 @@ def test_a_checkpoint_has_one_owner(tmp_path):
 
 def test_a_second_command_on_the_same_output_is_refused(tmp_path):
     """Two `uq run` on one output: the second is refused at once (exit 2), the first
-    finishes with the uninterrupted result."""
+    finishes. The first holds its first chunk until the second has answered (a file
+    'go'), so the two overlap however busy the machine is."""
     path = tmp_path / "s.yaml"
-    # long enough (~2 s of sampling) that the second starts (~1 s) while the first runs
-    path.write_text(yaml.safe_dump({**SWEEP, "sampling": {"n": 1_500_000, "seed": 7}}))
-    first = subprocess.Popen([sys.executable, "-m", "uq.cli", "run", str(path), "--quiet",
-                              "-o", "out.nc"], cwd=tmp_path, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 60
-    while not (tmp_path / "out.nc.partial" / "manifest.json").exists():
-        assert time.monotonic() < deadline and first.poll() is None
-        time.sleep(0.05)
-    second = subprocess.run([sys.executable, "-m", "uq.cli", "run", str(path), "--quiet",
-                             "-o", "out.nc"], cwd=tmp_path, capture_output=True, text=True)
+    path.write_text(yaml.safe_dump({**SWEEP, "sampling": {"n": 3000, "seed": 7}}))
+    first = subprocess.Popen([sys.executable, "-c", HELD, str(path)], cwd=tmp_path,
+                             stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 300           # (a safeguard: a hung child fails)
+        while not (tmp_path / "out.nc.partial" / "manifest.json").exists():
+            assert time.monotonic() < deadline and first.poll() is None
+            time.sleep(0.05)
+        second = subprocess.run([sys.executable, "-m", "uq.cli", "run", str(path), "--quiet",
+                                 "-o", "out.nc"], cwd=tmp_path, capture_output=True, text=True)
+        assert first.poll() is None                 # still holding its first chunk
+    finally:
+        (tmp_path / "go").write_text("")
     assert first.wait(timeout=300) == 0, first.stderr.read()
     assert second.returncode == 2 and "in use by another run" in second.stderr
     assert len(second.stderr.strip().splitlines()) == 1
+
+
+#: `uq run -o out.nc` whose first chunk waits for a file 'go' before it is kept.
+HELD = """
+import pathlib, sys, time
+import uq.pipeline.checkpoint as checkpoint
+save = checkpoint.Checkpoint.save
+def held(self, index, dataset):
+    while not pathlib.Path("go").exists():
+        time.sleep(0.02)
+    return save(self, index, dataset)
+checkpoint.Checkpoint.save = held
+from uq.cli import main
+sys.exit(main(["run", sys.argv[1], "--quiet", "-o", "out.nc"]))
+"""
 
 
 def test_kill_9_then_resume_is_bit_identical(tmp_path):
@@ -252,3 +271,88 @@ def test_a_fresh_run_after_an_interrupted_one_starts_afresh(tmp_path, one_scene_
                 checkpoint=Checkpoint(directory))
     assert seen == list(range(1, 9))                # every chunk computed again
     same(again, run(one_scene_per_chunk))
+
+
+def write_record(path, scale=1.0):
+    """A motion record (CSV) of roll, pitch and heave; `scale` multiplies pitch and heave
+    (the edit of the issue: doubled)."""
+    import numpy as np
+    t = np.arange(600) * 0.1
+    lines = ["time,roll,pitch,heave"] + [
+        f"{a:.1f},{3 * np.sin(0.9 * a):.6f},{scale * 2 * np.sin(1.3 * a + 1):.6f},"
+        f"{scale * 0.8 * np.sin(0.7 * a):.6f}" for a in t]
+    path.write_text("\n".join(lines) + "\n")
+
+
+#: A motion record's scenario of 6 scenes, one per chunk under KILLABLE.
+RECORDED = {"name": "recorded", "wind": {"speed": 8.0},
+            "ins": {"heading": {"dist": "normal", "u": 0.3}},
+            "motion": {"series": {"file": "record.csv", "time": "time",
+                                  "columns": {"roll": "roll", "pitch": "pitch",
+                                              "heave": "heave"}, "components": 16}},
+            "sampling": {"n": 40_000, "seed": 3}, "outputs": ["wind_speed"],
+            "sweep": {"wind.direction": [0.0, 60.0, 120.0, 180.0, 240.0, 300.0]}}
+
+
+def killed_after_two_chunks(folder, path):
+    """`uq run` on `path`, killed (SIGKILL) once two chunks are on disk."""
+    child = subprocess.Popen([sys.executable, "-c", KILLABLE, str(path)], cwd=folder)
+    partial = folder / "out.nc.partial"
+    deadline = time.monotonic() + 300               # a first run may compile the kernels
+    while len(list(partial.glob("chunk-*.nc.sha256"))) < 2:
+        assert time.monotonic() < deadline and child.poll() is None
+        time.sleep(0.02)
+    child.send_signal(signal.SIGKILL)
+    child.wait()
+    return partial
+
+
+def test_resume_after_editing_the_motion_record_is_refused(tmp_path):
+    """kill -9, then the motion record is edited (pitch and heave doubled): --resume is
+    refused with one line naming the record and its key (it would mix chunks of the old
+    record into the result), and the checkpoint is kept; with the record restored, the
+    resume completes, bit for bit the uninterrupted run."""
+    write_record(tmp_path / "record.csv")
+    original = (tmp_path / "record.csv").read_bytes()
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump(RECORDED))
+    partial = killed_after_two_chunks(tmp_path, path)
+    kept = sorted(p.name for p in partial.iterdir())
+    write_record(tmp_path / "record.csv", scale=2.0)
+    refused = subprocess.run([sys.executable, "-c", KILLABLE, str(path), "--resume"],
+                             cwd=tmp_path, capture_output=True, text=True)
+    lines = refused.stderr.strip().splitlines()
+    assert refused.returncode == 2 and len(lines) == 1, refused.stderr
+    assert "record.csv" in lines[0] and "motion.series.file" in lines[0]
+    assert not (tmp_path / "out.nc").exists()
+    assert sorted(p.name for p in partial.iterdir()) == kept
+    (tmp_path / "record.csv").write_bytes(original)
+    resumed = subprocess.run([sys.executable, "-c", KILLABLE, str(path), "--resume"],
+                             cwd=tmp_path, capture_output=True, text=True)
+    assert resumed.returncode == 0, resumed.stderr
+    clean = subprocess.run([sys.executable, "-c", KILLABLE, str(path), "-o", "clean.nc"],
+                           cwd=tmp_path, capture_output=True, text=True)
+    assert clean.returncode == 0, clean.stderr
+    with xr.open_dataset(tmp_path / "out.nc") as a, xr.open_dataset(tmp_path / "clean.nc") as b:
+        same(a.load(), b.load())
+
+
+def test_a_record_edited_during_the_run_is_not_mixed_in(tmp_path, monkeypatch):
+    """The record is edited while the run goes (after the second of six chunks): the run
+    stops with the error naming the record, before a chunk of the new record is kept."""
+    import uq.pipeline.sweep as sweep
+    from uq.errors import DataFileError
+    monkeypatch.setattr(sweep, "SWEEP_CHUNK_ELEMENTS", 1)
+    monkeypatch.setattr(sweep, "SWEEP_CHUNK_ELEMENTS_COMPILED", 1)
+    write_record(tmp_path / "record.csv")
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump({**RECORDED, "sampling": {"n": 2000, "seed": 3}}))
+    scenario = load_scenario(path)
+
+    def edit(done, total):
+        if done == 2:
+            write_record(tmp_path / "record.csv", scale=2.0)
+    directory = tmp_path / "out.nc.partial"
+    with pytest.raises(DataFileError, match="record.csv.*motion.series.file.*changed while"):
+        run(scenario, progress=edit, checkpoint=Checkpoint(directory))
+    assert len(list(directory.glob("chunk-*.nc"))) == 2

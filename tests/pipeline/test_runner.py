@@ -355,3 +355,77 @@ def test_compiled_run_equals_the_numpy_model(changes, monkeypatch):
         if name.startswith("wind_direction_mc_") and name[18:] in ("mean", "low", "high"):
             a = np.mod(a - b + 180.0, 360.0) - 180.0 + b       # on the circle
         np.testing.assert_allclose(a, b, rtol=1e-13, atol=atol, err_msg=name)
+
+
+def test_motion_ti_gum_is_nan_where_the_gum_is():
+    """Where the motion inputs' share of the GUM budget is NaN, wind_speed_motion_ti_gum
+    is NaN (it was 0: the sum over the inputs skipped NaN)."""
+    from uq.engine.inputs import Input, UniformCircle
+    from uq.pipeline.runner import _motion_ti
+    dataset = xr.Dataset({
+        "wind_speed_true": (("scene", "range"), [[8.0], [8.0]]),
+        "wind_speed_budget": (("scene", "range", "input"), [[[0.01, np.nan]], [[0.01, 0.04]]])},
+        coords={"input": ["ins.heading", "motion (phases)"]})
+    inputs = {"ins_heading": 0.0, "motion_phases": Input(UniformCircle(1.0), (1, 2))}
+    out = _motion_ti(None, {"sampling": {"method": "none"}}, inputs, None, dataset)
+    gum = out["wind_speed_motion_ti_gum"][1]
+    assert np.isnan(gum[0, 0]) and gum[1, 0] == pytest.approx(0.2 / 8.0, rel=1e-15)
+
+
+def test_a_calm_sea_is_the_static_answer():
+    """motion.spectrum.hs: 0 (allowed) is no motion: every trial valid, and the statistics
+    of the static scenario. GUM: the same linearisation (motion sensitivities 0): equal
+    to 1e-9 relative. Monte Carlo (2e4 trials, the draws of the INS errors may differ):
+    u within 5 relative standard errors 1/sqrt(2 N) = 0.5 %."""
+    base = {"wind": {"speed": 8.0, "direction": 30.0}, "correction": "full",
+            "ins": {"heading": {"dist": "normal", "u": 0.5}, "pitch": {"dist": "normal", "u": 0.5}},
+            "sampling": {"n": 20_000, "seed": 2}}
+    calm = uq.run({**base, "motion": {"spectrum": {"hs": 0.0, "tp": 8.0},
+                                      "response": {"roll": {"factor": 2.0},
+                                                   "heave": {"factor": 1.0}}}})
+    static = uq.run(base)
+    for q in ("wind_speed", "wind_direction", "vertical_wind"):
+        assert int(calm[f"{q}_mc_n_invalid"]) == 0
+        assert float(calm[f"{q}_gum_u"]) == pytest.approx(float(static[f"{q}_gum_u"]), rel=1e-9)
+        assert float(calm[f"{q}_mc_u"]) == pytest.approx(float(static[f"{q}_mc_u"]),
+                                                         rel=5 / np.sqrt(2 * 20_000))
+    # no motion: its TI is 0 to the rounding of the trials' speeds (~1e-15 relative)
+    assert abs(float(calm["wind_speed_motion_ti"])) < 1e-12
+    assert float(calm["wind_speed_motion_ti_gum"]) == 0
+
+
+@pytest.mark.parametrize("changes", [{"ins.heading.correlation_time": 1e20},
+                                     {"ins.heading.correlation_time": 1.0,
+                                      "lidar.scan.beam_duration": 1e-300}])
+def test_gauss_markov_errors_in_their_fully_correlated_limit(changes):
+    """tau = 1e20 s, or beams 1e-300 s apart: the correlation is all ones to rounding
+    (it was 'not positive definite'); the run is the limit, one error per scan (tau =
+    inf). GUM: the same linearisation and correlation (to rounding): 1e-12 relative.
+    Monte Carlo, 2e4 trials with other draws: u within 5 relative standard errors,
+    1/sqrt(2 N) = 0.5 % each, of the two estimates (5 sqrt(2) x 0.5 %)."""
+    base = {"wind": {"speed": 8.0, "direction": 30.0}, "sampling": {"n": 20_000, "seed": 3},
+            "ins": {"heading": {"dist": "normal", "u": 0.5, "correlation_time": 1.0},
+                    "pitch": {"dist": "normal", "u": 0.5}},
+            "lidar": {"scan": {"beam_duration": 1.0}}}
+    limit = uq.run(uq.load_scenario(base, {"ins.heading.correlation_time": np.inf}))
+    near = uq.run(uq.load_scenario(base, changes))
+    for q in ("wind_speed", "wind_direction", "vertical_wind"):
+        assert float(near[f"{q}_gum_u"]) == pytest.approx(float(limit[f"{q}_gum_u"]), rel=1e-12)
+        assert float(near[f"{q}_mc_u"]) == pytest.approx(
+            float(limit[f"{q}_mc_u"]), rel=5 * np.sqrt(2) / np.sqrt(2 * 20_000))
+
+
+@pytest.mark.parametrize("correction", ["pointwise", "full"])
+def test_every_results_file_has_gum_valid(correction):
+    """sampling.method none (the GUM alone): q_gum_valid is in the file (the contract's
+    variables), False: without Monte Carlo the GUM is not validated; and the summary
+    says 'nan' for the verdict, as before (no Monte Carlo)."""
+    from uq.outputs.summary import summary_table
+    ds = uq.run({"ins": {"heading": {"dist": "normal", "u": 0.1}}, "correction": correction,
+                 "motion": {"roll": {"amplitude": 3.0, "period": 6.0}},
+                 "sampling": {"method": "none"}})
+    for q in ("wind_speed", "wind_direction", "vertical_wind"):
+        assert ds[f"{q}_gum_valid"].dtype == bool and not ds[f"{q}_gum_valid"].any()
+        assert not ds[f"{q}_gum_validation_conclusive"].any()
+        assert ds[f"{q}_gum_valid"].attrs["flag_meanings"] == "not_validated validated"
+    assert "0/1" not in summary_table(ds)

@@ -20,6 +20,8 @@ import functools
 import numpy as np
 from scipy.special import ndtr
 
+from uq.constants import SEMIDEFINITE_TOLERANCE
+
 
 @dataclass(frozen=True)
 class Input:
@@ -227,7 +229,22 @@ def _cholesky(correlation, names, shapes, offsets, dimension, blocks=None):
     try:
         return np.linalg.cholesky(matrix)
     except np.linalg.LinAlgError:
-        raise ValueError("correlation matrix is not positive definite") from None
+        return semidefinite_root(matrix)
+
+
+def semidefinite_root(matrix):
+    """A square root L (``L L^T = matrix``) of a correlation matrix that Cholesky refuses
+    but that is positive semidefinite: singular (a Gauss-Markov process in its fully
+    correlated limit, correlation time -> inf or beams at one instant: every element the
+    same score) or positive definite only to rounding. From the eigen-decomposition,
+    with the eigenvalues that rounding pushed below 0 set to 0 (backward stable: L L^T
+    equals the matrix to rounding). ValueError if an eigenvalue is negative beyond
+    :data:`~uq.constants.SEMIDEFINITE_TOLERANCE` per row (inconsistent correlations)."""
+    values, vectors = np.linalg.eigh(matrix)
+    if values[0] < -SEMIDEFINITE_TOLERANCE * len(matrix):
+        raise ValueError(f"correlation matrix is not positive semidefinite (eigenvalue "
+                         f"{values[0]:.3g})")
+    return vectors * np.sqrt(np.clip(values, 0.0, None))
 
 
 def _is_normal(distribution):

@@ -160,6 +160,8 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     if runner.stats is not None:
         dataset = dataset.assign(_mc_variables(runner, dataset, circular, validation_digits))
         dataset = dataset.assign(_mc_covariances(runner, dataset))
+    else:
+        dataset = dataset.assign(_not_validated(dataset))
     dataset.attrs.update(n_samples=runner.n_done, seed=seed, sampling_method=method,
                          digits=validation_digits, interval=interval,
                          coverage_probability=COVERAGE_PROBABILITY, gum=gum_note,
@@ -476,6 +478,20 @@ def _mc_variables(runner, gum_results, circular, digits):
         })
         if q in circular:
             data[f"{q}_mc_circular_std"] = (dims, result["circular_std"])
+    return data
+
+
+def _not_validated(gum_results):
+    """Without Monte Carlo (method ``none``) the GUM is not validated: ``q_gum_valid``
+    and ``q_gum_validation_conclusive`` are False (present, as every results file has
+    them; there is no ``q_mc_u`` to validate against)."""
+    data = {}
+    for name in gum_results.data_vars:
+        if name.endswith("_gum_u"):
+            q, dims = name[:-len("_gum_u")], gum_results[name].dims
+            shape = gum_results[name].shape
+            data[f"{q}_gum_valid"] = (dims, np.zeros(shape, dtype=bool))
+            data[f"{q}_gum_validation_conclusive"] = (dims, np.zeros(shape, dtype=bool))
     return data
 
 

@@ -313,7 +313,7 @@ def gum_validity_answer(dataset, quantity="wind_speed"):
     """Share (and number) of the values (scenes x range gates) whose GUM interval Monte
     Carlo validates (JCGM 101 clause 8), and of those where that verdict is conclusive;
     None without Monte Carlo."""
-    if f"{quantity}_gum_valid" not in dataset:
+    if f"{quantity}_gum_valid" not in dataset or f"{quantity}_mc_u" not in dataset:
         return None
     valid = dataset[f"{quantity}_gum_valid"].values
     conclusive = dataset[f"{quantity}_gum_validation_conclusive"].values

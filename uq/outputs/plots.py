@@ -283,7 +283,7 @@ def _near(values, centre):
 def _validation_text(at, quantity, d_low, d_high):
     """The clause 8 verdict and its numbers, for a panel's title."""
     name = f"{quantity}_gum_valid"
-    if name not in at:
+    if name not in at or f"{quantity}_mc_u" not in at:       # no Monte Carlo to validate
         return QUANTITIES[quantity][0]
     verdict = "GUM validated" if bool(at[name]) else "GUM not validated"
     delta = at.get(f"{quantity}_mc_numerical_tolerance")

@@ -63,7 +63,7 @@ def _table(rows, columns):
 
 
 def _verdict(dataset, q, select):
-    if f"{q}_gum_valid" not in dataset:
+    if f"{q}_gum_valid" not in dataset or f"{q}_mc_u" not in dataset:   # no Monte Carlo
         return "nan"
     valid = dataset[f"{q}_gum_valid"].sel(select).values
     conclusive = dataset[f"{q}_gum_validation_conclusive"].sel(select).values

@@ -43,7 +43,6 @@ import weakref
 
 import numpy as np
 
-from uq import complexstep
 from uq.physics import fusedkernels as kernels
 from uq.physics import wind as wind_formulas
 from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
@@ -51,7 +50,6 @@ from uq.constants import FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS
 from uq.physics import modelinputs
 from uq.physics.modelinputs import STATIC_COMPILED, Correction
 from uq.physics.scene import OUTPUTS
-from uq.physics.rotation import attitude_matrix
 
 #: Outputs the fused loop computes: all of them.
 FUSED_OUTPUTS = OUTPUTS

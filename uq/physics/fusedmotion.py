@@ -41,6 +41,7 @@ from uq.physics.modelinputs import MOTION_COMPILED, Correction
 from uq.physics.motion import DEGREES_OF_FREEDOM
 from uq.physics.rotation import rotation_about_vertical, rotation_pitch, rotation_roll
 from uq.physics.scene import SCENE_FIELDS, sample_count
+from uq.physics.timing import dwell_frequency
 
 #: Outputs the compiled model computes; any other requested output uses the numpy model.
 FUSED_OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind")
@@ -185,7 +186,7 @@ def _scene_plan(scene):
     resolved = scene.time_resolved
     motion, timing, ins = resolved.motion, resolved.timing, resolved.ins
     n_beams, components = scene.n_beams, motion.components
-    fastest = max((c.angular_frequency for c in components), default=0.0)
+    fastest = dwell_frequency(components)
     times, weights = timing.nodes(n_beams, fastest)                      # (b, q), (q,)
     pointwise = scene.correction == "pointwise"
     stamps = timing.stamps(n_beams) if pointwise else \

@@ -56,6 +56,7 @@ from uq.physics.rotation import (attitude_from_matrix_analytic, attitude_matrix,
 from uq.physics import modelinputs
 from uq.physics.modelinputs import MOTION, MOTION_COMPILED
 from uq.physics.scene import sample_count
+from uq.physics.timing import dwell_frequency
 
 #: The inputs a scan in motion adds to the static model's (:mod:`uq.physics.modelinputs`).
 TIME_RESOLVED_INPUTS = tuple(name for name in modelinputs.names(MOTION)
@@ -158,7 +159,7 @@ def _measure(scene, resolved, phases, err, n):
     """True radial velocities plus noise, (n, b, g), and the gate heights (n, b, g)."""
     timing, motion = resolved.timing, resolved.motion
     n_beams = scene.n_beams
-    fastest = max((c.angular_frequency for c in motion.components), default=0.0)
+    fastest = dwell_frequency(motion.components)
     times, weights = timing.nodes(n_beams, fastest)                      # (b, q), (q,)
     kin = platform_kinematics(scene, motion, phases, times[None])         # (n', b, q, ...)
     half_cone = scene.half_cone + complexstep.radians(err["lidar_half_cone"])

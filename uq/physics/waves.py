@@ -57,7 +57,8 @@ def jonswap_components(hs, tp, gamma, components, band, response):
     frequencies = low + width * (np.arange(components) + 0.5)
     shape = np.asarray(jonswap(frequencies, fp=1.0 / tp, gamma=gamma, hs=hs).values,
                        dtype=float)
-    density = shape * (hs / 4.0) ** 2 / np.sum(shape * width)  # sum S df = m0 exactly
+    density = np.zeros(components) if hs == 0 else \
+        shape * (hs / 4.0) ** 2 / np.sum(shape * width)  # sum S df = m0 exactly; calm: 0
     amplitudes = np.sqrt(2.0 * density * width)
     out = []
     for frequency, amplitude in zip(frequencies, amplitudes):
@@ -68,6 +69,22 @@ def jonswap_components(hs, tp, gamma, components, band, response):
             gains[index], lags[index] = factor * scale * amplitude, lag
         out.append(MotionComponent(2 * math.pi * frequency, tuple(gains), tuple(lags), None))
     return tuple(out)
+
+
+def band_energy(tp, gamma, components, band):
+    """The sum ``S(f_j) df`` over the bins of :func:`jonswap_components` of a JONSWAP
+    spectrum of unit significant height [m2]: 0 or NaN where the band holds
+    none of its energy in double precision (a band far below the peak, where
+    ``exp(-1.25 (fp / f)^4)`` underflows), so that no significant height can be given
+    to its components."""
+    from wavespectra.construct.frequency import jonswap
+    low, high = band
+    width = (high - low) / components
+    frequencies = low + width * (np.arange(components) + 0.5)
+    with np.errstate(all="ignore"):
+        shape = np.asarray(jonswap(frequencies, fp=1.0 / tp, gamma=gamma, hs=1.0).values,
+                           dtype=float)
+        return float(np.sum(shape * width))
 
 
 def significant_height(components, dof):

@@ -3,11 +3,14 @@
 Each finished chunk of scenes is written to ``<output>.partial/chunk-<index>.nc``
 (atomically: temporary file, then rename) with a SHA-256 checksum beside it
 (``chunk-<index>.nc.sha256``), and ``manifest.json`` records what the chunks belong to:
-the scenario text, the seed, the uq version and the chunk plan (every chunk's group and
-scenes), with a digest of all of that that each chunk also carries. ``--resume`` reuses
-the chunks whose checksum and digest match and recomputes the rest (a chunk that fails
-is named in a warning); netCDF stores float64 exactly, so the resumed result is bit for
-bit the uninterrupted one.
+the scenario text, the seed, the uq version, the chunk plan (every chunk's group and
+scenes) and the SHA-256 of every file the scenario reads (a motion record,
+:func:`uq.pipeline.motionsection.input_files`), with a digest of all of that that each
+chunk also carries. ``--resume`` reuses the chunks whose checksum and digest match and
+recomputes the rest (a chunk that fails is named in a warning); netCDF stores float64
+exactly, so the resumed result is bit for bit the uninterrupted one. A resume after such
+a file was edited is refused, naming the file (its chunks would mix the old content
+with the new); so is a chunk whose file changed while the run was going.
 
 A checkpoint has one owner: the run holds an exclusive lock (``flock`` on
 ``<output>.partial/lock``, released by the operating system even after ``kill -9``); a
@@ -22,10 +25,11 @@ import json
 import logging
 import os
 import re
+import stat as stat_module
 from pathlib import Path
 
 from uq._version import __version__
-from uq.errors import CheckpointError, OutputError
+from uq.errors import CheckpointError, DataFileError, OutputError
 from uq.files import MARKER, write_marker, write_netcdf, write_text, written_by_uq
 
 MANIFEST = "manifest.json"
@@ -55,6 +59,7 @@ class Checkpoint:
         self.directory = Path(directory)
         self.resume = resume
         self.digest = None
+        self.inputs = ()
         self._lock = None
         self.seed = self._previous().get("seed") if resume else None
 
@@ -130,15 +135,20 @@ class Checkpoint:
         """Check (resume) or write (fresh) the manifest of this run; `chunks` is the
         sweep plan's chunks (index, group, start, stop); `model` the measurement model
         (``uq run --model``: a run never mixes the chunks of two models)."""
+        from uq.pipeline.motionsection import input_files
         plan = [[c.index, list(c.group), c.start, c.stop] for c in chunks]
+        self.inputs = tuple(InputFile.of(key, path) for key, path in input_files(scenario))
         manifest = {"scenario": scenario.text, "seed": int(seed), "uq_version": __version__,
                     "chunks": len(plan), "plan": plan,
+                    "files": [[f.key, f.path, f.sha256] for f in self.inputs],
                     **({"model": model} if model != "compiled" else {})}
         text = json.dumps(manifest, sort_keys=True)
         self.digest = hashlib.sha256(text.encode()).hexdigest()
         manifest["digest"] = self.digest
         if self.resume and (self.directory / MANIFEST).exists():
-            if self._previous() != manifest:
+            previous = self._previous()
+            if previous != manifest:
+                self._refuse_changed_files(previous, manifest)
                 raise CheckpointError(str(self.directory), MANIFEST, "the checkpoint belongs "
                                       "to a different scenario, seed, chunk plan, model "
                                       "(--model) or uq version; allowed: resume the same run, or run without "
@@ -147,6 +157,20 @@ class Checkpoint:
         self._remove_chunks()                 # a fresh start: the folder is ours (marked)
         self._remove(self.directory / MANIFEST)
         write_text(self.directory / MANIFEST, json.dumps(manifest, indent=1))
+
+    def _refuse_changed_files(self, previous, manifest):
+        """CheckpointError naming a file the scenario reads whose content differs from
+        the one the checkpoint was made with (the rest of the manifest being the same)."""
+        rest = {k: v for k, v in manifest.items() if k not in ("files", "digest")}
+        if {k: v for k, v in previous.items() if k not in ("files", "digest")} != rest:
+            return
+        before = {(key, path): digest for key, path, digest in previous.get("files", [])}
+        for key, path, digest in manifest["files"]:
+            if before.get((key, path)) != digest:
+                raise CheckpointError(path, key, f"changed since the checkpoint "
+                                      f"{self.directory} was written (its SHA-256 differs); "
+                                      "allowed: restore the file to resume, or run without "
+                                      "--resume to start afresh")
 
     def load(self):
         """Chunk index -> Dataset of every intact chunk of this run on disk; a chunk that
@@ -181,6 +205,10 @@ class Checkpoint:
         return "" if _sha256(path) == recorded else "checksum mismatch"
 
     def save(self, index, dataset):
+        """Keep a finished chunk (after checking that no file the scenario reads has
+        changed since the run started: DataFileError naming it)."""
+        for item in self.inputs:
+            item.verify()
         dataset = dataset.copy(deep=False)
         dataset.attrs[DIGEST_ATTRIBUTE] = self.digest
         path = self.directory / f"chunk-{index:06d}.nc"
@@ -217,9 +245,54 @@ class Checkpoint:
             pass
 
 
-def _sha256(path):
+class InputFile:
+    """A file a scenario reads, with its SHA-256 when the run started, and the size and
+    modification time it then had (a file whose size and time are unchanged is not read
+    again to check it)."""
+
+    def __init__(self, key, path, sha256, stat):
+        self.key, self.path, self.sha256, self._stat = key, path, sha256, stat
+
+    @classmethod
+    def of(cls, key, path):
+        stat = _stat(path, key)
+        return cls(key, path, _sha256(path, key), stat)
+
+    def verify(self):
+        """DataFileError if the content changed since :meth:`of`."""
+        stat = _stat(self.path, self.key)
+        if stat == self._stat:
+            return
+        if _sha256(self.path, self.key) != self.sha256:
+            raise DataFileError(self.path, self.key, "changed while the run was going (its "
+                                "SHA-256 differs from the one at the start); the chunks "
+                                "finished before are kept; allowed: leave the files a run "
+                                "reads alone until it ends, restore the file and run again "
+                                "with --resume, or run without --resume")
+        self._stat = stat
+
+
+def _stat(path, key):
+    try:
+        stat = os.stat(path)
+    except OSError as error:
+        raise DataFileError(str(path), key, f"cannot read it ({error.strerror}); allowed: "
+                            "the file the scenario names") from None
+    return stat.st_size, stat.st_mtime_ns
+
+
+def _sha256(path, key=None):
     digest = hashlib.sha256()
-    with open(path, "rb") as stream:
+    try:
+        handle = os.open(path, os.O_RDONLY | os.O_NONBLOCK)    # a FIFO: no wait for a writer
+    except OSError as error:
+        if key is None:
+            raise
+        raise DataFileError(str(path), key, f"cannot read it ({error.strerror}); allowed: "
+                            "the file the scenario names") from None
+    with open(handle, "rb") as stream:
+        if key is not None and not stat_module.S_ISREG(os.fstat(handle).st_mode):
+            raise DataFileError(str(path), key, "not a regular file; allowed: a file")
         for block in iter(lambda: stream.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()

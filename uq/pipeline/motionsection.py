@@ -42,10 +42,11 @@ from uq.physics.motion import DEGREES_OF_FREEDOM, Motion, MotionComponent
 from uq.physics.scene import TimeResolved
 from uq.errors import ScenarioError
 from uq.physics.series import WindowStart, series_components
-from uq.physics.timing import TIMESTAMPS, ScanTiming
-from uq.physics.waves import jonswap_components
-from uq.constants import (MAX_MAGNITUDE, MAX_SERIES_BYTES, MAX_SERIES_ROWS,
-                          MAX_WAVE_COMPONENTS)
+from uq.physics.timing import (TIMESTAMPS, DwellTooLong, ScanTiming, dwell_frequency,
+                               dwell_rule)
+from uq.physics.waves import band_energy, jonswap_components
+from uq.constants import (MAX_DWELL_TOTAL_NODES, MAX_SERIES_BYTES,
+                          MAX_SERIES_ROWS, MAX_WAVE_COMPONENTS, MIN_MOTION_PERIOD)
 
 HARMONIC_KEYS = ("amplitude", "period", "phase")
 SPECTRUM_KEYS = ("kind", "hs", "tp", "gamma", "components", "band")
@@ -59,6 +60,15 @@ MIN_SERIES_SAMPLES = 16
 #: Largest relative spread of a record's sampling intervals [1]: the Fourier series
 #: assumes equal spacing; clock jitter of 1 % of the interval is tolerated.
 SERIES_SPACING_TOLERANCE = 0.01
+#: Widest sampling interval of a motion record [s]: a record must resolve the
+#: wave-driven motion of a platform (periods down to ~2 s: 1 s is its Nyquist interval).
+#: A wider one is most likely a time column in milliseconds (100 at 10 Hz).
+MAX_SERIES_STEP = 1.0
+#: Longest period [s] of the strongest roll, pitch or heave in a record that passes
+#: without a warning: wave-driven motion has periods of 2-30 s (swell up to ~25 s);
+#: longer is a drift, or a time column in milliseconds.
+MAX_WAVE_PERIOD = 30.0
+WAVE_DOFS = ("roll", "pitch", "heave")
 #: Default band of a spectrum, in multiples of its peak frequency 1/tp [1]: the JONSWAP
 #: (gamma 3.3) energy outside [0.5, 4] fp is below 1e-3 of the total (the f^-5 tail).
 SPECTRUM_BAND = (0.5, 4.0)
@@ -100,6 +110,9 @@ def _series(check, value):
     columns = value["columns"]
     check.mapping(columns, f"{key}.columns")
     check.keys(columns, f"{key}.columns", DEGREES_OF_FREEDOM)
+    if not columns:
+        check.fail(f"{key}.columns", "empty; allowed: the column of at least one degree of "
+                   f"freedom ({', '.join(DEGREES_OF_FREEDOM)})")
     out = {"file": str(_beside(check.source, path)),
            "time": check.text(value.get("time", "time"), f"{key}.time"),
            "columns": {dof: check.text(c, f"{key}.columns.{dof}") for dof, c in
@@ -157,9 +170,33 @@ def _read_series(file, version, time, columns):
         raise DataFileError(str(file), time, f"{len(times)} samples; allowed: at least "
                             f"{MIN_SERIES_SAMPLES}, increasing and equally spaced (within "
                             f"{100 * SERIES_SPACING_TOLERANCE:g} %)")
+    step = float(np.mean(steps))
+    if step > MAX_SERIES_STEP:
+        raise DataFileError(str(file), time, f"samples {step:g} apart; allowed: the time in "
+                            f"seconds, samples at most {MAX_SERIES_STEP:g} s apart (a motion "
+                            "record resolves wave motion; is the time in milliseconds?)")
+    _warn_slow_motion(file, data, columns, len(times) * step)
     values = {dof: np.radians(data[c]) if dof in ANGULAR_DOFS else data[c]
               for dof, c in columns}
     return times, values
+
+
+def _warn_slow_motion(file, data, columns, length):
+    """Warn where the strongest roll, pitch or heave of a record is slower than wave
+    motion (:data:`MAX_WAVE_PERIOD`): a time column in milliseconds, or a drift."""
+    import logging
+    for dof, column in columns:
+        if dof not in WAVE_DOFS:
+            continue
+        power = np.abs(np.fft.rfft(data[column] - np.mean(data[column]))[1:])
+        if not power.size or not np.any(power > 0):
+            continue
+        period = length / (int(np.argmax(power)) + 1)
+        if period > MAX_WAVE_PERIOD:
+            logging.getLogger(__name__).warning(
+                "%s: column %s (%s): its strongest motion has a period of %.4g s; expected "
+                "wave motion, periods of 2-%g s (is the time in milliseconds?)", file, column,
+                dof, period, MAX_WAVE_PERIOD)
 
 
 def _spectrum(check, value):
@@ -167,24 +204,33 @@ def _spectrum(check, value):
     check.mapping(value, key)
     check.keys(value, key, SPECTRUM_KEYS)
     check.required(value, key, ("hs", "tp"), "a spectrum needs hs [m] and tp [s]")
-    tp = check.number(value["tp"], f"{key}.tp", low=0.0, low_open=True)
+    tp = _period(check, value["tp"], f"{key}.tp")
     band = value.get("band", [SPECTRUM_BAND[0] / tp, SPECTRUM_BAND[1] / tp])
     if "band" not in value:                  # the default band: a problem is tp's
-        if not all(0.0 < f <= MAX_MAGNITUDE for f in band):
+        if not all(0.0 < f <= 1.0 / MIN_MOTION_PERIOD for f in band):
             check.fail(f"{key}.tp", f"{tp:g} s gives the default band {SPECTRUM_BAND[0]:g}/tp "
                        f"to {SPECTRUM_BAND[1]:g}/tp = [{band[0]:g}, {band[1]:g}] Hz, beyond "
-                       f"the numbers allowed (at most {MAX_MAGNITUDE:g}); allowed: a peak "
-                       "period in seconds, or an explicit band")
-    band = check.number_list(band, f"{key}.band", low=0.0, low_open=True)
+                       f"{1.0 / MIN_MOTION_PERIOD:g} Hz (motion periods of at least "
+                       f"{MIN_MOTION_PERIOD:g} s); allowed: a peak period in seconds, or an "
+                       "explicit band")
+    band = check.number_list(band, f"{key}.band", low=0.0, low_open=True,
+                             high=1.0 / MIN_MOTION_PERIOD)
     if len(band) != 2 or not band[0] < band[1]:
         check.fail(f"{key}.band", "allowed: [lowest, highest] frequency in Hz, lowest first")
-    return {"kind": check.choice(value.get("kind", "jonswap"), f"{key}.kind", SPECTRUM_KINDS),
-            "hs": check.number(value["hs"], f"{key}.hs", low=0.0),
-            "tp": tp,
-            "gamma": check.number(value.get("gamma", 3.3), f"{key}.gamma", low=1.0, high=10.0),
-            "components": check.integer(value.get("components", 32), f"{key}.components",
-                                        low=1, high=MAX_WAVE_COMPONENTS),
-            "band": band}
+    out = {"kind": check.choice(value.get("kind", "jonswap"), f"{key}.kind", SPECTRUM_KINDS),
+           "hs": check.number(value["hs"], f"{key}.hs", low=0.0),
+           "tp": tp,
+           "gamma": check.number(value.get("gamma", 3.3), f"{key}.gamma", low=1.0, high=10.0),
+           "components": check.integer(value.get("components", 32), f"{key}.components",
+                                       low=1, high=MAX_WAVE_COMPONENTS),
+           "band": band}
+    energy = band_energy(tp, out["gamma"], out["components"], tuple(band)) if out["hs"] else 1
+    if not 0 < energy < math.inf:
+        check.fail(f"{key}.band", f"[{band[0]:g}, {band[1]:g}] Hz holds none of the energy "
+                   f"of a spectrum peaked at {1 / tp:g} Hz (it underflows); allowed: a band "
+                   f"around the peak, e.g. the default [{SPECTRUM_BAND[0] / tp:g}, "
+                   f"{SPECTRUM_BAND[1] / tp:g}] Hz")
+    return out
 
 
 def _response(check, value):
@@ -215,9 +261,19 @@ def _harmonic(check, value, key, angular):
                    "in [-360, 360], or random")
     return {"amplitude": check.number(value["amplitude"], f"{key}.amplitude", low=0.0,
                                       high=high),
-            "period": check.number(value["period"], f"{key}.period", low=0.0, low_open=True),
+            "period": _period(check, value["period"], f"{key}.period"),
             "phase": "random" if phase == "random" else check.number(
                 phase, f"{key}.phase", low=-360.0, high=360.0)}
+
+
+def _period(check, value, key):
+    """A motion period [s]: at least :data:`~uq.constants.MIN_MOTION_PERIOD`."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and \
+            0 < value < MIN_MOTION_PERIOD:
+        check.fail(key, f"{value:g} s is shorter than any platform motion; allowed: at "
+                   f"least {MIN_MOTION_PERIOD:g} s (faster is vibration, which no INS "
+                   "resolves)")
+    return check.number(value, key, low=MIN_MOTION_PERIOD)
 
 
 def validate_lever_arm(check, value):
@@ -246,6 +302,42 @@ def validate_ins_timing(check, value, out):
     if "interpolation" in value:
         out["interpolation"] = check.choice(value["interpolation"], "ins.interpolation",
                                             INTERPOLATIONS)
+
+
+def check_record(settings, n_beams):
+    """Refuse a motion record shorter than one scan (``n_beams`` beams of
+    ``lidar.scan.beam_duration``): its Fourier series would repeat it within the scan."""
+    from uq.errors import DataFileError
+    series = (settings.get("motion") or {}).get("series")
+    if not series:
+        return
+    times, _ = read_series(series["file"], series["time"], tuple(series["columns"].items()))
+    length = (times[-1] - times[0]) * len(times) / (len(times) - 1)
+    duration = {**SCAN_DEFAULTS, **settings["lidar"].get("scan", {})}["beam_duration"]
+    if length < n_beams * duration * (1 - SERIES_SPACING_TOLERANCE):   # (its clock jitter)
+        raise DataFileError(series["file"], series["time"], f"the record lasts {length:g} s, "
+                            f"shorter than one scan ({n_beams} beams of {duration:g} s): it "
+                            "would repeat within the scan; allowed: a record at least as "
+                            "long as a scan, the time in seconds")
+
+
+def check_dwell(check, settings):
+    """Refuse a dwell average whose quadrature would need more nodes than
+    :data:`~uq.constants.MAX_DWELL_TOTAL_NODES` (:func:`uq.physics.timing.dwell_rule`),
+    before anything is allocated: a dwell of more cycles of the motion than a lidar has."""
+    scan = settings["lidar"].get("scan") or {}
+    if not scan.get("dwell_average") or not is_time_resolved(settings):
+        return
+    frequency = dwell_frequency(time_resolved(settings).motion.components)
+    try:
+        dwell_rule(frequency * scan["beam_duration"])
+    except DwellTooLong as error:
+        check.fail("lidar.scan.beam_duration", f"{scan['beam_duration']:g} s averaged over "
+                   f"the motion (harmonics of the integrand up to "
+                   f"{frequency / (2 * math.pi):.3g} Hz) needs {error.nodes:.3g} quadrature "
+                   f"nodes per dwell; allowed: at most {MAX_DWELL_TOTAL_NODES} (a "
+                   f"beam_duration up to {error.longest_span / frequency:.3g} s), or "
+                   "lidar.scan.dwell_average: false")
 
 
 def is_time_resolved(settings):
@@ -314,6 +406,24 @@ def random_phase_count(settings):
     harmonics = sum(spec["phase"] == "random" for dof, spec in motion.items()
                     if dof in DEGREES_OF_FREEDOM)
     return harmonics + (motion["spectrum"]["components"] if "spectrum" in motion else 0)
+
+
+#: Scenario keys whose value is a file the run reads (relative to the scenario's folder).
+FILE_KEYS = ("motion.series.file",)
+
+
+def input_files(scenario):
+    """The files a scenario reads, as ``(dotted key, path)`` in a fixed order: the motion
+    record of the settings and every swept value of :data:`FILE_KEYS` (so that a
+    checkpoint can cover their content, :mod:`uq.pipeline.checkpoint`)."""
+    found = []
+    series = (scenario.settings.get("motion") or {}).get("series")
+    if series:
+        found.append((FILE_KEYS[0], str(series["file"])))
+    for key, values in scenario.sweep:
+        if key in FILE_KEYS:
+            found += [(key, str(_beside(scenario.source, value))) for value in values]
+    return list(dict.fromkeys(found))
 
 
 def beam_stamps(settings, n_beams):

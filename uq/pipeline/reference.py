@@ -145,7 +145,8 @@ MEANINGS = {
                                  "azimuths, then the vertical beam"),
     "lidar.scan.timestamp": ("", "a beam's time stamp: start, mid or end of its dwell"),
     "lidar.scan.dwell_average": ("", "radial velocity averaged over the dwell "
-                                 "(Gauss-Legendre quadrature)"),
+                                 "(composite Gauss-Legendre quadrature to 1e-9 of the "
+                                 "motion's highest harmonic; at most 512 nodes per dwell)"),
     "ins.rate": ("Hz", "INS sampling rate (absent: a continuous INS)"),
     "ins.interpolation": ("", "reading between INS samples: nearest, or linear (the "
                           "default; attitude on the rotation group); needs ins.rate"),

@@ -165,7 +165,7 @@ def _motion_ti(scene, settings, inputs, seed, dataset, compiled):
     budget = dataset["wind_speed_budget"]
     labels = [input_label(name) for name in MOTION_INPUTS]
     motion_variance = budget.sel(input=[i for i in budget["input"].values if i in labels]
-                                 ).sum("input").values
+                                 ).sum("input", skipna=False).values   # NaN stays NaN
     return {"wind_speed_motion_ti": (dims, u_motion / truth),
             "wind_speed_motion_ti_gum": (dims, np.sqrt(motion_variance) / truth)}
 

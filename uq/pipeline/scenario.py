@@ -27,7 +27,8 @@ from uq.physics.beams import beam_unit_vectors
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS, validate_error
 from uq.errors import ScenarioError
 from uq.pipeline.fitconfig import validate_fit
-from uq.pipeline.motionsection import (validate_ins_timing, validate_lever_arm, validate_motion,
+from uq.pipeline.motionsection import (check_dwell, check_record, random_phase_count,
+                                       validate_ins_timing, validate_lever_arm, validate_motion,
                                        validate_scan)
 from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
 from uq.physics.modelinputs import error_keys
@@ -350,6 +351,9 @@ def _check_time_resolved(check, settings):
     if DERIVED_OUTPUTS[0] in settings["outputs"] and not settings.get("motion"):
         check.fail("outputs", f"{DERIVED_OUTPUTS[0]} needs a motion section; allowed: the "
                    "other outputs")
+    check_dwell(check, settings)
+    lidar = settings["lidar"]
+    check_record(settings, len(lidar["azimuths"]) + int(lidar["vertical_beam"]))
 
 
 def _check_beams_determine_wind(check, lidar):
@@ -438,10 +442,16 @@ def _validate_sweep(value, settings, source):
                                 f"({', '.join(VECTOR_KEYS)}) or pairs of other keys")
         swept[follower] = swept[leader]
     for key, values in swept.items():
+        random = set()
         for item in _values_to_validate(key, values, source):
             raw = copy.deepcopy(settings)     # each value must make a valid scenario
             assign_dotted(raw, key, item, source)
-            _validate(raw, source)
+            random.add(random_phase_count(_validate(raw, source)) > 0)
+        if len(random) > 1:                   # the model's inputs would differ by value
+            raise ScenarioError(source, f"sweep.{key}", "some values give the motion random "
+                                "phases and others none (different Monte Carlo inputs "
+                                "cannot share one sweep); allowed: all values with "
+                                "random phases, or none (e.g. phases in degrees only)")
     return tuple(sweep), tuple(links)
 
 
