@@ -18,6 +18,7 @@ import xarray as xr
 from uq._version import __version__
 from uq.pipeline.distributions import error_distribution
 from uq.engine.inputs import Input, UniformCircle
+from uq.physics.correction import describe_corrections
 from uq.physics.ins import gauss_markov_correlation
 from uq.pipeline import motionsection, probesection
 from uq.physics import probe as probe_volume
@@ -482,6 +483,8 @@ def _global_attributes(scenario, seed, dataset, started):
             "scenes": int(dataset["mc_n_samples"].size),
             "seed": seed,
             "correction": scenario.settings["correction"],
+            "correction_description": describe_corrections(
+                dict(scenario.sweep).get("correction", (scenario.settings["correction"],))),
             "ins_correlation": scenario.settings["ins"]["correlation"],
             "runtime_s": time.perf_counter() - started, **_probe_attributes(scenario)}
 
