@@ -271,3 +271,35 @@ def test_a_slow_kernel_load_is_announced(slow, said, tmp_path, monkeypatch, caps
     assert notice.interval == run_command.KERNEL_NOTICE_AFTER and notice.cancelled
     notice.elapse()                        # after the load: too late to say anything
     assert ("compiling the model's kernels" in capsys.readouterr().err) == said
+
+
+@pytest.mark.parametrize("text, shown", [
+    ("name: y\nlidar:\n  ranges: [100, 200,, 300]\n",
+     "at line 3, column 21: expected the node content, but found ',' "
+     "(here: 'ranges: [100, 200,^, 300]')"),
+    ("name: y\n  lidar: 3\n", "at line 2, column 8: mapping values are not allowed here "
+     "(here: 'lidar^: 3')"),
+])
+def test_a_yaml_syntax_error_shows_its_line_and_a_caret(text, shown, tmp_path, capsys,
+                                                         monkeypatch):
+    path = write(tmp_path, text)
+    status, err = uq_in_process(["check", str(path)], tmp_path, capsys, monkeypatch)
+    assert status == 2 and err.strip() == f"uq: error: {path}: not valid YAML {shown}"
+
+
+@pytest.mark.parametrize("override, key", [("lidar.half_cone=95", "lidar.half_cone"),
+                                           ("lidar.ranges=[1, -2]", "lidar.ranges[1]"),
+                                           ("sweep.wind.direction=abc", "sweep.wind.direction"),
+                                           ("lidar.foo=1", "lidar.foo")])
+def test_a_bad_override_is_blamed_on_the_set_option(override, key, tmp_path, capsys,
+                                                    monkeypatch):
+    path = write(tmp_path, GOOD, "good.yaml")
+    status, err = uq_in_process(["check", str(path), "--set", override], tmp_path, capsys,
+                                monkeypatch)
+    assert status == 2 and len(err.splitlines()) == 1
+    assert err.startswith(f"uq: error: --set {override.split('=')[0]}=") and \
+        f"(applied to {path}): {key}: " in err, err
+    # the same value in the file is the file's error
+    status, err = uq_in_process(["check", str(write(tmp_path, "lidar: {half_cone: 95}\n"))],
+                                tmp_path, capsys, monkeypatch)
+    assert status == 2 and err.startswith(f"uq: error: {tmp_path / 'bad.yaml'}: ")

@@ -178,10 +178,25 @@ def load_scenario(path_or_mapping, overrides=None):
                             f"{', '.join(DEFAULTS)}")
     for dotted, value in (overrides or {}).items():
         assign_dotted(raw, dotted, value, source)
-    scenario = _build(raw, source)
+    try:
+        scenario = _build(raw, source)
+    except ScenarioError as error:
+        raise _blame_override(error, overrides or {}) from None
     for key, text in keys_without_effect(scenario.settings, dict(scenario.sweep)):
         log.warning("%s: %s: %s", source, key, text)
     return scenario
+
+
+def _blame_override(error, overrides):
+    """`error` as an error of the ``--set KEY=VALUE`` that set its key (or a key above
+    it), with the file it was applied to; unchanged where no override set it."""
+    for dotted, value in overrides.items():
+        if error.key == dotted or error.key.startswith((dotted + ".", dotted + "[")):
+            text = yaml.safe_dump(value, default_flow_style=True).strip()
+            text = text[:-4].strip() if text.endswith("...") else text
+            return ScenarioError(f"--set {dotted}={text} (applied to {error.source})",
+                                 error.key, error.problem)
+    return error
 
 
 #: Largest half-cone angle [deg] that is taken for a slip into radians (pi/2 rad is

@@ -17,7 +17,8 @@ from pathlib import Path
 
 import yaml
 
-from uq.constants import MAX_CONFIG_BYTES, MAX_CONFIG_DEPTH, MAX_CONFIG_NODES
+from uq.constants import (MAX_BEAMS, MAX_CONFIG_BYTES, MAX_CONFIG_DEPTH, MAX_CONFIG_NODES,
+                          MAX_GATES)
 from uq.errors import ScenarioError
 
 
@@ -71,9 +72,7 @@ def parse_yaml(text, source):
     except ScenarioError:
         raise
     except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark else ""
-        raise ScenarioError(source, "", f"not valid YAML{where}") from None
+        raise ScenarioError(source, "", f"not valid YAML{_where(error, text)}") from None
     except ValueError as error:             # e.g. an integer of more than 4300 digits
         raise ScenarioError(source, "", f"cannot read a value ({str(error)[:80]}); "
                             "allowed: numbers of at most a few hundred digits") from None
@@ -82,6 +81,25 @@ def parse_yaml(text, source):
                             "allowed: a scenario's few levels") from None
     finally:
         loader.dispose()
+
+
+#: Characters of a line shown around the place of a YAML syntax error.
+SHOWN_LINE = 60
+
+
+def _where(error, text):
+    """`` at line L, column C: problem (here: "text ^text")`` for a YAML error with a
+    place: the line as written, a caret where the parser stopped (one line)."""
+    mark = getattr(error, "problem_mark", None)
+    if mark is None:
+        return ""
+    lines = text.splitlines()
+    line = lines[mark.line] if mark.line < len(lines) else ""
+    first = max(0, mark.column - SHOWN_LINE // 2)
+    shown = line[first:mark.column] + "^" + line[mark.column:first + SHOWN_LINE]
+    problem = getattr(error, "problem", None)
+    return (f" at line {mark.line + 1}, column {mark.column + 1}"
+            f"{': ' + problem if problem else ''} (here: {shown.strip()!r})")
 
 
 class _Loader(yaml.SafeLoader):
@@ -140,5 +158,43 @@ def _check_expansion(root, source):
         return sizes[id(node)]
 
     if size(root) > MAX_CONFIG_NODES:
-        raise ScenarioError(source, "", f"expands to more than {MAX_CONFIG_NODES} values "
-                            "(YAML aliases); allowed: a scenario's few hundred values")
+        key = _largest_key(root, sizes)
+        aliases = _has_alias(root)
+        raise ScenarioError(source, key, f"more than {MAX_CONFIG_NODES} values"
+                            f"{' once its YAML aliases are expanded' if aliases else ''}; "
+                            f"allowed: a scenario's few hundred values"
+                            f"{LIST_BOUNDS.get(key, '')}")
+
+
+#: What the validator allows in the lists a file may make long (said where a file holds
+#: more values than MAX_CONFIG_NODES).
+LIST_BOUNDS = {"lidar.ranges": f" (at most {MAX_GATES} range gates)",
+               "lidar.azimuths": f" (at most {MAX_BEAMS} beams)"}
+
+
+def _largest_key(root, sizes):
+    """Dotted key of the mapping entry that holds most of the document's values: down
+    from the root, into the largest value of each mapping ('' if the root is a list)."""
+    parts, node = [], root
+    while isinstance(node, yaml.MappingNode) and node.value:
+        key_node, value = max(node.value, key=lambda kv: sizes.get(id(kv[1]), 1))
+        if not isinstance(key_node, yaml.ScalarNode):
+            break
+        parts.append(str(key_node.value))
+        node = value
+    return ".".join(parts)
+
+
+def _has_alias(root):
+    """Does a node appear twice in the document (an alias), anywhere below `root`?"""
+    seen, stack = set(), [root]
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            return True
+        seen.add(id(node))
+        if isinstance(node, yaml.SequenceNode):
+            stack.extend(node.value)
+        elif isinstance(node, yaml.MappingNode):
+            stack.extend(v for pair in node.value for v in pair)
+    return False
