@@ -3,12 +3,11 @@ makes them (``uq run``, ``uq plot``, ``uq fit``, ``uq golden``, ``uq bench``):
 
     python scripts/docs_figures.py            # every figure but the benchmark (~1 min)
     python scripts/docs_figures.py --bench    # also docs/bench.png (a full uq bench, ~6 min)
+    python scripts/docs_figures.py --only rubio2022_case_i.png   # one figure
 
 The runs go to a temporary folder that is removed afterwards; only the figures are copied
 into docs/ (they are the repository's own files, so they are replaced). Each figure is the
-one ``uq plot`` (or ``uq fit`` / ``uq golden``) writes for that scenario; the case-i
-figure puts two runs (one INS reading per scan, independent per beam) on one plot with
-:func:`uq.outputs.plots.plot_uncertainty_against_direction`.
+one ``uq plot`` (or ``uq fit`` / ``uq golden``) writes for that scenario.
 """
 import argparse
 import shutil
@@ -21,6 +20,8 @@ DOCS = Path(__file__).resolve().parent.parent / "docs"
 
 #: docs figure -> (uq commands, the figure they write, relative to the run folder)
 PLOTTED = {
+    "rubio2022_case_i.png": ([["run", "rubio2022_case_i", "-o", "c.nc"], ["plot", "c.nc"]],
+                             "c_figures/uncertainty_against_direction.png"),
     "rubio2022_fig2.png": ([["run", "rubio2022_misalignment", "-o", "m.nc"], ["plot", "m.nc"]],
                            "m_figures/fig2_speed_maps.png"),
     "tiana2017_fig4a.png": ([["run", "tiana2017_vad", "-o", "t.nc"], ["plot", "t.nc"]],
@@ -43,29 +44,16 @@ def uq(arguments, folder):
                    check=True)
 
 
-def case_i(target):
-    """docs/rubio2022_case_i.png: u against wind direction, scan and beam correlation."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import uq as tool
-    from uq.outputs.plots import plot_uncertainty_against_direction
-    from uq.pipeline.shipped import scenario_path
-    path = scenario_path("rubio2022_case_i")
-    runs = {"one INS reading per scan": tool.run(tool.load_scenario(path)),
-            "independent per beam": tool.run(tool.load_scenario(
-                path, {"ins.correlation": "beam"}))}
-    figure = plot_uncertainty_against_direction(runs)
-    figure.suptitle("rubio2022_case_i: Vh = 5 m/s, sog = 2 m/s, u(sog) = 0.1 m/s, "
-                    "u(cog) = u(heading) = 0.1 deg", fontsize=10)
-    figure.savefig(target, dpi=110)
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--bench", action="store_true", help="also run uq bench (~6 min)")
+    parser.add_argument("--only", action="append", choices=sorted(PLOTTED), metavar="FIGURE",
+                        help="make only this figure of docs/ (repeatable)")
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as folder:
         for name, (commands, made) in PLOTTED.items():
+            if args.only and name not in args.only:
+                continue
             for command in commands:
                 uq(command, folder)
             shutil.copyfile(Path(folder) / made, DOCS / name)
@@ -74,8 +62,6 @@ def main(argv=None):
             uq(["bench", "-o", "bench.nc"], folder)
             shutil.copyfile(Path(folder) / "bench.png", DOCS / "bench.png")
             print("docs/bench.png")
-    case_i(DOCS / "rubio2022_case_i.png")
-    print("docs/rubio2022_case_i.png")
 
 
 if __name__ == "__main__":

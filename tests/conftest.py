@@ -1,4 +1,6 @@
 """Shared helpers for the tests."""
+import resource
+
 import numpy as np
 import pytest
 
@@ -20,6 +22,31 @@ def _nest(changes):
             node = node.setdefault(part, {})
         node[parts[-1]] = value
     return out
+
+
+#: CPU time a child process of a test may use before the kernel stops it [s]: a cold
+#: start that compiles every numba kernel (~100 s of CPU on the 2-core CI machine) and
+#: the longest child's own work (a notebook's fits, ~60 s), with a factor of 3 to spare.
+#: A bound on work, not on wall time: a loaded machine slows a child, it does not make
+#: it use more CPU.
+CHILD_CPU_SECONDS = 600
+
+
+def cpu_limited(seconds=CHILD_CPU_SECONDS):
+    """A ``preexec_fn`` for :mod:`subprocess` that limits the child's CPU time to
+    `seconds` (``RLIMIT_CPU``; the kernel ends a child that exceeds it with SIGXCPU, so
+    a runaway child fails the test with its status instead of hanging it). Its own
+    children (dask workers) inherit the limit, each for itself."""
+    def limit():
+        resource.setrlimit(resource.RLIMIT_CPU, (seconds, seconds))
+    return limit
+
+
+def child_failure(result):
+    """What a failed child process said: its status and the ends of its stdout and
+    stderr (for an assertion's message)."""
+    return (f"child exited with status {result.returncode}; stdout: "
+            f"{(result.stdout or '')[-1000:]!r}; stderr: {(result.stderr or '')[-2000:]!r}")
 
 
 @pytest.fixture

@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import child_failure, cpu_limited
 
 NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("*.ipynb"))
 
@@ -21,8 +22,9 @@ def test_notebook_runs_headless(notebook, tmp_path):
     script = tmp_path / f"{notebook.stem}.py"
     script.write_text(code)
     run = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True,
-                         text=True, env={**os.environ, "MPLBACKEND": "Agg"}, timeout=600)
-    assert run.returncode == 0, run.stderr[-2000:]
+                         text=True, env={**os.environ, "MPLBACKEND": "Agg"},
+                         preexec_fn=cpu_limited())
+    assert run.returncode == 0, child_failure(run)
     assert "Warning" not in run.stderr, run.stderr[-2000:]
     assert sorted(p.name for p in tmp_path.iterdir()) == [script.name]   # writes no file
 

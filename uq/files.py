@@ -125,11 +125,17 @@ def remove_if_empty(folders):
             return
 
 
-def check_target(path, source="-o"):
-    """Refuse a target the tool may not write: a folder, or a file it did not write."""
+def _not_a_folder(path, source):
+    """`path`, or OutputError where it is a folder."""
     path = Path(path)
     if path.is_dir():
         raise OutputError(source, str(path), "is a folder; allowed: a file name")
+    return path
+
+
+def check_target(path, source="-o"):
+    """Refuse a target the tool may not write: a folder, or a file it did not write."""
+    path = _not_a_folder(path, source)
     if path.exists() and not written_by_uq(path):
         raise OutputError(source, str(path), "exists and was not written by uq; allowed: "
                           "a new file name (uq replaces only its own files)")
@@ -137,10 +143,12 @@ def check_target(path, source="-o"):
 
 
 @contextlib.contextmanager
-def atomic_file(path, source="-o"):
+def atomic_file(path, source="-o", replace_any=False):
     """Yield a temporary path beside `path`; on success give it the umask's permissions
-    and rename it onto `path`, on failure remove it. Refuses targets uq did not write."""
-    path = check_target(path, source)
+    and rename it onto `path`, on failure remove it. Refuses targets uq did not write,
+    unless the user asked to replace any file (`replace_any`, ``uq export --force``);
+    a folder is refused always."""
+    path = check_target(path, source) if not replace_any else _not_a_folder(path, source)
     _make_folder(path.parent, source)
     try:
         handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part",
@@ -216,9 +224,10 @@ def _make_folder(folder, source):
                           f"({error.strerror}); allowed: a writable folder") from None
 
 
-def write_text(path, text, source="-o"):
-    """Write `text` to `path` atomically; returns the path."""
-    with atomic_file(path, source) as temporary:
+def write_text(path, text, source="-o", replace_any=False):
+    """Write `text` to `path` atomically; returns the path. `replace_any`: replace a file
+    uq did not write (only where the user asked for it)."""
+    with atomic_file(path, source, replace_any) as temporary:
         temporary.write_text(text)
     return Path(path)
 

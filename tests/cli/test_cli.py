@@ -6,6 +6,7 @@ from pathlib import Path
 import pytest
 import xarray as xr
 import yaml
+from conftest import cpu_limited
 
 from uq.cli import main
 
@@ -15,9 +16,10 @@ GOOD = {"name": "tiny", "ins": {"heading": {"dist": "normal", "u": 0.1}},
 
 
 def uq(*args, cwd):
-    """Run the command in a new process (what a user sees, tracebacks included)."""
+    """Run the command in a new process (what a user sees, tracebacks included), bounded
+    in CPU time (not wall time)."""
     return subprocess.run([sys.executable, "-m", "uq.cli", *args], cwd=cwd, capture_output=True,
-                          text=True, timeout=300)
+                          text=True, preexec_fn=cpu_limited())
 
 
 def uq_in_process(args, cwd, capsys, monkeypatch):
@@ -219,20 +221,85 @@ def test_quiet_prints_nothing_and_results_go_to_stdout(tmp_path):
     assert "wrote l.nc" in loud.stdout and "wrote" not in loud.stderr
 
 
+class ManualTimer:
+    """threading.Timer whose interval elapses when the test says so (:meth:`elapse`), not
+    on the clock: what the kernel notice does is then independent of the machine's load."""
+
+    made = []
+
+    def __init__(self, interval, function):
+        self.interval, self.function, self.cancelled = interval, function, False
+        ManualTimer.made.append(self)
+
+    daemon = False
+
+    def start(self):
+        pass
+
+    def cancel(self):
+        self.cancelled = True
+
+    def elapse(self):
+        if not self.cancelled:
+            self.function()
+
+
 @pytest.mark.parametrize("slow, said", [(True, True), (False, False)])
 def test_a_slow_kernel_load_is_announced(slow, said, tmp_path, monkeypatch, capsys):
     """The first run after an install compiles numba's kernels for a minute or more: `uq
-    run` says so on stderr when loading them takes longer than KERNEL_NOTICE_AFTER (here a
-    load made to take 0.5 s against 0.1 s), and says nothing when it is quick."""
-    import time
+    run` says so on stderr when loading them takes longer than KERNEL_NOTICE_AFTER (here
+    the interval elapses during the load), and says nothing when the load ends first (the
+    interval elapses after it)."""
+    import threading
 
     from uq.cli import run as run_command
     from uq.physics import fusedkernels
     original = fusedkernels.compiled
-    monkeypatch.setattr(run_command, "KERNEL_NOTICE_AFTER", 0.1)
-    monkeypatch.setattr(fusedkernels, "compiled", lambda dtype: (
-        time.sleep(0.25) if slow else None, original(dtype))[1])
+
+    def load(dtype):
+        if slow:
+            ManualTimer.made[-1].elapse()
+        return original(dtype)
+
+    ManualTimer.made = []
+    monkeypatch.setattr(threading, "Timer", ManualTimer)
+    monkeypatch.setattr(fusedkernels, "compiled", load)
     monkeypatch.chdir(tmp_path)
     assert main(["run", "rubio2022_case_i", "--set", "sampling.n=100",
                  "--set", "sweep={}", "-o", "out.nc"]) == 0
+    notice, = ManualTimer.made
+    assert notice.interval == run_command.KERNEL_NOTICE_AFTER and notice.cancelled
+    notice.elapse()                        # after the load: too late to say anything
     assert ("compiling the model's kernels" in capsys.readouterr().err) == said
+
+
+@pytest.mark.parametrize("text, shown", [
+    ("name: y\nlidar:\n  ranges: [100, 200,, 300]\n",
+     "at line 3, column 21: expected the node content, but found ',' "
+     "(here: 'ranges: [100, 200,^, 300]')"),
+    ("name: y\n  lidar: 3\n", "at line 2, column 8: mapping values are not allowed here "
+     "(here: 'lidar^: 3')"),
+])
+def test_a_yaml_syntax_error_shows_its_line_and_a_caret(text, shown, tmp_path, capsys,
+                                                         monkeypatch):
+    path = write(tmp_path, text)
+    status, err = uq_in_process(["check", str(path)], tmp_path, capsys, monkeypatch)
+    assert status == 2 and err.strip() == f"uq: error: {path}: not valid YAML {shown}"
+
+
+@pytest.mark.parametrize("override, key", [("lidar.half_cone=95", "lidar.half_cone"),
+                                           ("lidar.ranges=[1, -2]", "lidar.ranges[1]"),
+                                           ("sweep.wind.direction=abc", "sweep.wind.direction"),
+                                           ("lidar.foo=1", "lidar.foo")])
+def test_a_bad_override_is_blamed_on_the_set_option(override, key, tmp_path, capsys,
+                                                    monkeypatch):
+    path = write(tmp_path, GOOD, "good.yaml")
+    status, err = uq_in_process(["check", str(path), "--set", override], tmp_path, capsys,
+                                monkeypatch)
+    assert status == 2 and len(err.splitlines()) == 1
+    assert err.startswith(f"uq: error: --set {override.split('=')[0]}=") and \
+        f"(applied to {path}): {key}: " in err, err
+    # the same value in the file is the file's error
+    status, err = uq_in_process(["check", str(write(tmp_path, "lidar: {half_cone: 95}\n"))],
+                                tmp_path, capsys, monkeypatch)
+    assert status == 2 and err.startswith(f"uq: error: {tmp_path / 'bad.yaml'}: ")

@@ -80,6 +80,8 @@ def test_a_record_in_a_scenario(tmp_path):
     ("t,r\n" + "".join(f"{0.1 * i * (1 + i % 2)},{i}\n" for i in range(40)), "t"),  # uneven
     ("t,r\n" + "".join(f"{0.1 * i},{'x' if i == 5 else i}\n" for i in range(40)), "r"),
     ("t,q\n" + "".join(f"{0.1 * i},{i}\n" for i in range(40)), "motion.series.columns"),
+    ("time,r\n" + "".join(f"{0.1 * i},{i}\n" for i in range(40)), "motion.series.time: no "
+     "column 't'"),                                # the time column is named by its key
 ])
 def test_bad_records(tmp_path, content, key):
     (tmp_path / "rec.csv").write_text(content)

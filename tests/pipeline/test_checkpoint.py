@@ -6,12 +6,12 @@ import os
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
 import xarray as xr
 import yaml
+from conftest import cpu_limited
 
 import uq.pipeline.sweep
 from uq.cli import main
@@ -98,75 +98,87 @@ def test_a_checkpoint_has_one_owner(tmp_path):
 
 def test_a_second_command_on_the_same_output_is_refused(tmp_path):
     """Two `uq run` on one output: the second is refused at once (exit 2), the first
-    finishes. The first holds its first chunk until the second has answered (a file
-    'go'), so the two overlap however busy the machine is."""
+    finishes with the uninterrupted result. The first stops itself (SIGSTOP) once it holds
+    the checkpoint, so the second always meets it running, however loaded the machine."""
     path = tmp_path / "s.yaml"
-    path.write_text(yaml.safe_dump({**SWEEP, "sampling": {"n": 3000, "seed": 7}}))
-    first = subprocess.Popen([sys.executable, "-c", HELD, str(path)], cwd=tmp_path,
-                             stderr=subprocess.PIPE, text=True)
+    path.write_text(yaml.safe_dump(SWEEP))
+    first = subprocess.Popen([sys.executable, "-c", KILLABLE, str(path)], cwd=tmp_path,
+                             env={**os.environ, STOP_AT: "start"}, stderr=subprocess.PIPE,
+                             text=True, preexec_fn=cpu_limited())
+    wait_until_stopped(first)
     try:
-        deadline = time.monotonic() + 300           # (a safeguard: a hung child fails)
-        while not (tmp_path / "out.nc.partial" / "manifest.json").exists():
-            assert time.monotonic() < deadline and first.poll() is None
-            time.sleep(0.05)
         second = subprocess.run([sys.executable, "-m", "uq.cli", "run", str(path), "--quiet",
-                                 "-o", "out.nc"], cwd=tmp_path, capture_output=True, text=True)
-        assert first.poll() is None                 # still holding its first chunk
+                                 "-o", "out.nc"], cwd=tmp_path, capture_output=True,
+                                text=True, preexec_fn=cpu_limited())
     finally:
-        (tmp_path / "go").write_text("")
-    assert first.wait(timeout=300) == 0, first.stderr.read()
+        first.send_signal(signal.SIGCONT)
+    assert first.wait() == 0, first.stderr.read()
     assert second.returncode == 2 and "in use by another run" in second.stderr
     assert len(second.stderr.strip().splitlines()) == 1
+    assert (tmp_path / "out.nc").exists()
 
 
-#: `uq run -o out.nc` whose first chunk waits for a file 'go' before it is kept.
-HELD = """
-import pathlib, sys, time
-import uq.pipeline.checkpoint as checkpoint
-save = checkpoint.Checkpoint.save
-def held(self, index, dataset):
-    while not pathlib.Path("go").exists():
-        time.sleep(0.02)
-    return save(self, index, dataset)
-checkpoint.Checkpoint.save = held
-from uq.cli import main
-sys.exit(main(["run", sys.argv[1], "--quiet", "-o", "out.nc"]))
-"""
+def wait_until_stopped(child):
+    """Wait until `child` has stopped itself (SIGSTOP); fail if it exited instead."""
+    _, status = os.waitpid(child.pid, os.WUNTRACED)
+    if not os.WIFSTOPPED(status):
+        child.returncode = os.waitstatus_to_exitcode(status)
+        raise AssertionError(f"the child exited with status {child.returncode} before it "
+                             f"stopped: {child.stderr.read() if child.stderr else ''}")
 
 
 def test_kill_9_then_resume_is_bit_identical(tmp_path):
+    """kill -9 after exactly the second chunk (the child stops itself there), then
+    --resume: the result of an uninterrupted run, bit for bit."""
     path = tmp_path / "s.yaml"
     path.write_text(yaml.safe_dump({**SWEEP, "sampling": {"n": 60_000, "seed": None}}))
     env = dict(os.environ)
     child = subprocess.Popen([sys.executable, "-c", KILLABLE, str(path)], cwd=tmp_path,
-                             env=env)
+                             env={**env, STOP_AT: "save 2"}, preexec_fn=cpu_limited())
     partial = tmp_path / "out.nc.partial"
-    deadline = time.monotonic() + 120
-    while len(list(partial.glob("chunk-*.nc.sha256"))) < 2:
-        assert time.monotonic() < deadline and child.poll() is None
-        time.sleep(0.02)
+    wait_until_stopped(child)
     child.send_signal(signal.SIGKILL)
     child.wait()
+    assert len(list(partial.glob("chunk-*.nc.sha256"))) == 2
     assert not (tmp_path / "out.nc").exists()
     resumed = subprocess.run([sys.executable, "-c", KILLABLE, str(path), "--resume"],
-                             cwd=tmp_path, env=env, capture_output=True, text=True)
+                             cwd=tmp_path, env=env, capture_output=True, text=True,
+                             preexec_fn=cpu_limited())
     assert resumed.returncode == 0, resumed.stderr
     with xr.open_dataset(tmp_path / "out.nc") as ds:
         out = ds.load()
     clean = subprocess.run([sys.executable, "-c", KILLABLE, str(path), "-o", "clean.nc",
                             "--set", f"sampling.seed={out.attrs['seed']}"],
-                           cwd=tmp_path, env=env, capture_output=True, text=True)
+                           cwd=tmp_path, env=env, capture_output=True, text=True,
+                           preexec_fn=cpu_limited())
     assert clean.returncode == 0, clean.stderr
     with xr.open_dataset(tmp_path / "clean.nc") as ds:
         same(out, ds.load())
     assert not partial.exists()
 
 
+#: Environment variable that makes KILLABLE stop itself (SIGSTOP): "start" once it holds
+#: the checkpoint and has written its manifest, "save N" after its N-th chunk.
+STOP_AT = "UQ_TEST_STOP_AT"
+
 #: `uq run` with one scene per chunk (so the sweep has several chunks to kill between).
 KILLABLE = """
-import sys
+import os, signal, sys
 import uq.pipeline.sweep
+from uq.pipeline.checkpoint import Checkpoint
 uq.pipeline.sweep.SWEEP_CHUNK_ELEMENTS = uq.pipeline.sweep.SWEEP_CHUNK_ELEMENTS_COMPILED = 1
+where, _, count = os.environ.get("UQ_TEST_STOP_AT", "").partition(" ")
+def stopping(method, after):
+    calls = []
+    def wrapped(self, *args):
+        result = method(self, *args)
+        calls.append(1)
+        if len(calls) == after:
+            os.kill(os.getpid(), signal.SIGSTOP)
+        return result
+    return wrapped
+if where:
+    setattr(Checkpoint, where, stopping(getattr(Checkpoint, where), int(count or 1)))
 from uq.cli import main
 args = sys.argv[1:]
 extra = [] if "-o" in args else ["-o", "out.nc"]

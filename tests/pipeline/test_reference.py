@@ -65,3 +65,27 @@ def _with(key, value):
 def test_bounded_keys_were_found():
     assert {"wind.speed", "wind.shear", "ship.pitch", "lidar.half_cone",
             "sampling.n"} <= {key for key, _, _ in BOUNDED}
+
+
+def test_each_key_has_its_own_meaning():
+    """Issue 27: no sentence shared by several keys (the per-degree-of-freedom rows of
+    motion stand for every degree of freedom, one row each)."""
+    meanings = {}
+    for key in ROWS:
+        meanings.setdefault(reference.meaning(key)[1], []).append(key)
+    assert {text: keys for text, keys in meanings.items() if len(keys) > 1} == {}
+
+
+def test_sweep_correlation_time_and_required_keys_are_in_the_table():
+    text = reference.render()
+    for key in ("sweep", "ins.<error>.correlation_time", "lidar.azimuths"):
+        assert f"| `{key}` |" in text
+    assert "| `motion.spectrum.hs` | number | m | **required** |" in text
+    assert "Every key is optional" not in text
+    assert "omega x r is not removed" in text and "Longuet-Higgins" in text
+
+
+def test_every_key_without_required_is_optional():
+    """What the reference calls optional is: the default scenario of the validator
+    fills every key whose default is not **required** (an empty scenario is valid)."""
+    assert load_scenario({}).settings["lidar"]["azimuths"] == DEFAULTS["lidar"]["azimuths"]

@@ -1,5 +1,6 @@
-"""Command line: ``uq run``, ``uq check``, ``uq plot``, ``uq report``, ``uq bench``,
-``uq fit``, ``uq golden``, ``uq --version``; one module per subcommand.
+"""Command line: ``uq run``, ``uq check``, ``uq list``, ``uq plot``, ``uq report``,
+``uq export``, ``uq bench``, ``uq fit``, ``uq golden``, ``uq --version``; one module per
+subcommand.
 
 The command line dispatches; it computes nothing. Each subcommand module adds its
 parser and imports what it needs only when it runs, so ``uq --help`` and ``uq --version``
@@ -12,13 +13,13 @@ allowed; no traceback; no output file); 1 anything else; 130 interrupted (Ctrl-C
 import sys
 
 from uq._version import __version__
-from uq.cli import bench, check, fit, golden, plot, report, run
+from uq.cli import bench, check, export, fit, golden, listing, plot, report, run
 from uq.cli.common import (EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK,  # noqa: F401
                            EXIT_TERMINATED, Parser, add_common_options, configure_logging,
                            interrupted_status, parse_overrides, stop_on_sigterm)
 from uq.errors import InputError
 
-SUBCOMMANDS = (run, check, plot, report, bench, fit, golden)
+SUBCOMMANDS = (run, check, listing, plot, report, export, bench, fit, golden)
 
 
 def build_parser():

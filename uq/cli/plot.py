@@ -1,4 +1,4 @@
-"""``uq plot RESULTS.nc [-o FOLDER] [--format png|pdf|svg] [--select DIM=VALUE]``."""
+"""``uq plot RESULTS.nc | NAME [-o FOLDER] [--format png|pdf|svg] [--select DIM=VALUE]``."""
 from pathlib import Path
 
 from uq.cli.common import EXIT_OK, say
@@ -9,7 +9,8 @@ def add_parser(commands):
     plot = commands.add_parser("plot", help="draw the figures a results file supports: "
                                "single scenes, sweeps of 1-3 dimensions, Rubio & Gottschall "
                                "(2022) Figs. 2-7")
-    plot.add_argument("results", help="results file of uq run (netCDF)")
+    plot.add_argument("results", help="results file of uq run (netCDF), or the name of a "
+                      "run (results/NAME.nc)")
     plot.add_argument("-o", "--output", help="folder for the figures "
                       "(default: beside the results, <name>_figures/)")
     plot.add_argument("--format", action="append", choices=("png", "pdf", "svg"),
@@ -36,10 +37,13 @@ def parse_select(items):
     return select
 
 
-def open_results(path):
-    """(path, Dataset) of a results file of ``uq run``; bad input names the file."""
+def open_results(argument):
+    """(path, Dataset) of the results file of ``uq run`` that a command-line argument
+    names (a path, or the name of a run: ``results/NAME.nc``); bad input names the file."""
     from uq.pipeline.results import open_results as read
-    return Path(path), read(Path(path))
+    from uq.pipeline.shipped import results_path
+    path = results_path(argument)
+    return path, read(path)
 
 
 def command(args):

@@ -1,4 +1,4 @@
-"""``uq report RESULTS.nc [-o REPORT.html] [--target U]``."""
+"""``uq report RESULTS.nc | NAME [-o REPORT.html] [--target U]``."""
 from pathlib import Path
 
 from uq.cli.common import EXIT_OK, say
@@ -9,7 +9,8 @@ from uq.errors import ScenarioError
 def add_parser(commands):
     report = commands.add_parser("report", help="write a self-contained HTML report of a "
                                  "results file: scenario, figures, tables, planning answers")
-    report.add_argument("results", help="results file of uq run (netCDF)")
+    report.add_argument("results", help="results file of uq run (netCDF), or the name of "
+                        "a run (results/NAME.nc)")
     report.add_argument("-o", "--output", help="report file (default: beside the results, "
                         "<name>_report.html)")
     report.add_argument("--target", type=float, action="append", metavar="U",

@@ -132,8 +132,11 @@ def dask_client(args):
         yield None
         return
     # dask's own log lines (task cancelled at Ctrl-C, ...) are not the user's business;
-    # workers read this from the environment they inherit
-    os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "error")
+    # workers read this from the environment they inherit. "critical", not "error": on a
+    # loaded machine a worker's heartbeat can meet the scheduler already closed at Ctrl-C
+    # and log that as an error with a traceback; a failing task still reaches the user
+    # as the exception it raised, through the client.
+    os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "critical")
     try:
         from dask.distributed import Client, LocalCluster
     except ImportError:

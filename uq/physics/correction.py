@@ -61,6 +61,36 @@ CORRECTION_MODELS = tuple(model.key for model in Correction)
 STATIC_CORRECTION_MODELS = tuple(model.key for model in Correction
                                  if model != Correction.POINTWISE)
 
+#: What each correction model does to the lidar-frame wind, and exactly which platform
+#: velocity it removes (the results' ``correction_description`` attribute and the scenario
+#: reference). "Per scan": one INS reading for all beams, taken at the scan's mid time when
+#: the platform moves during the scan (``motion``). The INS reports the velocity of its own
+#: point; the lidar, a lever arm r away, moves at that velocity plus omega x r (R'(t) r).
+#: Only ``pointwise`` adds omega x r; the per-scan models remove the INS point's velocity.
+CORRECTION_DESCRIPTIONS = {
+    "none": "no motion correction: the wind is reconstructed in a frame assumed level at "
+            "the nominal heading; no platform velocity is removed",
+    "yaw": "per scan: rotates the wind by the INS heading and removes the INS's horizontal "
+           "velocity (sog, cog); no pitch or roll, no vertical velocity, no lever-arm "
+           "velocity omega x r",
+    "tilt2d": "per scan: Rubio & Gottschall (2022) Eq. 13, the INS rotation (heading, "
+              "pitch, roll) applied to the horizontal lidar-frame components only, and "
+              "the INS's horizontal velocity removed; vertical wind uncorrected; no "
+              "lever-arm velocity omega x r",
+    "full": "per scan: the INS rotation (heading, pitch, roll) applied to all three "
+            "lidar-frame components and the INS's velocity removed, heave included; the "
+            "velocity of the INS's own point: the lever arm's omega x r is not removed",
+    "pointwise": "per beam: each beam corrected with the INS attitude and velocity read at "
+                 "its own time stamp, the lidar's velocity taken as the INS's plus the "
+                 "lever arm's omega x r at that time, then least squares",
+}
+
+
+def describe_corrections(models):
+    """``"model: what it removes; ..."`` for each of `models` (the results' attribute
+    ``correction_description``)."""
+    return "; ".join(f"{model}: {CORRECTION_DESCRIPTIONS[model]}" for model in models)
+
 
 def correction_rotation(model, heading, pitch, roll, nominal_heading):
     """Lidar-to-earth rotation the correction model believes [rad in, (..., 3, 3) out]."""

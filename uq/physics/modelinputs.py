@@ -136,23 +136,29 @@ def _row(name, key, unit, shape, angular, models, meaning, label=None):
 #: random numbers: a new row goes at the end of its section, never between old ones).
 INPUTS = (
     _row("ins_heading", "ins.heading", "degree", "reading", True, _ALL,
-         "INS heading error"),
+         "error of the INS heading: turns the whole corrected wind"),
     _row("ins_pitch", "ins.pitch", "degree", "reading", True, _ALL,
-         "INS pitch error (positive bow up)"),
+         "error of the INS pitch (bow up): tilts the corrected beams about the "
+         "athwartship axis"),
     _row("ins_roll", "ins.roll", "degree", "reading", True, _ALL,
-         "INS roll error (positive starboard down)"),
+         "error of the INS roll (starboard down): tilts the corrected beams about the "
+         "fore-and-aft axis"),
     _row("ins_sog", "ins.sog", "m s-1", "reading", False, _ALL,
-         "INS speed-over-ground error, along the course"),
+         "error of the INS speed over ground, along the course: enters the wind whole "
+         "where the correction removes the platform velocity"),
     _row("ins_cog", "ins.cog", "degree", "reading", True, _ALL,
-         "INS course-over-ground error"),
+         "error of the INS course over ground: turns the removed horizontal velocity "
+         "(matters in proportion to sog)"),
     _row("ins_heave", "ins.heave", "m s-1", "reading", False, _ALL,
-         "INS vertical-velocity error"),
+         "error of the INS vertical velocity (positive up): enters the vertical wind of "
+         "full and pointwise"),
     _row("lidar_half_cone", "lidar.errors.half_cone", "degree", "scan", True, _ALL,
-         "true minus configured half-cone angle"),
+         "true minus configured half-cone angle (common to all beams: the scanner)"),
     _row("lidar_misalignment", "lidar.errors.misalignment", "degree", "scan", True, _ALL,
-         "true minus configured misalignment (lidar heading relative to the bow)"),
+         "true minus configured misalignment, the lidar's heading relative to the bow "
+         "(the mounting)"),
     _row("lidar_radial_velocity", "lidar.errors.radial_velocity", "m s-1", "beam_gate",
-         False, _ALL, "radial-velocity noise"),
+         False, _ALL, "noise of each radial velocity"),
     _row("lidar_height", "lidar.errors.height", "m", "scan", False, _ALL,
          "true minus configured height of the lidar above sea level (draft, ballast, tide)"),
     _row("lidar_gate_length", "lidar.errors.gate_length", "m", "scan", False, _NUMPY,

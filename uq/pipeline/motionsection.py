@@ -151,8 +151,9 @@ def _read_series(file, version, time, columns):
                      DataFileError, "motion.series.file")
     wanted = [time] + [c for _, c in columns]
     missing = [c for c in wanted if c not in table.columns]
-    if missing:
-        raise DataFileError(str(file), "motion.series.columns", f"no column "
+    if missing:                  # named by the key that asked for it: time or columns
+        key = "motion.series.time" if missing[0] == time else "motion.series.columns"
+        raise DataFileError(str(file), key, f"no column "
                             f"{', '.join(map(repr, missing))}; allowed: "
                             f"{', '.join(map(str, table.columns[:12]))}")
     data = {}

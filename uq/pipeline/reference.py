@@ -16,7 +16,9 @@ from pathlib import Path
 import numpy as np
 
 from uq.physics import modelinputs
+from uq.physics.correction import CORRECTION_DESCRIPTIONS
 from uq.pipeline import scenario as scenario_module
+from uq.pipeline.probesection import KIND_PARAMETERS
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS
 from uq.pipeline.probesection import PROBE_ERROR_KEYS
 from uq.pipeline.scenario import DEFAULTS, Checker
@@ -76,7 +78,9 @@ MEANINGS = {
     "lidar.height": ("m", "height of the lidar above sea level"),
     "lidar.ranges": ("m", "range-gate heights above a level lidar"),
     "lidar.half_cone": ("deg", "half-cone angle of the slanted beams, from vertical"),
-    "lidar.azimuths": ("deg", "beam azimuths, clockwise from the reference beam"),
+    "lidar.azimuths": ("deg", "beam azimuths, clockwise from the reference beam: a list, "
+                       "or {start, stop, step} (stop excluded; e.g. a conical scan of 50 "
+                       "lines of sight: {start: 0, stop: 360, step: 7.2})"),
     "lidar.vertical_beam": ("", "a vertical beam besides the slanted ones"),
     "lidar.misalignment": ("deg", "angle from the bow to the reference beam, clockwise"),
     "lidar.probe.kind": ("", "range weighting of each radial velocity along its beam: "
@@ -95,11 +99,8 @@ MEANINGS = {
                                "this fraction of its peak (abs(s) <= sqrt(1/t - 1) z_R); "
                                "part of the model (the Lorentzian's variance is infinite), stated "
                                "in the results' probe attribute"),
-    "correction": ("", "motion correction: none, yaw (heading and ship velocity), tilt2d "
-                   "(Rubio & Gottschall 2022 Eq. 13 as written), full (rotation of all "
-                   "three components and the ship velocity), with one INS reading per scan; "
-                   "pointwise: each beam with the INS read at its own time stamp, lever "
-                   "arm included"),
+    "correction": ("", "motion correction; what each removes is stated below (Correction "
+                   "models) and in the results' correction_description attribute"),
     "sampling.method": ("", "mc, lhs, sobol, or none (GUM and the paper's model only)"),
     "sampling.n": ("1", "Monte Carlo trials per scene (give n or digits)"),
     "sampling.digits": ("1", "adaptive sampling to this many significant digits "
@@ -131,7 +132,8 @@ MEANINGS = {
                                    "a random phase"),
     "motion.spectrum.band": ("Hz", "[lowest, highest] frequency (default [0.5, 4] / tp)"),
     "motion.response.<dof>.factor": ("deg m-1 or m m-1", "motion of a degree of freedom "
-                                     "per metre of wave amplitude (a flat response)"),
+                                     "per metre of wave amplitude (a flat response; "
+                                     "typical values below, Response factors)"),
     "motion.response.<dof>.lag": ("deg", "phase lag of that degree of freedom"),
     "motion.series.file": ("", "CSV of a measured motion record (relative to the "
                            "scenario file); each trial reads a random window of it"),
@@ -150,8 +152,10 @@ MEANINGS = {
     "ins.rate": ("Hz", "INS sampling rate (absent: a continuous INS)"),
     "ins.interpolation": ("", "reading between INS samples: nearest, or linear (the "
                           "default; attitude on the rotation group); needs ins.rate"),
-    "ins.*.correlation_time": ("s", "Gauss-Markov correlation time of an INS error "
-                               "between the beams (0: independent, .inf: one per scan)"),
+    "ins.<error>.correlation_time": ("s", "Gauss-Markov correlation time of that INS "
+                                     "error between the beams, timed by lidar.scan (0: "
+                                     "independent per beam, .inf: one per scan); in any "
+                                     "error of ins.heading ... ins.heave"),
     "fit.profile": ("", "wind-profile model of uq fit"),
     "fit.reference_height": ("m", "z_ref of the power law"),
     "fit.scatter": ("", "fit an extra scatter ln_sigma"),
@@ -167,8 +171,42 @@ MEANINGS = {
     "fit.ensembles": ("1", "independent ensembles (for R-hat)"),
     "fit.max_steps": ("1", "steps per ensemble before a fit is declared not converged"),
     "fit.seed": ("1", "seed of the chains"),
-    "fit.columns.*": ("", "CSV column of height, speed, speed_u or height_u"),
+    "fit.columns.height": ("", "CSV column of the measurement heights [m]"),
+    "fit.columns.speed": ("", "CSV column of the wind speeds [m s-1]"),
+    "fit.columns.speed_u": ("", "CSV column of the speeds' standard uncertainties [m s-1] "
+                            "(absent: the fit's scatter alone)"),
+    "fit.columns.height_u": ("", "CSV column of the heights' standard uncertainties [m] "
+                             "(absent: exact heights)"),
+    "sweep": ("", "scenes to run: dotted keys mapped to a list of values, {start, stop, "
+              "step} (stop excluded) or {same_as: another.swept.key}; the outer product "
+              "(see Sweeps below)"),
 }
+#: Why the per-scan models leave the lever arm's velocity in (docs/scenario.md).
+PER_SCAN_LEVER_ARM = (
+    "The per-scan models (`yaw`, `tilt2d`, `full`) take one INS reading per scan (at the "
+    "scan's mid time when the platform moves during the scan) and remove the velocity "
+    "the INS reports: that of its own point. A lidar `lidar.lever_arm` r away from the "
+    "INS moves at that velocity plus omega x r; the per-scan models do not remove "
+    "omega x r (a lidar 2.5 m above the INS of a buoy rolling 5 deg at 7 s moves ~0.2 m/s "
+    "faster or slower than the INS), `pointwise` does, at each beam's time stamp. "
+    "Without `motion` the platform does not rotate and the two are the same.")
+#: Typical response factors of a buoy (docs/scenario.md, "Response factors").
+RESPONSE_FACTORS = (
+    "`motion.response` moves each degree of freedom by a factor per metre of wave "
+    "amplitude (one factor and lag for every wave component). For a buoy small against "
+    "the wave length that follows the sea surface, linear (Airy) deep-water wave theory "
+    "gives the factors: it heaves with the surface, **1 m/m**; it surges with the "
+    "horizontal orbital motion, **1 m/m**, a quarter period from the heave (a lag of "
+    "90 deg, its sign set by the waves' direction against the bow); "
+    "and it tilts with the surface slope, k a for a wave of amplitude a and wave number "
+    "k = omega^2 / g, i.e. **(2 pi / Tp)^2 / g rad/m**: 9.2 deg/m at Tp = 5 s, "
+    "4.7 deg/m at 7 s, 2.3 deg/m at 10 s (pitch for waves from ahead, roll from abeam; "
+    "Longuet-Higgins, Cartwright & Smith 1963, who measured directional wave spectra "
+    "from exactly this slope-following of a pitch-roll buoy; Holthuijsen 2007, *Waves "
+    "in Oceanic and Coastal Waters*, Ch. 7). A larger hull (a 3 m discus or a spar "
+    "lidar buoy) filters the waves shorter than itself and responds less: take these as "
+    "upper bounds, and a measured record (`motion.series`) where one exists. "
+    "`floating_lidar_waves` uses roll 4, pitch 3 deg/m, heave 1, surge 0.5 m/m at Tp = 7 s.")
 DISTRIBUTION_MEANINGS = {
     "normal": "N(mean, u^2)",
     "uniform": "U(mean - half_width, mean + half_width); u = half_width / sqrt(3)",
@@ -186,6 +224,11 @@ class RecordingChecker(Checker):
     def __init__(self, source):
         super().__init__(source)
         self.records, self._depth, self.overlay = {}, 0, {}
+        self.required_keys = set()
+
+    def required(self, mapping, prefix, names, needs):
+        self.required_keys.update(f"{prefix}.{name}" for name in names)
+        return super().required(mapping, prefix, names, needs)
 
     def _record(self, kind, key, value, **limits):
         if self._depth:
@@ -233,7 +276,8 @@ class RecordingChecker(Checker):
 
 def recorded_checks():
     """Dotted key -> (kind, value, limits) of every check the validator makes; the value
-    is the default wherever the exemplar leaves the key unset."""
+    is the default wherever the exemplar leaves the key unset, ``REQUIRED`` where the
+    validator requires the key in its section."""
     import tempfile
     with tempfile.TemporaryDirectory() as folder:
         record = Path(folder) / "record.csv"
@@ -250,7 +294,14 @@ def _recorded(series):
         raw = _merge(copy.deepcopy(DEFAULTS), overlay)
         raw["outputs"] = list(scenario_module.OUTPUTS)
         scenario_module._validate(raw, checker.source, checker)
-    return checker.records
+    required = checker.required_keys | {f"lidar.probe.{name}" for name in
+                                        KIND_PARAMETERS["pulsed"] + KIND_PARAMETERS["cw"]}
+    return {key: (kind, REQUIRED if key in required else value, limits)
+            for key, (kind, value, limits) in checker.records.items()}
+
+
+#: The default of a key that must be given when its section is (see :func:`render`).
+REQUIRED = "required"
 
 
 def _merge(base, overlay):
@@ -272,7 +323,7 @@ def error_meaning(key):
     (:mod:`uq.physics.modelinputs`), or None."""
     for row in modelinputs.INPUTS:
         if row.holds_distribution and row.key == key:
-            draw = {"reading": "one per INS reading (ins.correlation)",
+            draw = {"reading": "one reading per scan, or per beam with ins.correlation: beam",
                     "scan": "one draw per scan", "beam_gate": "one draw per beam and gate"}
             needs = " (needs the parameter in lidar.probe)" if \
                 key.rpartition(".")[2] in PROBE_ERROR_KEYS else ""
@@ -306,6 +357,8 @@ def documented_keys(records):
         if parent in errors and not key.endswith(".correlation_time"):
             rows.setdefault(parent, ("distribution", None, {}))
             continue
+        if key.startswith("ins.") and key.endswith(".correlation_time"):
+            key = "ins.<error>.correlation_time"
         if key.startswith("fit.priors."):     # one row per prior key, any parameter
             key, value = "fit.priors.<parameter>." + key.rpartition(".")[2], None
         if key.startswith("motion.series.columns."):
@@ -317,9 +370,10 @@ def documented_keys(records):
             key = "motion.<dof>." + key.rpartition(".")[2]
         if key == "outputs":
             kind = "list of choices"
-        if kind.startswith("list of"):        # the default of the whole list
+        if kind.startswith("list of") and value != REQUIRED:    # the whole list's default
             value = _lookup(DEFAULTS, key) if _is_set(DEFAULTS, key) else None
         rows.setdefault(key, (kind, value, limits))
+    rows["sweep"] = ("mapping", None, {})
     return rows
 
 
@@ -340,6 +394,8 @@ def _allowed(kind, limits):
         return "a distribution (below)"
     if kind == "name":
         return "letters, digits, '_', '.', '-'"
+    if kind == "mapping":
+        return "dotted keys of single values"
     low, high = limits.get("low"), limits.get("high")
     if low is None and high is None:
         return "any finite" if kind != "text" and kind != "boolean" else \
@@ -357,6 +413,10 @@ def _number(value, infinite):
 def _default(key, kind, value):
     if kind == "distribution":
         return "none (no error)"
+    if value == REQUIRED:
+        return "**required**"
+    if key == "sweep":
+        return "none (one scene)"
     if key == "sampling.seed":
         return "none (a new seed, recorded)"
     if value is None or isinstance(value, dict):
@@ -379,8 +439,11 @@ def render():
     lines = ["# Scenario reference", "",
              "Generated from the validator (`python -m uq.pipeline.reference > "
              "docs/scenario.md`); `tests/pipeline/test_reference.py` fails when the two "
-             "drift apart. Every key is optional; unknown keys are an error. Angles are in "
-             "degrees, clockwise; wind direction is where the wind comes from.", "",
+             "drift apart. Every top-level section is optional, and so is every key "
+             "with a default; a key whose default reads **required** must be given "
+             "when its section is (for `lidar.probe`, when its `kind` uses it). Unknown "
+             "keys are an error. Angles are in degrees, clockwise; wind direction is "
+             "where the wind comes from.", "",
              "| key | type | unit | default | allowed | meaning |",
              "|---|---|---|---|---|---|"]
     for key in sorted(rows, key=_order):
@@ -397,7 +460,13 @@ def render():
     lines += ["", "## Sweeps", "",
               "`sweep` maps dotted keys to a list of values, to `{start, stop, step}` (stop "
               "excluded) or to `{same_as: another.swept.key}`; the scenes are the outer "
-              "product. Only single-valued keys can be swept.", ""]
+              "product. Only single-valued keys can be swept."]
+    lines += ["", "## Correction models", "",
+              "What each `correction` removes from the measured radial velocities (the "
+              "same text is the results' `correction_description` attribute):", ""]
+    lines += [f"* `{model}`: {text}." for model, text in CORRECTION_DESCRIPTIONS.items()]
+    lines += ["", PER_SCAN_LEVER_ARM]
+    lines += ["", "## Response factors", "", RESPONSE_FACTORS, ""]
     return "\n".join(lines)
 
 

@@ -21,6 +21,7 @@ from uq.engine.inputs import Input
 from uq.pipeline import probesection
 from uq.pipeline.modelsetup import (MOTION_INPUTS, error_inputs, input_label, scene_from_settings,
                                     skipped_work)
+from uq.physics.correction import describe_corrections
 from uq.physics import probe as probe_volume
 from uq.physics.measurement import measurement_model, true_values
 from uq.physics.modelinputs import error_keys, navigation_keys
@@ -382,6 +383,8 @@ def _global_attributes(scenario, seed, dataset, started, model):
             "scenes": int(dataset["mc_n_samples"].size),
             "seed": seed,
             "correction": scenario.settings["correction"],
+            "correction_description": describe_corrections(
+                dict(scenario.sweep).get("correction", (scenario.settings["correction"],))),
             "ins_correlation": scenario.settings["ins"]["correlation"],
             "runtime_s": time.perf_counter() - started, **_probe_attributes(scenario),
             **({"model": "numpy: the numpy reference model throughout (uq run --model "

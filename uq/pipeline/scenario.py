@@ -11,6 +11,7 @@ Angles are in degrees here (and in results); internally radians. Angles on the c
 wrapped into [0, 360).
 """
 import copy
+import logging
 import math
 import os
 import re
@@ -41,6 +42,8 @@ from uq.pipeline.yamlfile import read_yaml
 
 #: What a scenario file is, in messages about the file itself.
 SCENARIO_KIND = "a YAML scenario"
+
+log = logging.getLogger(__name__)
 
 INS_CORRELATIONS = ("scan", "beam")
 #: The errors of the INS readings (``ins.<key>``) and of the lidar (``lidar.errors.<key>``,
@@ -182,7 +185,58 @@ def load_scenario(path_or_mapping, overrides=None):
                             f"{', '.join(DEFAULTS)}")
     for dotted, value in (overrides or {}).items():
         assign_dotted(raw, dotted, value, source)
-    return _build(raw, source)
+    try:
+        scenario = _build(raw, source)
+    except ScenarioError as error:
+        raise _blame_override(error, overrides or {}) from None
+    for key, text in keys_without_effect(scenario.settings, dict(scenario.sweep)):
+        log.warning("%s: %s: %s", source, key, text)
+    return scenario
+
+
+def _blame_override(error, overrides):
+    """`error` as an error of the ``--set KEY=VALUE`` that set its key (or a key above
+    it), with the file it was applied to; unchanged where no override set it."""
+    for dotted, value in overrides.items():
+        if error.key == dotted or error.key.startswith((dotted + ".", dotted + "[")):
+            text = yaml.safe_dump(value, default_flow_style=True).strip()
+            text = text[:-4].strip() if text.endswith("...") else text
+            return ScenarioError(f"--set {dotted}={text} (applied to {error.source})",
+                                 error.key, error.problem)
+    return error
+
+
+#: Largest half-cone angle [deg] that is taken for a slip into radians (pi/2 rad is
+#: 90 deg; a lidar's half-cone is 15-40 deg, and 1.57 deg is none a lidar has).
+RADIAN_LOOKING_HALF_CONE = math.pi / 2
+
+
+def keys_without_effect(settings, sweep=None):
+    """(dotted key, why) of each key of validated `settings` that changes no number in
+    this scene, or looks like a slip (a half-cone in radians); `sweep` maps swept keys to
+    their values. ``load_scenario`` warns of each on stderr."""
+    sweep = sweep or {}
+    moving = bool(settings.get("motion"))
+    ins, lidar = settings["ins"], settings["lidar"]
+    timed = any("correlation_time" in ins[k] for k in INS_KEYS if k in ins)
+    found = []
+    if "rate" in ins and not moving:
+        found.append(("ins.rate", "has no effect without a motion section (an INS on a "
+                      "platform at rest reads the same at every sample: the same model, "
+                      "other random draws); allowed: add motion, or leave ins.rate out"))
+    if "scan" in lidar and not moving and not timed:
+        found.append(("lidar.scan", "has no effect without a motion section or an INS "
+                      "error's correlation_time (the beams' times matter only where "
+                      "something changes between them)"))
+    if "pointwise" in {settings["correction"], *sweep.get("correction", ())} and not moving:
+        found.append(("correction", "pointwise gives the numbers of full without a motion "
+                      "section (every beam sees the platform of the scan); allowed: add "
+                      "motion, or correction: full"))
+    if lidar["half_cone"] <= RADIAN_LOOKING_HALF_CONE:
+        found.append(("lidar.half_cone", f"{lidar['half_cone']:g} deg: angles are in "
+                      f"degrees; {lidar['half_cone']:g} rad would be "
+                      f"{math.degrees(lidar['half_cone']):.1f} deg"))
+    return found
 
 
 def assign_dotted(raw, dotted, value, source):
@@ -310,6 +364,7 @@ def _ins_error(check, spec, key):
 
 def _lidar(check, value):
     lid = _section(check, value, "lidar", OPTIONAL_LIDAR_KEYS)
+    lid["azimuths"] = _azimuth_steps(check, lid["azimuths"])
     check.length(lid["ranges"], "lidar.ranges", MAX_GATES)
     check.length(lid["azimuths"], "lidar.azimuths", MAX_BEAMS)
     out = {"height": check.number(lid["height"], "lidar.height", low=0.0),
@@ -354,6 +409,32 @@ def _check_time_resolved(check, settings):
     check_dwell(check, settings)
     lidar = settings["lidar"]
     check_record(settings, len(lidar["azimuths"]) + int(lidar["vertical_beam"]))
+
+
+def _azimuth_steps(check, value):
+    """``lidar.azimuths`` as a list: a list as it is, ``{start, stop, step}`` (stop
+    excluded) as its values, counted against MAX_BEAMS before they are made."""
+    if not (isinstance(value, dict) and set(value) == {"start", "stop", "step"}):
+        if isinstance(value, dict):
+            check.fail("lidar.azimuths", "expected a list of angles or {start, stop, step} "
+                       f"(stop excluded), got a mapping of {', '.join(map(str, value))}")
+        return value
+    start, stop, step = (check.number(value[k], f"lidar.azimuths.{k}", low=-FULL_CIRCLE_DEG,
+                                      high=FULL_CIRCLE_DEG) for k in ("start", "stop", "step"))
+    span = (stop - start) / step if step else math.nan
+    if not span > 0:
+        check.fail("lidar.azimuths", "start, stop, step give no angles; allowed: step != 0 "
+                   "pointing from start towards stop (stop excluded)")
+    count = math.ceil(span - STEP_ROUNDING)
+    if count > MAX_BEAMS:
+        check.fail("lidar.azimuths", f"start, stop, step give {count} beams; allowed: at "
+                   f"most {MAX_BEAMS}")
+    return [start + i * step for i in range(count)]
+
+
+#: Part of a step by which {start, stop, step} may overshoot stop and still exclude it
+#: (rounding of a step such as 7.2 = 360/50, which is not exact in binary) [1].
+STEP_ROUNDING = 1e-9
 
 
 def _check_beams_determine_wind(check, lidar):
@@ -525,7 +606,7 @@ def _sweep_values(spec, key, source):
             raise ScenarioError(source, key, f"start, stop, step give {span:.3g} values; "
                                 f"allowed: at most {max_scenes()} (environment variable "
                                 "UQ_MAX_SCENES)")
-        count = math.ceil(span - 1e-9)
+        count = math.ceil(span - STEP_ROUNDING)
         return _Steps(start, step, count)
     raise ScenarioError(source, key, "must be a list of values, {start, stop, step} or "
                         "{same_as: another swept key}")

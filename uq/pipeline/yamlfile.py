@@ -17,7 +17,8 @@ from pathlib import Path
 
 import yaml
 
-from uq.constants import MAX_CONFIG_BYTES, MAX_CONFIG_DEPTH, MAX_CONFIG_NODES
+from uq.constants import (MAX_BEAMS, MAX_CONFIG_BYTES, MAX_CONFIG_DEPTH, MAX_CONFIG_NODES,
+                          MAX_GATES)
 from uq.errors import ScenarioError
 from uq.pipeline.inputfile import decode, read_bytes
 
@@ -48,9 +49,7 @@ def parse_yaml(text, source):
     except ScenarioError:
         raise
     except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark else ""
-        raise ScenarioError(source, "", f"not valid YAML{where}") from None
+        raise ScenarioError(source, "", f"not valid YAML{_where(error, text)}") from None
     except ValueError as error:             # e.g. an integer of more than 4300 digits
         raise ScenarioError(source, "", f"cannot read a value ({str(error)[:80]}); "
                             "allowed: numbers of at most a few hundred digits") from None
@@ -59,6 +58,25 @@ def parse_yaml(text, source):
                             "allowed: a scenario's few levels") from None
     finally:
         loader.dispose()
+
+
+#: Characters of a line shown around the place of a YAML syntax error.
+SHOWN_LINE = 60
+
+
+def _where(error, text):
+    """`` at line L, column C: problem (here: "text ^text")`` for a YAML error with a
+    place: the line as written, a caret where the parser stopped (one line)."""
+    mark = getattr(error, "problem_mark", None)
+    if mark is None:
+        return ""
+    lines = text.splitlines()
+    line = lines[mark.line] if mark.line < len(lines) else ""
+    first = max(0, mark.column - SHOWN_LINE // 2)
+    shown = line[first:mark.column] + "^" + line[mark.column:first + SHOWN_LINE]
+    problem = getattr(error, "problem", None)
+    return (f" at line {mark.line + 1}, column {mark.column + 1}"
+            f"{': ' + problem if problem else ''} (here: {shown.strip()!r})")
 
 
 class _Loader(yaml.SafeLoader):
@@ -83,13 +101,14 @@ def _check_nodes(root, source):
     """Check the composed document before anything is built: every key once per mapping,
     only plain YAML tags, and at most MAX_CONFIG_NODES values once aliases are expanded.
     Each problem names the dotted key where it sits (shared nodes are visited once)."""
-    sizes, open_nodes = {}, set()
+    sizes, open_nodes, aliased = {}, set(), []
 
     def size(node, path):
         if id(node) in open_nodes:
             _fail(source, path, f"a YAML alias refers to itself (line "
                   f"{node.start_mark.line + 1}); allowed: aliases of finished values")
         if id(node) in sizes:
+            aliased.append(path)                 # a node seen twice: an alias
             return sizes[id(node)]
         open_nodes.add(id(node))
         _check_tag(node, path, source)
@@ -102,8 +121,9 @@ def _check_nodes(root, source):
             total = 1
         open_nodes.discard(id(node))
         if total > MAX_CONFIG_NODES:
-            _fail(source, path, f"expands to more than {MAX_CONFIG_NODES} values (YAML "
-                  "aliases or a long list); allowed: a scenario's few hundred values")
+            _fail(source, path, f"more than {MAX_CONFIG_NODES} values"
+                  f"{' once its YAML aliases are expanded' if aliased else ''}; allowed: "
+                  f"a scenario's few hundred values{LIST_BOUNDS.get(path, '')}")
         sizes[id(node)] = total
         return total
 
@@ -148,3 +168,9 @@ _MERGE = _STANDARD + "merge"
 
 def _fail(source, path, problem):
     raise ScenarioError(source, path or "", problem)
+
+
+#: What the validator allows in the lists a file may make long (said where a file holds
+#: more values than MAX_CONFIG_NODES).
+LIST_BOUNDS = {"lidar.ranges": f" (at most {MAX_GATES} range gates)",
+               "lidar.azimuths": f" (at most {MAX_BEAMS} beams)"}
