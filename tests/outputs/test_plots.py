@@ -164,7 +164,7 @@ def test_flat_panels_do_not_force_a_scale_each():
 
 
 def test_monte_carlo_error_bars_fall_back_to_the_normal_standard_error(sweeps):
-    """2000 trials make no two batches of 2^14: the stored standard error of u is NaN and
+    """2000 trials make no two batches of 2^10: the stored standard error of u is NaN and
     the error bars use that of the standard deviation of N normal draws, u/sqrt(2(N-1))."""
     from uq.outputs.plots import u_standard_error
     ds = sweeps[1]

@@ -278,11 +278,13 @@ class StreamingStatistics:
         are computed from the element-major copy)."""
         self.add(values, max(len(values), 1))
 
-    def add(self, values, batch_size, summarize=False, kind="symmetric"):
+    def add(self, values, batch_size, summarize=False, kind="symmetric", summary_size=None):
         """Add samples (m, *shape) batch by batch: each batch's moments are merged in
         order (so the result does not depend on how the samples were chunked, when
         chunks start on batch boundaries). With `summarize`, returns the mean, u, low
-        and high of every full batch, ``[(start, summary), ...]`` (JCGM 101, 7.9)."""
+        and high of every full batch, ``[(start, summary), ...]`` (JCGM 101, 7.9), or of
+        every full sub-batch of `summary_size` (a divisor of `batch_size`): more, smaller
+        batches for the standard errors, with the same merges, hence the same results."""
         values = np.asarray(values, dtype=float)
         m = len(values)
         flat = values.reshape(m, self.size)          # (a view where the layout allows)
@@ -302,8 +304,8 @@ class StreamingStatistics:
                 statkernels.resultant(columns, offset + start, offset + stop,
                                       self.reference, self._cos, self._sin)
             if summarize and stop - start == batch_size:
-                summaries.append((start, self._summary(columns, offset + start, offset + stop,
-                                                       count, mean, m2, kind)))
+                summaries.extend(self._summaries(columns, offset, start, stop, (count, mean, m2),
+                                                 kind, summary_size or batch_size))
         if self._stored:
             self._count += m
             if self._count * self.size > self._budget:
@@ -311,6 +313,21 @@ class StreamingStatistics:
         else:
             self._add_to_tails(columns[:, :m].T)
         return summaries
+
+    def _summaries(self, columns, offset, start, stop, moments, kind, size):
+        """``[(start, summary), ...]`` of the sub-batches of `size` of the batch
+        [start, stop) (its own `moments` where `size` is the batch's)."""
+        if size >= stop - start:
+            return [(start, self._summary(columns, offset + start, offset + stop, *moments,
+                                          kind))]
+        count, mean, m2 = (np.empty_like(m) for m in moments)
+        out = []
+        for first in range(start, stop - size + 1, size):
+            statkernels.moments(columns, offset + first, offset + first + size, count, mean,
+                                m2)
+            out.append((first, self._summary(columns, offset + first, offset + first + size,
+                                             count, mean, m2, kind)))
+        return out
 
     def _room(self, m):
         """(columns, offset) to write m more samples into: the store (grown by

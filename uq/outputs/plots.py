@@ -204,12 +204,17 @@ def plot_against_gate(dataset):
             ax.plot(values, gates, **model_style(model))
             if model == "mc_u":
                 ax.errorbar(values, gates, xerr=2 * u_standard_error(dataset, quantity),
-                            fmt="none", ecolor="k", elinewidth=0.8, zorder=4)
+                            fmt="none", ecolor="k", elinewidth=0.8, zorder=4,
+                            label=ERROR_BAR_LABEL)
         ax.set_xlabel(quantity_label(quantity))
         ax.grid(alpha=0.3)
     axes[0, 0].set_ylabel(coordinate_label(dataset, "range"))
     axes[0, 0].legend(fontsize=7)
     return figure
+
+
+#: Legend entry of the error bars on the Monte Carlo u: what they are, in the PNG.
+ERROR_BAR_LABEL = "MC u ±2 Monte Carlo standard errors"
 
 
 def u_standard_error(dataset, quantity):
@@ -315,7 +320,8 @@ def plot_against_sweep(dataset, dim=None):
                 if model == "mc_u":                     # +-2 standard errors of u
                     ax.errorbar(x, at[f"{quantity}_mc_u"].values,
                                 yerr=2 * u_standard_error(at, quantity), fmt="none",
-                                ecolor=style["color"], elinewidth=0.7, zorder=4)
+                                ecolor=style["color"], elinewidth=0.7, zorder=4,
+                                label=ERROR_BAR_LABEL if k == 0 else None)
         ax.set_xlabel(coordinate_label(dataset, dim))
         ax.set_ylabel(quantity_label(quantity))
         ax.grid(alpha=0.3)
