@@ -171,3 +171,38 @@ def test_monte_carlo_error_bars_fall_back_to_the_normal_standard_error(sweeps):
     assert np.isnan(ds["wind_speed_mc_u_standard_error"]).all()
     np.testing.assert_allclose(u_standard_error(ds, "wind_speed"),
                                ds["wind_speed_mc_u"] / np.sqrt(2 * (2000 - 1)), rtol=1e-15)
+
+
+def _mesh_of(figure, title):
+    ax = next(ax for ax in figure.axes if ax.get_title().startswith(title))
+    return ax, next(c for c in ax.collections if isinstance(c, QuadMesh))
+
+
+@pytest.mark.parametrize("effect, averaged", [(0.9, True), (6.0, False)])
+def test_monte_carlo_noise_draws_no_structure(sweeps, effect, averaged):
+    """Issue 27, item 3: common random numbers make the Monte Carlo noise of
+    neighbouring scenes alike, and a colour map stretched over it drew "blobs" over
+    misalignment where the model has no effect. A Monte Carlo variation along a swept
+    key within +-2 standard errors (here a smooth one of `effect` x 2 SE peak to peak
+    over misalignment: 0.9 x 2 = 1.8 SE < 4 SE) is averaged away, and the panel says so;
+    a larger one (6 x 2 SE = 12 SE) is drawn."""
+    from uq.outputs.plots import plot_maps
+    ds = sweeps[2].copy()
+    se = ds["wind_speed_mc_u_standard_error"].fillna(
+        ds["wind_speed_mc_u"] / np.sqrt(2 * (ds["mc_n_samples"] - 1)))
+    shape = np.sin(np.deg2rad(2 * ds["lidar_misalignment"]))       # 0 .. 1 .. 0
+    ds["wind_speed_mc_u"] = ds["wind_speed_gum_u"] + effect * 2 * se * shape
+    figure = plot_maps(ds, "wind_speed", "lidar_misalignment", "wind_direction")
+    ax, mesh = _mesh_of(figure, "Monte Carlo")
+    drawn = np.asarray(mesh.get_array()).reshape(ds.sizes["wind_direction"],
+                                                 ds.sizes["lidar_misalignment"])
+    along = np.ptp(drawn, axis=1)                    # spread over misalignment, per row
+    notes = [t.get_text() for t in ax.texts]
+    if averaged:
+        # the mean of each row, to rounding of the float64 mean (1e-12 relative)
+        np.testing.assert_allclose(along, 0, atol=1e-12 * float(np.max(drawn)))
+        assert notes and "±2 Monte Carlo standard errors" in notes[0]
+        assert "lidar misalignment" in notes[0]
+    else:
+        assert np.all(along > 0) and not notes
+    plt.close(figure)

@@ -332,45 +332,104 @@ def plot_against_sweep(dataset, dim=None):
 def plot_maps(dataset, quantity, x, y, facet=None):
     """Maps of u(`quantity`) over the sweep dimensions `x` and `y`, one column per model
     and one row per value of `facet` (a third sweep dimension); a shared colour scale or
-    one per panel (:func:`shared_scale`). With range gates, the middle gate."""
+    one per panel (:func:`shared_scale`). With range gates, the middle gate.
+
+    Monte Carlo noise draws nothing: a Monte Carlo panel whose values all lie within +-2
+    of their standard errors of one value is drawn flat, at its mean, and says so
+    (common random numbers make the noise of neighbouring scenes alike, so it would
+    look like structure); no colour scale spans less than the panels' +-2 standard
+    errors (nor MAP_MIN_RELATIVE_SPAN of their mean)."""
     at, gate_text = middle_gate(dataset)
     models = available_models(at, quantity)
     rows = [None] if facet is None else list(at[facet].values)
+    noise = _map_noise(at, quantity)
     panels = [[at[f"{quantity}_{m}"].sel({facet: r}) if facet else at[f"{quantity}_{m}"]
                for m in models] for r in rows]
-    shared = shared_scale([p.values for row in panels for p in row])
+    bands = [[_panel_noise(noise, m, facet, r) for m in models] for r in rows]
+    smoothed = [[_without_noise(panel, band, (x, y), at) for panel, band in zip(row, band_row)]
+                for row, band_row in zip(panels, bands)]
+    drawn = [[panel for panel, _ in row] for row in smoothed]
+    flats = [[note for _, note in row] for row in smoothed]
+    flat = [p.values for row in drawn for p in row]
+    band = max([b for row in bands for b in row], default=0.0)
+    shared = shared_scale(flat)
     figure, axes = plt.subplots(len(rows), len(models),
                                 figsize=(4.3 * len(models) + 0.8, 3.3 * len(rows) + 0.5),
                                 constrained_layout=True, squeeze=False, sharex=True,
                                 sharey=True)
-    flat = [p.values for row in panels for p in row]
-    limits = (min(np.nanmin(v) for v in flat), max(np.nanmax(v) for v in flat))
-    for i, (row, value) in enumerate(zip(panels, rows)):
+    limits = _panel_limits(np.concatenate([v.ravel() for v in flat]), band)
+    for i, (row, value) in enumerate(zip(drawn, rows)):
         for j, (panel, model) in enumerate(zip(row, models)):
             ax = axes[i, j]
             mesh = ax.pcolormesh(_positions(at[x]), _positions(at[y]),
                                  panel.transpose(y, x).values, shading="nearest",
                                  cmap="viridis", **dict(zip(("vmin", "vmax"), limits if shared
-                                                            else _panel_limits(panel.values))))
+                                                            else _panel_limits(panel.values,
+                                                                               bands[i][j]))))
             _name_ticks(ax.xaxis, at[x])
             _name_ticks(ax.yaxis, at[y])
+            if flats[i][j]:
+                ax.text(0.5, 0.02, flats[i][j], transform=ax.transAxes, ha="center",
+                        va="bottom", fontsize=7, bbox={"facecolor": "white", "alpha": 0.8,
+                                                       "edgecolor": "none"})
             if not shared:
                 bar = figure.colorbar(mesh, ax=ax, label=quantity_label(quantity))
                 bar.formatter.set_useOffset(False)           # the values, not an offset
             title = model_style(model)["label"]
             if facet is not None:
-                title += f"\n{coordinate_label(at, facet)} = {value:g}"
+                title += f"\n{coordinate_label(at, facet)} = {_format(value)}"
             ax.set_title(title, fontsize=9)
             if i == len(rows) - 1:
                 ax.set_xlabel(coordinate_label(at, x))
             if j == 0:
                 ax.set_ylabel(coordinate_label(at, y))
     if shared:
-        figure.colorbar(mesh, ax=axes, label=quantity_label(quantity))
+        bar = figure.colorbar(mesh, ax=axes, label=quantity_label(quantity))
+        bar.formatter.set_useOffset(False)
     scale = "one colour scale" if shared else "one colour scale per panel"
     figure.suptitle(f"u({QUANTITIES[quantity][0]}), {scale}"
                     + (f", {gate_text}" if gate_text else ""), fontsize=10)
     return figure
+
+
+def _map_noise(at, quantity):
+    """Twice the standard error of the Monte Carlo u of every scene (a DataArray), or
+    None without Monte Carlo."""
+    if f"{quantity}_mc_u" not in at:
+        return None
+    u = at[f"{quantity}_mc_u"]
+    normal = u / np.sqrt(2 * (at["mc_n_samples"] - 1))
+    stored = at.get(f"{quantity}_mc_u_standard_error")
+    return 2 * (normal if stored is None else stored.fillna(normal))
+
+
+def _panel_noise(noise, model, facet, value):
+    """The largest +-2 standard errors of a panel [units of u]: 0 for a model without
+    sampling noise (GUM, the paper's)."""
+    if noise is None or not model.startswith("mc_"):
+        return 0.0
+    panel = noise.sel({facet: value}) if facet else noise
+    return float(panel.max()) if np.isfinite(panel).any() else 0.0
+
+
+def _without_noise(panel, band, dims, dataset):
+    """(panel to draw, note): a Monte Carlo panel averaged along each of its `dims` whose
+    variation (the largest spread along it) lies within 2 `band`, i.e. within +-2 standard
+    errors of one value, with a note saying so; unchanged, '' otherwise."""
+    if not band or not np.isfinite(panel.values).any():
+        return panel, ""
+    mean = float(np.nanmean(np.abs(panel.values)))
+    notes = []
+    for dim in dims:
+        spread = float((panel.max(dim) - panel.min(dim)).max())
+        if NUMERICAL_ZERO * mean < spread <= 2 * band:
+            panel = panel * 0 + panel.mean(dim)
+            notes.append(f"{coordinate_label(dataset, dim).split(' [')[0]} "
+                         f"({100 * spread / mean:.2g} %)")
+    if not notes:
+        return panel, ""
+    return panel, (f"averaged over {' and '.join(notes)}: the spread is within\n"
+                   f"±2 Monte Carlo standard errors (±{100 * band / mean:.2g} %)")
 
 
 def _positions(coordinate):
@@ -380,11 +439,12 @@ def _positions(coordinate):
     return values if values.dtype.kind in "iuf" else np.arange(values.size)
 
 
-def _panel_limits(values):
-    """(vmin, vmax) of a panel with its own colour scale: its range, widened about its
-    middle to at least MAP_MIN_RELATIVE_SPAN of its mean magnitude."""
+def _panel_limits(values, band=0.0):
+    """(vmin, vmax) of a colour scale: the values' range, widened about its middle to at
+    least MAP_MIN_RELATIVE_SPAN of their mean magnitude and to +-`band` (the Monte Carlo
+    noise, twice the standard error), so that noise takes few colours."""
     low, high = float(np.nanmin(values)), float(np.nanmax(values))
-    span = MAP_MIN_RELATIVE_SPAN * float(np.nanmean(np.abs(values)))
+    span = max(MAP_MIN_RELATIVE_SPAN * float(np.nanmean(np.abs(values))), 2 * band)
     if high - low >= span:
         return low, high
     middle = (low + high) / 2
