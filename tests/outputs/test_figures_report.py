@@ -115,12 +115,37 @@ def test_a_single_scene_has_figures_and_its_report_the_single_scene_ones(tmp_pat
     path = write_results(single, tmp_path / "one.nc")
     assert main(["plot", str(path)]) == 0
     assert sorted(p.name for p in (tmp_path / "one_figures").iterdir()) == [
-        "budget.png", "histogram.png", "uncertainty_against_gate.png"]
+        "budget.png", "histogram.png", "radial_velocity_per_beam.png",
+        "uncertainty_against_gate.png"]
     page = render_report(single)
     assert len(re.findall("<img ", page)) == len(re.findall("<figcaption><b>[a-z_]+.</b> [A-Za-z]",
-                                                             page)) == 3
+                                                             page)) == 4
     answers = page.split("Campaign-planning answers")[1].split("<h2>Figures")[0]
     assert "for 3 of 3 (3 range gates)" in answers and "scene" not in answers
+
+
+def test_every_requested_output_is_shown(tmp_path):
+    """Issue 27, item 4: gate_height and radial_velocity (requested by
+    floating_lidar_full) were in neither the figures nor the report, although clause 8
+    refuses the GUM for the gate height (a flat-topped distribution from the uniform
+    half-cone error). Each has its budget, bias and u table in the report and a figure
+    panel; the histogram of each output shows the gate where the GUM fails."""
+    from uq.outputs.plots import histogram_gate, sweep_quantities
+    single = uq.run(uq.load_scenario(ROOT / "scenarios" / "floating_lidar_full.yaml",
+                                     {"sampling.n": 4000}))
+    page = render_report(single)
+    for words in ("gate height", "radial velocity"):
+        assert f"Uncertainty budget of {words}" in page and f"<h3>u({words})" in page
+        assert f"<h4>Bias: {words}</h4>" in page
+    assert "beam at 90 deg" in page and "vertical beam" in page
+    assert "gate_height" in sweep_quantities(single)
+    failed = ~single["gate_height_gum_valid"].values
+    gate = histogram_gate(single, "gate_height")
+    assert failed[gate] if failed.any() else gate == single.sizes["range"] // 2
+    valid = single.copy()
+    valid["wind_speed_gum_valid"][:] = True
+    valid["wind_speed_gum_valid"][2] = False
+    assert histogram_gate(valid, "wind_speed") == 2            # not the middle gate
 
 
 def test_report_says_zero_for_rounding_and_folds_the_scenario(results):

@@ -12,7 +12,7 @@ from scipy.stats import norm
 import uq
 from uq.errors import ScenarioError
 from uq.outputs.figures import figure_plan, make_figures, no_figure_reason
-from uq.outputs.plots import plot_budget, plot_histogram, shared_scale
+from uq.outputs.plots import histogram_gate, plot_budget, plot_histogram, shared_scale
 from uq.outputs.samples import scene_trials
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -50,7 +50,8 @@ def labelled(figure):
 
 def test_single_scene_gets_budget_gate_and_histogram_figures(single):
     plan = figure_plan(single)
-    assert [stem for stem, _ in plan] == ["budget", "uncertainty_against_gate", "histogram"]
+    assert [stem for stem, _ in plan] == ["budget", "uncertainty_against_gate", "histogram",
+                                          "radial_velocity_per_beam"]
     for _, function in plan:
         figure = function(single)
         assert labelled(figure)
@@ -86,7 +87,7 @@ def test_histogram_draws_the_runs_own_trials_and_both_intervals(single):
                                rtol=1e-12)
     figure = plot_histogram(single, trials)
     ax = figure.axes[0]
-    gate = single.isel(range=1)
+    gate = single.isel(range=histogram_gate(single, "wind_speed"))
     u, value = float(gate.wind_speed_gum_u), float(gate.wind_speed_gum_value)
     curve = next(line for line in ax.lines if len(line.get_xdata()) > 2)
     assert np.max(curve.get_ydata()) == pytest.approx(1 / (u * np.sqrt(2 * np.pi)), rel=1e-3)
@@ -102,7 +103,7 @@ def test_histogram_draws_the_runs_own_trials_and_both_intervals(single):
 def test_any_1d_and_2d_sweep_gets_figures(sweeps):
     assert [stem for stem, _ in figure_plan(sweeps[1])] == ["uncertainty_against_sweep"]
     stems = [stem for stem, _ in figure_plan(sweeps[2])]
-    assert stems == ["maps_wind_speed", "maps_wind_direction"]    # no vertical-wind u here
+    assert stems == ["uncertainty_against_sweep"]        # 3 x 3 scenes: lines, not maps
     for k in (1, 2):
         for _, function in figure_plan(sweeps[k]):
             figure = function(sweeps[k])
@@ -125,8 +126,7 @@ def test_more_dimensions_name_the_select_that_gives_figures(sweeps, tmp_path):
     reason = no_figure_reason(sweeps[4])
     assert "--select ship_sog=1" in reason and "--select wind_speed=4" in reason
     written = make_figures(sweeps[4], tmp_path, select={"ship_sog": "4", "wind_speed": 8})
-    assert sorted(p.name for p in written) == ["maps_wind_direction_ship_sog_4_wind_speed_8.png",
-                                               "maps_wind_speed_ship_sog_4_wind_speed_8.png"]
+    assert [p.name for p in written] == ["uncertainty_against_sweep_ship_sog_4_wind_speed_8.png"]
     assert no_figure_reason(sweeps[2]) is None
     with pytest.raises(ScenarioError, match="no such sweep dimension"):
         figure_plan(sweeps[4], select={"ship_cog": 0})
@@ -153,7 +153,7 @@ def test_report_of_many_dimensions_says_how_to_get_figures(sweeps):
     page = render_report(sweeps[4])
     assert "--select" in page.split("<h2>Figures</h2>")[1] and "<img" not in page
     page = render_report(sweeps[4], select={"ship_sog": 4, "wind_speed": 8})
-    assert page.count("<img") == 2
+    assert page.count("<img") == 1
 
 
 def test_flat_panels_do_not_force_a_scale_each():
@@ -205,4 +205,23 @@ def test_monte_carlo_noise_draws_no_structure(sweeps, effect, averaged):
         assert "lidar misalignment" in notes[0]
     else:
         assert np.all(along > 0) and not notes
+    plt.close(figure)
+
+
+def test_a_small_sweep_draws_lines_not_maps(sweeps):
+    """Issue 27, item 7: a small sweep (here 3 x 3 scenes) drew maps of 3-valued axes.
+    It draws u against one key with a line per value of the other, each line the
+    result's own numbers."""
+    ds = sweeps[2]
+    (stem, function), = figure_plan(ds)
+    figure = function(ds)
+    ax = figure.axes[0]
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    for value in ds["lidar_misalignment"].values:
+        label = f"GUM, physical model, lidar misalignment {value:g}"
+        np.testing.assert_array_equal(lines[label].get_ydata(), ds["wind_speed_gum_u"].sel(
+            lidar_misalignment=value).values)
+        np.testing.assert_array_equal(lines[label].get_xdata(), ds["wind_direction"].values)
+    texts = [t.get_text() for legend in figure.legends for t in legend.get_texts()]
+    assert "MC u ±2 Monte Carlo standard errors" in texts          # the bars say what they are
     plt.close(figure)

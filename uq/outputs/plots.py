@@ -42,8 +42,13 @@ SHOWN_GATES = 3
 MAP_MIN_RELATIVE_SPAN = 0.01
 #: Largest number of values of a numeric sweep axis that get a tick each [1].
 MAP_VALUE_TICKS = 12
+#: Most columns of a legend under the panels.
+LEGEND_COLUMNS = 4
 #: Histogram bins of the Monte Carlo trials.
 HISTOGRAM_BINS = 80
+#: Height of a histogram panel over its tallest bar or curve [1]: room for the legend
+#: above the data.
+HISTOGRAM_HEADROOM = 1.45
 
 
 def plot_uncertainty_against_direction(results, axes_pair=None):
@@ -185,32 +190,79 @@ def plot_budget(dataset):
     return figure
 
 
+def _gate_name(dataset, gate):
+    """``range gate 100 m`` of gate index `gate` ('' without a range coordinate)."""
+    if "range" not in dataset.coords:
+        return ""
+    ranges = np.atleast_1d(dataset["range"].values)
+    return f"range gate {float(ranges[gate]):g} m"
+
+
 def _gate_text(dataset, gate):
     if "range" not in dataset.dims:
         return "GUM"
     return f"range gate {float(dataset['range'].values[gate]):g} m"
 
 
-def plot_against_gate(dataset):
+def plot_against_gate(dataset, panels=None):
     """Single scene with several range gates: u of each model (Monte Carlo with +-2
-    standard errors of u) against the range gate; one panel per output."""
-    quantities = sweep_quantities(dataset)
-    figure, axes = plt.subplots(1, len(quantities), figsize=(4.2 * len(quantities), 4),
+    standard errors of u) against the range gate; one panel per output (`panels`:
+    (quantity, {dim: index}, title) each, default :func:`output_panels`)."""
+    panels = output_panels(dataset) if panels is None else panels
+    figure, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 4),
                                 sharey=True, constrained_layout=True, squeeze=False)
     gates = dataset["range"].values
-    for ax, quantity in zip(axes[0], quantities):
-        for model in available_models(dataset, quantity):
-            values = dataset[f"{quantity}_{model}"].values
+    for ax, (quantity, where, title) in zip(axes[0], panels):
+        at = dataset.isel(where)
+        for model in available_models(at, quantity):
+            values = at[f"{quantity}_{model}"].values
             ax.plot(values, gates, **model_style(model))
             if model == "mc_u":
-                ax.errorbar(values, gates, xerr=2 * u_standard_error(dataset, quantity),
+                ax.errorbar(values, gates, xerr=2 * u_standard_error(at, quantity),
                             fmt="none", ecolor="k", elinewidth=0.8, zorder=4,
                             label=ERROR_BAR_LABEL)
         ax.set_xlabel(quantity_label(quantity))
+        if title:
+            ax.set_title(title, fontsize=9)
         ax.grid(alpha=0.3)
     axes[0, 0].set_ylabel(coordinate_label(dataset, "range"))
-    axes[0, 0].legend(fontsize=7)
+    legend_below(figure, axes[0, 0])
     return figure
+
+
+def output_panels(dataset):
+    """(quantity, {}, None) per output a sweep figure shows (:func:`sweep_quantities`)."""
+    return [(quantity, {}, None) for quantity in sweep_quantities(dataset)]
+
+
+def beam_panels(dataset, quantity="radial_velocity"):
+    """(quantity, {"beam": k}, "radial velocity, beam at 90 deg") per beam of an output
+    with a beam dimension; [] when the result has no uncertainty of it."""
+    if f"{quantity}_gum_u" not in dataset or "beam" not in dataset[f"{quantity}_gum_u"].dims \
+            or not uncertain(dataset, quantity):
+        return []
+    azimuths = dataset["beam_azimuth"].values if "beam_azimuth" in dataset.coords else \
+        dataset["beam"].values.astype(float)
+    return [(quantity, {"beam": k}, f"{QUANTITIES[quantity][0]}, "
+             + ("vertical beam" if np.isnan(azimuth) else f"beam at {azimuth:g} deg"))
+            for k, azimuth in enumerate(azimuths)]
+
+
+def plot_beams(dataset, quantity="radial_velocity"):
+    """An output with a value per beam (radial velocity): a panel per beam, u against
+    the range gate (a single scene) or the swept key (a 1-D sweep)."""
+    panels = beam_panels(dataset, quantity)
+    if dataset["mc_n_samples"].ndim == 0:
+        return plot_against_gate(dataset, panels)
+    return plot_against_sweep(dataset, panels=panels)
+
+
+def legend_below(figure, ax, fontsize=7):
+    """The legend of `ax`'s lines under the panels, off the data."""
+    handles, labels = ax.get_legend_handles_labels()
+    if handles:
+        figure.legend(handles, labels, loc="outside lower center", fontsize=fontsize,
+                      ncols=min(len(handles), LEGEND_COLUMNS), frameon=False)
 
 
 #: Legend entry of the error bars on the Monte Carlo u: what they are, in the PNG.
@@ -238,21 +290,38 @@ def plot_histogram(dataset, trials):
     trials : dict
         output -> (n, n_gates) trials (:func:`uq.outputs.samples.scene_trials`).
     """
-    at, gate_text = middle_gate(dataset)
     quantities = [q for q in sweep_quantities(dataset) if q in trials]
-    figure, axes = plt.subplots(1, len(quantities), figsize=(4.6 * len(quantities), 3.8),
+    figure, axes = plt.subplots(1, len(quantities), figsize=(4.6 * len(quantities), 4.0),
                                 constrained_layout=True, squeeze=False)
-    gate = dataset.sizes["range"] // 2 if "range" in dataset.dims else 0
     for ax, quantity in zip(axes[0], quantities):
-        _histogram_panel(ax, at, quantity, trials[quantity].reshape(len(trials[quantity]), -1)
-                         [:, gate])
+        gate = histogram_gate(dataset, quantity)
+        at = dataset.isel(range=gate) if "range" in dataset.dims else dataset
+        values = trials[quantity].reshape(len(trials[quantity]), -1)[:, gate]
+        _histogram_panel(ax, at, quantity, values, _gate_name(dataset, gate))
     n = len(next(iter(trials.values())))
-    figure.suptitle(f"Monte Carlo ({n:,} trials) against the GUM"
-                    + (f", {gate_text}" if gate_text else ""), fontsize=10)
+    figure.suptitle(f"Monte Carlo ({n:,} trials) against the GUM; each panel at the range "
+                    "gate where the GUM fails, else the middle one", fontsize=10)
     return figure
 
 
-def _histogram_panel(ax, at, quantity, values):
+def histogram_gate(dataset, quantity):
+    """Index of the range gate a histogram shows: the first where clause 8 refuses the
+    GUM conclusively, else the first where it refuses it, else the middle gate (0
+    without gates)."""
+    if "range" not in dataset.dims:
+        return 0
+    valid = dataset.get(f"{quantity}_gum_valid")
+    if valid is not None:
+        failed = ~valid.values.astype(bool)
+        conclusive = dataset.get(f"{quantity}_gum_validation_conclusive")
+        sure = failed & (conclusive.values.astype(bool) if conclusive is not None else True)
+        for candidates in (sure, failed):
+            if candidates.any():
+                return int(np.flatnonzero(candidates)[0])
+    return dataset.sizes["range"] // 2
+
+
+def _histogram_panel(ax, at, quantity, values, where=""):
     value, u = float(at[f"{quantity}_gum_value"]), float(at[f"{quantity}_gum_u"])
     low, high = float(at[f"{quantity}_mc_low"]), float(at[f"{quantity}_mc_high"])
     if quantity == "wind_direction":                 # on the circle: about the GUM value
@@ -274,9 +343,10 @@ def _histogram_panel(ax, at, quantity, values):
                    if end < value else None)
     ax.set_xlabel(f"{QUANTITIES[quantity][0]} [{QUANTITIES[quantity][2]}]")
     ax.set_ylabel("probability density")
-    ax.set_title(_validation_text(at, quantity, value - k * u - low, value + k * u - high),
-                 fontsize=8)
-    ax.legend(fontsize=6, loc="upper left")
+    ax.set_title(_validation_text(at, quantity, value - k * u - low, value + k * u - high)
+                 + (f"\n{where}" if where else ""), fontsize=8)
+    ax.set_ylim(top=ax.get_ylim()[1] * HISTOGRAM_HEADROOM)      # the legend above the bars
+    ax.legend(fontsize=6, loc="upper left", ncols=2)
 
 
 def _near(values, centre):
@@ -297,36 +367,55 @@ def _validation_text(at, quantity, d_low, d_high):
             f"endpoint differences {d_low:+.2g}, {d_high:+.2g}{tolerance}")
 
 
-def plot_against_sweep(dataset, dim=None):
-    """Any 1-D sweep: u of each model against the swept value, one panel per output;
-    with range gates, a colour per shown gate (model by line style and marker); Monte
-    Carlo with +-2 standard errors of u."""
+def plot_against_sweep(dataset, dim=None, lines=None, panels=None):
+    """u of each model against a swept value, one panel per output (`panels`, see
+    :func:`plot_against_gate`), Monte Carlo with +-2 standard errors of u.
+
+    A colour per value of `lines` (a second, short sweep dimension, e.g. ``correction``:
+    one line per value; then at the middle range gate), else per shown range gate; the
+    model by line style and marker."""
     dim = dim or dataset["mc_n_samples"].dims[0]
-    quantities = sweep_quantities(dataset)
-    figure, axes = plt.subplots(1, len(quantities), figsize=(4.5 * len(quantities), 3.6),
+    panels = output_panels(dataset) if panels is None else panels
+    figure, axes = plt.subplots(1, len(panels), figsize=(4.5 * len(panels), 3.6),
                                 constrained_layout=True, squeeze=False)
-    gates = shown_gates(dataset)
-    x = dataset[dim].values
-    for ax, quantity in zip(axes[0], quantities):
-        for k, gate in enumerate(gates):
-            at = dataset.isel(range=gate) if "range" in dataset.dims else dataset
+    curves = _curves(dataset, lines)
+    for ax, (quantity, where, title) in zip(axes[0], panels):
+        for k, (at, name) in enumerate(curves):
+            at = at.isel(where)
             for model in available_models(dataset, quantity):
                 style = model_style(model)
                 style.setdefault("marker", ".")          # a value alone still shows
-                if len(gates) > 1:
-                    style.update(color=f"C{k}", label=f"{style['label']}, "
-                                 f"{_gate_text(dataset, gate)}")
-                ax.plot(x, at[f"{quantity}_{model}"].values, **style)
+                if len(curves) > 1:
+                    style.update(color=f"C{k}", label=f"{style['label']}, {name}")
+                ax.plot(_positions(dataset[dim]), at[f"{quantity}_{model}"].values, **style)
                 if model == "mc_u":                     # +-2 standard errors of u
-                    ax.errorbar(x, at[f"{quantity}_mc_u"].values,
+                    ax.errorbar(_positions(dataset[dim]), at[f"{quantity}_mc_u"].values,
                                 yerr=2 * u_standard_error(at, quantity), fmt="none",
                                 ecolor=style["color"], elinewidth=0.7, zorder=4,
                                 label=ERROR_BAR_LABEL if k == 0 else None)
+        _name_ticks(ax.xaxis, dataset[dim])
         ax.set_xlabel(coordinate_label(dataset, dim))
         ax.set_ylabel(quantity_label(quantity))
+        if title:
+            ax.set_title(title, fontsize=9)
         ax.grid(alpha=0.3)
-    axes[0, 0].legend(fontsize=6)
+    if lines is not None and "range" in dataset.dims:
+        figure.suptitle(middle_gate(dataset)[1], fontsize=9)
+    legend_below(figure, axes[0, 0])
     return figure
+
+
+def _curves(dataset, lines):
+    """(data, name) per line of :func:`plot_against_sweep`: per value of `lines` (at
+    the middle gate), else per shown gate."""
+    if lines is not None:
+        at = middle_gate(dataset)[0]
+        return [(at.sel({lines: value}), f"{coordinate_label(dataset, lines).split(' [')[0]}"
+                 f" {_format(value)}") for value in dataset[lines].values]
+    if "range" not in dataset.dims:
+        return [(dataset, "")]
+    return [(dataset.isel(range=gate), _gate_text(dataset, gate))
+            for gate in shown_gates(dataset)]
 
 
 def plot_maps(dataset, quantity, x, y, facet=None):

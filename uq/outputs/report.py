@@ -23,7 +23,10 @@ from uq.outputs.figures import (caption, figure_plan, no_figure_reason, select_s
                                 sweep_dimensions)
 from uq.outputs.labels import KEY_WORDS
 
-QUANTITY_UNITS = {"wind_speed": "m/s", "wind_direction": "deg", "vertical_wind": "m/s"}
+QUANTITY_UNITS = {"wind_speed": "m/s", "wind_direction": "deg", "vertical_wind": "m/s",
+                  "gate_height": "m", "radial_velocity": "m/s"}
+#: Most scenes of a sweep whose numbers the report lists scene by scene.
+MAX_TABLE_SCENES = 48
 #: NUMERICAL_ZERO as the text writes it (1e-9).
 _ZERO = f"{NUMERICAL_ZERO:.0e}".replace("e-0", "e-")
 #: Units as the report's text writes them.
@@ -123,7 +126,7 @@ def _answers(dataset, targets):
         out += ["<h3>Largest velocity ratio that keeps u(Vh) under a target</h3><p>VR = sog / "
                 "Vh on the swept grid, for every swept wind speed (direction-averaged u).</p>",
                 _table(("target u(Vh) [m/s]", "model", "largest VR", "limiting Vh [m/s]"), rows)]
-    for quantity in ("wind_speed", "wind_direction", "vertical_wind"):
+    for quantity in QUANTITY_UNITS:
         if f"{quantity}_budget" not in dataset:
             continue
         if not planning.uncertain(dataset, quantity):
@@ -331,8 +334,9 @@ def _summary_tables(dataset):
         if single:
             gates = np.atleast_1d(dataset["range"].values)
             header = ("model",) + tuple(f"range gate {g:g} m" for g in gates)
-            rows = [(label,) + tuple(_number(v) for v in np.atleast_1d(dataset[name].values))
-                    for label, name in names]
+            rows = [(label + beam,) + tuple(_number(v) for v in np.atleast_1d(values))
+                    for label, name in names
+                    for beam, values in _per_beam(dataset, dataset[name])]
         else:
             header = ("model", "min", "median", "max", "outside the model")
             rows = [(label, _number(np.nanmin(v)), _number(np.nanmedian(v)),
@@ -341,6 +345,17 @@ def _summary_tables(dataset):
             header = header[:-1] + (f"outside the model (of {extent(dataset, names[0][1])})",)
         out += [f"<h3>u({quantity.replace('_', ' ')}) [{unit}]</h3>", _table(header, rows)]
     return "\n".join(out)
+
+
+def _per_beam(dataset, variable):
+    """[(", beam at 90 deg", values over the gates), ...] of a variable with a beam
+    dimension, else [("", its values)]."""
+    if "beam" not in variable.dims:
+        return [("", variable.values)]
+    azimuths = dataset["beam_azimuth"].values if "beam_azimuth" in dataset.coords else \
+        variable["beam"].values.astype(float)
+    return [(", vertical beam" if np.isnan(a) else f", beam at {a:g} deg",
+             variable.isel(beam=k).values) for k, a in enumerate(azimuths)]
 
 
 def _number(value):
