@@ -238,3 +238,27 @@ def test_a_correction_sweep_gets_a_budget_column_per_correction():
     budget = page.split("Uncertainty budget of wind direction")[1].split("</table>")[0]
     assert "share, none" in budget and "share, yaw" in budget
     assert "<td>ins.heading</td><td>-</td><td>100.0 %</td>" in budget, budget
+
+
+def test_a_small_sweep_gets_its_answer_as_a_table():
+    """Issue 27, items 5 and 7: a planner's small sweep (here correction x wind
+    direction, 6 scenes) got ranges and maps, its numbers only in the netCDF, and the
+    Run table named one correction. The report lists every scene: its keys, u, the 95 %
+    interval and the bias, the result's own numbers to the 4 digits written; the
+    attribute and the Run table say the correction is swept."""
+    ds = uq.run(uq.load_scenario(ROOT / "scenarios" / "rubio2022_case_i.yaml", {
+        "sampling.n": 2000, "sweep": {"correction": ["yaw", "full"],
+                                      "wind.direction": [0, 90, 180]}}))
+    assert ds.attrs["correction"] == "swept: yaw, full"
+    page = render_report(ds)
+    assert "<td>correction</td><td>swept: yaw, full</td>" in page
+    table = page.split("<h2>Scene by scene</h2>")[1].split("</table>")[0]
+    rows = re.findall(r"<tr>(.*?)</tr>", table)[1:]
+    assert len(rows) == 6
+    for row in rows:
+        cells = re.findall(r"<td>(.*?)</td>", row)
+        at = ds.sel(correction=cells[0], wind_direction=float(cells[1]))
+        assert cells[2] == f"{float(at.wind_speed_mc_u):.4g}"
+        assert cells[3] == f"[{float(at.wind_speed_mc_low):.4g}, " \
+            f"{float(at.wind_speed_mc_high):.4g}]"
+        assert cells[4] == f"{float(at.wind_speed_mc_bias):.4g}"

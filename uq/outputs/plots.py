@@ -21,6 +21,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 from scipy.stats import norm  # noqa: E402
 
@@ -401,8 +402,27 @@ def plot_against_sweep(dataset, dim=None, lines=None, panels=None):
         ax.grid(alpha=0.3)
     if lines is not None and "range" in dataset.dims:
         figure.suptitle(middle_gate(dataset)[1], fontsize=9)
-    legend_below(figure, axes[0, 0])
+    if len(curves) > 1:          # colours for the lines, styles for the models: a short key
+        _key_below(figure, [name for _, name in curves],
+                   available_models(dataset, panels[0][0]))
+    else:
+        legend_below(figure, axes[0, 0])
     return figure
+
+
+def _key_below(figure, names, models):
+    """A legend under the panels: a colour per line (C0, C1, ...), then each model's
+    style in black, then the error bars."""
+    handles = [Line2D([], [], color=f"C{k}", label=name) for k, name in enumerate(names)]
+    for model in models:
+        style = {**model_style(model), "color": "k"}
+        style.setdefault("marker", ".")
+        handles.append(Line2D([], [], **style))
+    if "mc_u" in models:
+        handles.append(Line2D([], [], color="k", marker="|", linestyle="none", markersize=8,
+                              label=ERROR_BAR_LABEL))
+    figure.legend(handles=handles, loc="outside lower center", fontsize=7, frameon=False,
+                  ncols=min(len(handles), LEGEND_COLUMNS))
 
 
 def _curves(dataset, lines):
