@@ -303,9 +303,9 @@ class StreamingStatistics:
             if circular:
                 statkernels.resultant(columns, offset + start, offset + stop,
                                       self.reference, self._cos, self._sin)
-            if summarize and stop - start == batch_size:
+            if summarize:
                 summaries.extend(self._summaries(columns, offset, start, stop, (count, mean, m2),
-                                                 kind, summary_size or batch_size))
+                                                 kind, summary_size or batch_size, batch_size))
         if self._stored:
             self._count += m
             if self._count * self.size > self._budget:
@@ -314,12 +314,13 @@ class StreamingStatistics:
             self._add_to_tails(columns[:, :m].T)
         return summaries
 
-    def _summaries(self, columns, offset, start, stop, moments, kind, size):
-        """``[(start, summary), ...]`` of the sub-batches of `size` of the batch
-        [start, stop) (its own `moments` where `size` is the batch's)."""
-        if size >= stop - start:
-            return [(start, self._summary(columns, offset + start, offset + stop, *moments,
-                                          kind))]
+    def _summaries(self, columns, offset, start, stop, moments, kind, size, batch_size):
+        """``[(start, summary), ...]`` of the full sub-batches of `size` of the batch
+        [start, stop) (a partial batch, at the end of a run, may hold some), or of the
+        batch itself (with its own `moments`) where `size` is the batch's and it is full."""
+        if size >= batch_size:
+            return [] if stop - start < batch_size else \
+                [(start, self._summary(columns, offset + start, offset + stop, *moments, kind))]
         count, mean, m2 = (np.empty_like(m) for m in moments)
         out = []
         for first in range(start, stop - size + 1, size):
