@@ -163,8 +163,10 @@ def _apparent_ti(dataset, true_ti):
     else:
         rows.append(("as run", _percent_range(motion), _percent_range(apparent_ti(
             true_ti, motion.values))))
+    note = planning.fixed_phase_note(dataset)
     return "\n".join([
         "<h3>Apparent turbulence intensity</h3>",
+        f"<p><b>Note:</b> {_e(note[0].upper() + note[1:])}.</p>" if note else "",
         f"<p>A true turbulence intensity of {100 * true_ti:g} % reads as sqrt(TI^2 + "
         "TI_motion^2): the motion-induced increment (u of Vh from the motion alone, over Vh) "
         "adds in quadrature (<code>--true-ti</code> sets the true TI).</p>",
