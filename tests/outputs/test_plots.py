@@ -225,3 +225,13 @@ def test_a_small_sweep_draws_lines_not_maps(sweeps):
     texts = [t.get_text() for legend in figure.legends for t in legend.get_texts()]
     assert "MC u ±2 Monte Carlo standard errors" in texts          # the bars say what they are
     plt.close(figure)
+
+
+def test_the_motion_is_named_in_words_with_units():
+    """Issue 27, item 5: a measured motion record was titled "harmonic motion: ;"."""
+    from uq.outputs.motionfigures import _sea
+    record = {"motion": {"series": {"file": "data/buoy_imu.csv", "components": 128}}}
+    assert _sea(record).startswith("measured motion record buoy_imu.csv (128 harmonics")
+    harmonic = {"motion": {"pitch": {"amplitude": 5.0, "period": 6.0, "phase": "random"},
+                           "heave": {"amplitude": 0.5, "period": 8.0, "phase": 0}}}
+    assert _sea(harmonic) == "harmonic motion: pitch 5 deg at 6 s, heave 0.5 m at 8 s"
