@@ -235,3 +235,15 @@ def test_the_motion_is_named_in_words_with_units():
     harmonic = {"motion": {"pitch": {"amplitude": 5.0, "period": 6.0, "phase": "random"},
                            "heave": {"amplitude": 0.5, "period": 8.0, "phase": 0}}}
     assert _sea(harmonic) == "harmonic motion: pitch 5 deg at 6 s, heave 0.5 m at 8 s"
+
+
+def test_a_selection_is_in_the_figure_title(sweeps):
+    """Issue 27, item 5: `--select` figures did not say which scenes they show."""
+    from uq.outputs.figures import figure_plan, mark_selection, select_scenes
+    select = {"ship_sog": "4", "wind_speed": 7}
+    chosen = select_scenes(sweeps[4], select)
+    (stem, function), = figure_plan(chosen)
+    figure = mark_selection(function(chosen), chosen, select)
+    title = figure._suptitle.get_text()
+    assert "selected: ship speed over ground = 4" in title and "wind speed = 8" in title
+    plt.close(figure)

@@ -36,16 +36,16 @@ from matplotlib.lines import Line2D  # noqa: E402
 from uq.errors import ScenarioError  # noqa: E402
 from uq.files import check_target, output_folder, save_figure  # noqa: E402
 from uq.outputs import motionfigures, plots  # noqa: E402
-from uq.outputs.labels import model_style  # noqa: E402
+from uq.outputs.labels import MODELS as LABEL_MODELS  # noqa: E402
+from uq.outputs.labels import coordinate_label, model_style  # noqa: E402
 from uq.outputs.planning import VELOCITY_RATIOS, velocity_ratio_line  # noqa: E402
 from uq.outputs.planning import models as available_models  # noqa: E402
 from uq.outputs.plots import plot_uncertainty_against_direction  # noqa: E402
 from uq.outputs.samples import can_redraw, scene_trials  # noqa: E402
 
-#: Uncertainty variables: suffix -> (label, line style).
-MODELS = {"paper_u": ("Rubio & Gottschall (2022)", "-"),
-          "gum_u": ("GUM, physical model", "--"),
-          "mc_u": ("Monte Carlo, physical model", ":")}
+#: Uncertainty variables: suffix -> (label, ...): the one mapping of
+#: :data:`uq.outputs.labels.MODELS` (labels, line styles, markers and colours).
+MODELS = LABEL_MODELS
 UNITS = {"wind_speed": "m s$^{-1}$", "wind_direction": "deg", "radial_velocity": "m s$^{-1}$"}
 SYMBOLS = {"wind_speed": "$V_h$", "wind_direction": r"$\Theta$", "radial_velocity": "$v_r$"}
 BEAM_NAMES = {0.0: "N", 90.0: "E", 180.0: "S", 270.0: "W"}
@@ -554,10 +554,24 @@ def make_figures(dataset, directory, stem="", formats=("png",), select=None):
     output_folder(directory)
     written = []
     for name, function in plan:
-        figure = function(dataset)
+        figure = mark_selection(function(dataset), dataset, select)
         written += [save_figure(figure, path, dpi=130) for path in targets[name]]
         plt.close(figure)
     return written
+
+
+def mark_selection(figure, dataset, select):
+    """The fixed sweep values of `select` (``--select``) in the figure's title, so that a
+    figure of some scenes says which; `dataset` is the selection. Returns the figure."""
+    if not select:
+        return figure
+    text = "selected: " + ", ".join(
+        f"{coordinate_label(dataset, dim).split(' [')[0]} = {_text(dataset[dim].values.item())}"
+        + (f" {dataset[dim].attrs['units']}" if dataset[dim].attrs.get("units") else "")
+        for dim in select)
+    title = figure._suptitle.get_text() if figure._suptitle is not None else ""
+    figure.suptitle(f"{title}\n{text}" if title else text, fontsize=9)
+    return figure
 
 
 def _text(value):

@@ -59,31 +59,45 @@ def plot_uncertainty_against_direction(results, axes_pair=None):
     ----------
     results : dict
         Label -> Dataset with a ``wind_direction`` sweep dimension (e.g. one per INS
-        correlation mode). Each is drawn as Monte Carlo (points), physical GUM (line) and,
-        from the first, the Rubio & Gottschall (2022) model (dashed).
+        correlation mode). Each is drawn as Monte Carlo (markers) and physical GUM
+        (dashed), and, from the first, the Rubio & Gottschall (2022) model: the models'
+        one style (:func:`uq.outputs.labels.model_style`); with several results a colour
+        per result.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    figure, axes = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True) \
+    figure, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True) \
         if axes_pair is None else (axes_pair[0].figure, axes_pair)
-    for (label, ds), colour in zip(results.items(), ("tab:blue", "tab:orange", "tab:green")):
+    several = len(results) > 1
+    for k, (label, ds) in enumerate(results.items()):
         x = ds["wind_direction"].values
-        for ax, q, unit in ((axes[0], "wind_speed", "m s$^{-1}$"), (axes[1], "wind_direction", "deg")):
-            ax.plot(x, ds[f"{q}_gum_u"], color=colour, label=f"GUM, physical ({label})")
-            ax.plot(x, ds[f"{q}_mc_u"], "o", ms=3, color=colour, label=f"Monte Carlo ({label})")
+        for ax, q in ((axes[0], "wind_speed"), (axes[1], "wind_direction")):
+            for model in ("gum_u", "mc_u"):
+                style = model_style(model)
+                if several:
+                    style.update(color=RESULT_COLOURS[k % len(RESULT_COLOURS)],
+                                 label=f"{style['label']} ({label})")
+                ax.plot(x, ds[f"{q}_{model}"], **style)
             ax.set_xlabel("wind direction [deg]")
-            ax.set_ylabel(f"u({q.replace('_', ' ')}) [{unit}]")
+            ax.set_ylabel(quantity_label(q))
     first = next(iter(results.values()))
     for ax, q in ((axes[0], "wind_speed"), (axes[1], "wind_direction")):
-        ax.plot(first["wind_direction"], first[f"{q}_paper_u"], "k--",
-                label="Rubio & Gottschall (2022)")
+        if f"{q}_paper_u" in first and np.isfinite(first[f"{q}_paper_u"].values).any():
+            ax.plot(first["wind_direction"], first[f"{q}_paper_u"], **model_style("paper_u"))
         ax.set_xlim(0, 360)
         ax.set_xticks(range(0, 361, 90))
         ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=7)
+    if axes_pair is None:
+        legend_below(figure, axes[0])
+    else:
+        axes[0].legend(fontsize=7)
     return figure
+
+
+#: Colours of several results in one figure (the models keep their line styles).
+RESULT_COLOURS = ("tab:blue", "tab:orange", "tab:green")
 
 
 def _two_and_five(value, _position):

@@ -21,8 +21,8 @@ from scipy.stats import norm
 from uq.constants import COVERAGE_PROBABILITY, NUMERICAL_ZERO
 from uq.files import SIGNATURE, write_text
 from uq.outputs import planning
-from uq.outputs.figures import (caption, figure_plan, no_figure_reason, select_scenes,
-                                sweep_dimensions)
+from uq.outputs.figures import (caption, figure_plan, mark_selection, no_figure_reason,
+                                select_scenes, sweep_dimensions)
 from uq.outputs.labels import KEY_WORDS
 
 QUANTITY_UNITS = {"wind_speed": "m/s", "wind_direction": "deg", "vertical_wind": "m/s",
@@ -68,7 +68,7 @@ def render_report(dataset, source="", targets=planning.DEFAULT_TARGETS, select=N
              _run_table(dataset, source), _answers(dataset, targets),
              _apparent_ti(dataset, true_ti), _findings(dataset),
              _summary_tables(dataset), _scene_tables(dataset),
-             _figures(select_scenes(dataset, select)),
+             _figures(select_scenes(dataset, select), select),
              _scenario(dataset),
              "</body></html>"]
     return "\n".join(parts)
@@ -464,13 +464,13 @@ def _number(value):
     return "0" if abs(value) <= NUMERICAL_ZERO else f"{value:.4g}"
 
 
-def _figures(dataset):
+def _figures(dataset, select=None):
     out = ["<h2>Figures</h2>"]
     reason = no_figure_reason(dataset)
     if reason:
         out.append(f"<p>{_e(reason)}.</p>")
     for name, function in figure_plan(dataset):
-        figure = function(dataset)
+        figure = mark_selection(function(dataset), dataset, select)
         buffer = io.BytesIO()
         figure.savefig(buffer, format="png", dpi=100)
         plt.close(figure)
