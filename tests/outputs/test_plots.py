@@ -247,3 +247,32 @@ def test_a_selection_is_in_the_figure_title(sweeps):
     title = figure._suptitle.get_text()
     assert "selected: ship speed over ground = 4" in title and "wind speed = 8" in title
     plt.close(figure)
+
+
+def test_the_bench_figure_fits_lines_above_the_reference_floor():
+    """Issue 27, item 5: the bench figure joined medians of a few repeats (a zig-zag)
+    and showed no floor where the reference's own error is reached. Runs with errors
+    exactly e = 1e-4 (t / 1 s)^-1/2 above the floor give a line of slope -1/2 (to
+    rounding, 1e-9), runs at the floor are left out of the fit, and the floor is drawn."""
+    import xarray as xr
+    from uq.outputs.plots import plot_bench
+    times = np.array([1e-3, 1e-2, 1e-1, 1.0, 10.0])
+    floor = 2e-5
+    errors = np.maximum(1e-4 * times ** -0.5, floor)          # at the floor from 10 s on
+    shape = (1, 1, times.size, 2)
+    ds = xr.Dataset({"relative_error": (("scene", "method", "n", "repeat"),
+                                        np.broadcast_to(errors[:, None], shape[2:])[None, None]),
+                     "time_s": (("scene", "method", "n", "repeat"),
+                                np.broadcast_to(times[:, None], shape[2:])[None, None]),
+                     "reference_relative_error": ("scene", [floor])},
+                    coords={"scene": ["s"], "method": ["mc"], "n": range(times.size),
+                            "repeat": range(2)})
+    figure = plot_bench(ds)
+    ax = figure.axes[0]
+    fit = next(line for line in ax.get_lines() if line.get_linestyle() == "-"
+               and len(line.get_xdata()) > 2)
+    x, y = np.log(fit.get_xdata()), np.log(fit.get_ydata())
+    assert np.polyfit(x, y, 1)[0] == pytest.approx(-0.5, abs=1e-9)
+    assert fit.get_xdata().max() == pytest.approx(1.0)           # 10 s is at the floor
+    assert any(np.allclose(line.get_ydata(), floor) for line in ax.get_lines())
+    plt.close(figure)

@@ -43,6 +43,10 @@ SHOWN_GATES = 3
 MAP_MIN_RELATIVE_SPAN = 0.01
 #: Largest number of values of a numeric sweep axis that get a tick each [1].
 MAP_VALUE_TICKS = 12
+#: The bench figure fits its lines to the runs whose error is above this many times the
+#: reference's own relative error [1]: the observed error is ~sqrt(e^2 + floor^2), 5 %
+#: above e at 3x the floor.
+BENCH_FLOOR_FACTOR = 3.0
 #: Most columns of a legend under the panels.
 LEGEND_COLUMNS = 4
 #: Histogram bins of the Monte Carlo trials.
@@ -109,17 +113,30 @@ def _two_and_five(value, _position):
 
 def plot_bench(dataset):
     """Relative error of u(wind speed) against wall time, one panel per scene: every
-    repeated run as a point, the median per method and sample size as a line."""
+    repeated run as a point, the median per method and sample size as a marker, and a
+    power law fitted per method to the runs whose error is above BENCH_FLOOR_FACTOR times
+    the reference's own relative error (the floor, drawn as a grey band): medians of a few
+    repeats zig-zag, and below the floor the error measured is the reference's."""
     scenes = list(dataset["scene"].values)
-    figure, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4),
+    figure, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4.2),
                                 constrained_layout=True, squeeze=False)
     for ax, scene in zip(axes[0], scenes):
+        floor = float(dataset["reference_relative_error"].sel(scene=scene)) \
+            if "reference_relative_error" in dataset else 0.0
         for method in dataset["method"].values:
             data = dataset.sel({"scene": scene, "method": method})
-            line, = ax.plot(data["time_s"].median("repeat"),
-                            data["relative_error"].median("repeat"), "-", label=str(method))
-            ax.plot(data["time_s"].values.ravel(), data["relative_error"].values.ravel(), ".",
-                    color=line.get_color(), alpha=0.4, ms=4)
+            times, errors = data["time_s"].values.ravel(), data["relative_error"].values.ravel()
+            points, = ax.plot(times, errors, ".", alpha=0.4, ms=4, label=str(method))
+            colour = points.get_color()
+            ax.plot(data["time_s"].median("repeat"), data["relative_error"].median("repeat"),
+                    "D", color=colour, ms=4, markerfacecolor="none")
+            fit = _power_law(times, errors, BENCH_FLOOR_FACTOR * floor)
+            if fit is not None:
+                ax.plot(*fit, "-", color=colour, lw=1.2)
+        if floor > 0:
+            ax.axhspan(ax.get_ylim()[0] if ax.get_yscale() == "log" else 0, floor,
+                       color="0.85", zorder=0)
+            ax.axhline(floor, color="0.5", lw=0.8)
         ax.axhline(1e-3, color="k", lw=0.8, ls="--")
         ax.set_xscale("log")
         ax.set_yscale("log")
@@ -130,10 +147,23 @@ def plot_bench(dataset):
         ax.grid(alpha=0.3, which="both")
     # below the panels: inside, the legend would cover runs' points
     figure.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside lower center",
-                  ncols=len(dataset["method"]), fontsize=8,
-                  title="method (points: runs; line: median); dashed: the 1e-3 target",
-                  title_fontsize=8)
+                  ncols=len(dataset["method"]), fontsize=8, markerscale=3,
+                  title="method (points: runs; diamonds: medians;\nlines: power law fitted "
+                  f"above {BENCH_FLOOR_FACTOR:g}x the floor); dashed: the 1e-3 target;\n"
+                  "grey: below the reference's own error (the floor)", title_fontsize=8)
     return figure
+
+
+def _power_law(times, errors, above):
+    """(times, fitted errors) of log error = a + b log time over the runs with an error
+    above `above`, across their time range; None with fewer than 3 such runs or one
+    time only."""
+    keep = np.isfinite(times) & np.isfinite(errors) & (errors > max(above, 0.0)) & (times > 0)
+    if np.count_nonzero(keep) < 3 or np.ptp(np.log(times[keep])) == 0:
+        return None
+    slope, intercept = np.polyfit(np.log(times[keep]), np.log(errors[keep]), 1)
+    span = np.geomspace(times[keep].min(), times[keep].max(), 20)
+    return span, np.exp(intercept + slope * np.log(span))
 
 
 def sweep_quantities(dataset):
