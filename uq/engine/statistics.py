@@ -357,8 +357,7 @@ class StreamingStatistics:
         """Coverage interval of every element from columns[:, start:stop]."""
         low, high = np.empty(self.size), np.empty(self.size)
         if kind == "symmetric":
-            ranks = np.array([_symmetric_ranks(int(c), probability) or (-1, -1)
-                              for c in count], dtype=np.int64).reshape(-1, 2)
+            ranks = _rank_pairs(count, probability)
             parts = element_parts(self.size)
             length = statkernels.scratch_length(stop - start)
             if len(self._scratch) != len(parts) or self._scratch[0].shape[1] < length:
@@ -490,6 +489,16 @@ class _Tail:
 #: Up to this many columns a batch's endpoints come from bracketed selection, column by
 #: column (2-4x faster than numpy.partition per column, but a Python loop over them).
 _SELECTION_COLUMNS = 8
+
+
+def _rank_pairs(counts, probability):
+    """(elements, 2) int64 ranks of :func:`_symmetric_ranks` per element's count ((-1, -1)
+    where there is no interval), computed once per distinct count."""
+    counts = np.asarray(counts).reshape(-1)
+    distinct, where = np.unique(counts, return_inverse=True)
+    pairs = np.array([_symmetric_ranks(int(c), probability) or (-1, -1) for c in distinct],
+                     dtype=np.int64).reshape(-1, 2)
+    return pairs[where.reshape(-1)]
 
 
 def _symmetric_ranks(m, probability):

@@ -318,10 +318,15 @@ def u_standard_error(dataset, quantity):
     """Standard error of the Monte Carlo u: the run's own, from independent batches
     (``q_mc_u_standard_error``), or, where it has fewer than two batches (NaN), that of
     the standard deviation of N normal draws, u / sqrt(2 (N - 1))."""
+    return u_standard_error_array(dataset, quantity).values
+
+
+def u_standard_error_array(dataset, quantity):
+    """:func:`u_standard_error` as a DataArray (the result's dimensions)."""
     u = dataset[f"{quantity}_mc_u"]
     normal = u / np.sqrt(2 * (dataset["mc_n_samples"] - 1))
     stored = dataset.get(f"{quantity}_mc_u_standard_error")
-    return (normal if stored is None else stored.fillna(normal)).values
+    return normal if stored is None else stored.fillna(normal)
 
 
 def plot_histogram(dataset, trials):
@@ -550,10 +555,7 @@ def _map_noise(at, quantity):
     None without Monte Carlo."""
     if f"{quantity}_mc_u" not in at:
         return None
-    u = at[f"{quantity}_mc_u"]
-    normal = u / np.sqrt(2 * (at["mc_n_samples"] - 1))
-    stored = at.get(f"{quantity}_mc_u_standard_error")
-    return 2 * (normal if stored is None else stored.fillna(normal))
+    return 2 * u_standard_error_array(at, quantity)
 
 
 def _panel_noise(noise, model, facet, value):
