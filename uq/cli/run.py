@@ -113,9 +113,10 @@ def dask_client(args):
     if args.workers is None and args.scheduler is None:
         yield None
         return
-    # dask's own log lines (task cancelled at Ctrl-C, ...) are not the user's business;
-    # workers read this from the environment they inherit
-    os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "error")
+    # dask's own log lines (task cancelled at Ctrl-C, a worker's heartbeat to a scheduler
+    # that Ctrl-C has closed, ...) are not the user's business: a failed task reaches uq
+    # as its exception; workers read this from the environment they inherit
+    os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "critical")
     try:
         from dask.distributed import Client, LocalCluster
     except ImportError:
