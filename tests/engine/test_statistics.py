@@ -159,3 +159,21 @@ def test_element_parts_cover_every_element_once():
             covered = np.concatenate([np.arange(size)[part]
                                       for part in element_parts(size, threads)])
             np.testing.assert_array_equal(covered, np.arange(size))
+
+
+def test_smaller_summary_batches_leave_the_results_unchanged(rng):
+    """Summaries of sub-batches (the standard errors' batches) are those of each
+    sub-batch alone (batch_statistics), and the merged results are bit for bit those of
+    summaries of whole batches: the merges follow the moments' batches only."""
+    values = rng.gamma(2.0, size=(3 * 4096, 2))
+    whole = StreamingStatistics((2,), tail_capacity(len(values)) + 1)
+    parts = StreamingStatistics((2,), tail_capacity(len(values)) + 1)
+    assert len(whole.add(values, 4096, summarize=True)) == 3
+    summaries = parts.add(values, 4096, summarize=True, summary_size=1024)
+    assert [start for start, _ in summaries] == list(range(0, len(values), 1024))
+    for start, summary in summaries:
+        expected = batch_statistics(values[start:start + 1024])
+        for key in ("mean", "u", "low", "high"):
+            np.testing.assert_allclose(summary[key], expected[key], rtol=1e-12)
+    for key, value in whole.result().items():
+        np.testing.assert_array_equal(value, parts.result()[key])

@@ -14,7 +14,8 @@ from uq.cli import main
 from uq.engine.inputs import input_set
 from uq.physics.measurement import measurement_model
 from uq.pipeline.modelsetup import error_inputs, scene_from_settings
-from uq.fit.fitting import combine_fits
+from uq.fit.command import fit_settings, fit_table
+from uq.fit.fitting import combine_fits, fit_profile, profile_from_results
 from uq.fit.plots import plot_corner
 from uq.fit.profilefit import least_squares_profile
 from uq.physics.profiles import power_law_profile
@@ -177,7 +178,8 @@ def fake_fit(steps, rng, heavy_tail=False):
                for k, p in (("low95", 0.025), ("median", 0.5), ("high95", 0.975))}
     return xr.Dataset({**summary, "chain": (("ensemble", "step", "walker", "parameter"), chain),
                        "tau": ("parameter", [10.0, 10.0])},
-                      coords={"parameter": names}, attrs={"burn": 20, "thin": 5})
+                      coords={"parameter": names}, attrs={"burn": 20, "thin": 5,
+                                                        "least_squares_basis": "known"})
 
 
 def test_fits_of_different_chain_length_combine():
@@ -229,3 +231,23 @@ def test_fit_file_passes_the_cf_checker(results, fitted, cf_compliance):
     assert fitted.attrs["Conventions"] == "CF-1.10" and "uq fit" in fitted.attrs["history"]
     assert all("long_name" in fitted[name].attrs for name in fitted.variables)
     assert list(fitted["parameter_units"].values) == ["m s-1", "1"]
+
+
+
+def test_least_squares_interval_carries_the_data_uncertainty(results):
+    """Issue 27, item 1: with fit.scatter: true the least-squares interval of U_ref had
+    almost no width ([8.983, 8.984] against the posterior's [8.755, 9.207]): it took the
+    scatter of Monte Carlo means about a smooth profile. It now rests on the propagated
+    covariance (the Monte Carlo means lie on the profile: no extra scatter), says so, and
+    is as wide as the posterior to within what the free scatter adds to the posterior
+    (less than a factor 1.5: 8 gates leave 6 residual degrees of freedom to bound it)
+    and the MCMC error of the posterior's ends (5 %)."""
+    ds = xr.open_dataset(results).load()
+    config = fit_settings(None, {"fit": {"scatter": True, "ensembles": 2}}, {})
+    fit = combine_fits({"propagated": fit_profile(profile_from_results(ds), config)})
+    prop = fit.sel(fit="propagated", parameter="reference_speed")
+    least = float(prop.least_squares_high95 - prop.least_squares_low95)
+    posterior = float(prop.posterior_high95 - prop.posterior_low95)
+    assert posterior / 1.5 < least <= posterior * 1.05, (least, posterior)
+    assert "least squares, propagated: the given covariance (it explains the residuals" \
+        in fit_table(fit)

@@ -226,3 +226,15 @@ def test_thin_bins_are_named_on_stderr(tmp_path, capsys):
     assert "uq golden: warning: flsb-mast at 80 m: required bins with too few records: " \
            "5.5 m/s (0)" in err
     assert "5.5 m/s (0)" in (tmp_path / "out" / "report.md").read_text()
+
+
+def test_variables_of_several_units_claim_none(six):
+    """Issue 27, item 5: golden_campaign.nc gave the bin means of temperature (and every
+    other environmental variable) units = "1" and the slopes "percent" (they are percent
+    per unit of the variable). One netCDF variable along `variable` holds several units
+    the configuration does not name: no units attribute, and the long name says whose."""
+    for name in ("verification_mean", "slope", "slope_standard_error", "paired_environment"):
+        if name in six:
+            assert "units" not in six[name].attrs, name
+            assert "unit" in six[name].attrs["long_name"], name
+    assert six["slope_intercept"].attrs["units"] == "percent"

@@ -115,12 +115,37 @@ def test_a_single_scene_has_figures_and_its_report_the_single_scene_ones(tmp_pat
     path = write_results(single, tmp_path / "one.nc")
     assert main(["plot", str(path)]) == 0
     assert sorted(p.name for p in (tmp_path / "one_figures").iterdir()) == [
-        "budget.png", "histogram.png", "uncertainty_against_gate.png"]
+        "budget.png", "histogram.png", "radial_velocity_per_beam.png",
+        "uncertainty_against_gate.png"]
     page = render_report(single)
     assert len(re.findall("<img ", page)) == len(re.findall("<figcaption><b>[a-z_]+.</b> [A-Za-z]",
-                                                             page)) == 3
+                                                             page)) == 4
     answers = page.split("Campaign-planning answers")[1].split("<h2>Figures")[0]
     assert "for 3 of 3 (3 range gates)" in answers and "scene" not in answers
+
+
+def test_every_requested_output_is_shown(tmp_path):
+    """Issue 27, item 4: gate_height and radial_velocity (requested by
+    floating_lidar_full) were in neither the figures nor the report, although clause 8
+    refuses the GUM for the gate height (a flat-topped distribution from the uniform
+    half-cone error). Each has its budget, bias and u table in the report and a figure
+    panel; the histogram of each output shows the gate where the GUM fails."""
+    from uq.outputs.plots import histogram_gate, sweep_quantities
+    single = uq.run(uq.load_scenario(ROOT / "scenarios" / "floating_lidar_full.yaml",
+                                     {"sampling.n": 4000}))
+    page = render_report(single)
+    for words in ("gate height", "radial velocity"):
+        assert f"Uncertainty budget of {words}" in page and f"<h3>u({words})" in page
+        assert f"<h4>Bias: {words}</h4>" in page
+    assert "beam at 90 deg" in page and "vertical beam" in page
+    assert "gate_height" in sweep_quantities(single)
+    failed = ~single["gate_height_gum_valid"].values
+    gate = histogram_gate(single, "gate_height")
+    assert failed[gate] if failed.any() else gate == single.sizes["range"] // 2
+    valid = single.copy()
+    valid["wind_speed_gum_valid"][:] = True
+    valid["wind_speed_gum_valid"][2] = False
+    assert histogram_gate(valid, "wind_speed") == 2            # not the middle gate
 
 
 def test_report_says_zero_for_rounding_and_folds_the_scenario(results):
@@ -213,3 +238,27 @@ def test_a_correction_sweep_gets_a_budget_column_per_correction():
     budget = page.split("Uncertainty budget of wind direction")[1].split("</table>")[0]
     assert "share, none" in budget and "share, yaw" in budget
     assert "<td>ins.heading</td><td>-</td><td>100.0 %</td>" in budget, budget
+
+
+def test_a_small_sweep_gets_its_answer_as_a_table():
+    """Issue 27, items 5 and 7: a planner's small sweep (here correction x wind
+    direction, 6 scenes) got ranges and maps, its numbers only in the netCDF, and the
+    Run table named one correction. The report lists every scene: its keys, u, the 95 %
+    interval and the bias, the result's own numbers to the 4 digits written; the
+    attribute and the Run table say the correction is swept."""
+    ds = uq.run(uq.load_scenario(ROOT / "scenarios" / "rubio2022_case_i.yaml", {
+        "sampling.n": 2000, "sweep": {"correction": ["yaw", "full"],
+                                      "wind.direction": [0, 90, 180]}}))
+    assert ds.attrs["correction"] == "swept: yaw, full"
+    page = render_report(ds)
+    assert "<td>correction</td><td>swept: yaw, full</td>" in page
+    table = page.split("<h2>Scene by scene</h2>")[1].split("</table>")[0]
+    rows = re.findall(r"<tr>(.*?)</tr>", table)[1:]
+    assert len(rows) == 6
+    for row in rows:
+        cells = re.findall(r"<td>(.*?)</td>", row)
+        at = ds.sel(correction=cells[0], wind_direction=float(cells[1]))
+        assert cells[2] == f"{float(at.wind_speed_mc_u):.4g}"
+        assert cells[3] == f"[{float(at.wind_speed_mc_low):.4g}, " \
+            f"{float(at.wind_speed_mc_high):.4g}]"
+        assert cells[4] == f"{float(at.wind_speed_mc_bias):.4g}"

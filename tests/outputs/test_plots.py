@@ -12,7 +12,7 @@ from scipy.stats import norm
 import uq
 from uq.errors import ScenarioError
 from uq.outputs.figures import figure_plan, make_figures, no_figure_reason
-from uq.outputs.plots import plot_budget, plot_histogram, shared_scale
+from uq.outputs.plots import histogram_gate, plot_budget, plot_histogram, shared_scale
 from uq.outputs.samples import scene_trials
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -50,7 +50,8 @@ def labelled(figure):
 
 def test_single_scene_gets_budget_gate_and_histogram_figures(single):
     plan = figure_plan(single)
-    assert [stem for stem, _ in plan] == ["budget", "uncertainty_against_gate", "histogram"]
+    assert [stem for stem, _ in plan] == ["budget", "uncertainty_against_gate", "histogram",
+                                          "radial_velocity_per_beam"]
     for _, function in plan:
         figure = function(single)
         assert labelled(figure)
@@ -86,7 +87,7 @@ def test_histogram_draws_the_runs_own_trials_and_both_intervals(single):
                                rtol=1e-12)
     figure = plot_histogram(single, trials)
     ax = figure.axes[0]
-    gate = single.isel(range=1)
+    gate = single.isel(range=histogram_gate(single, "wind_speed"))
     u, value = float(gate.wind_speed_gum_u), float(gate.wind_speed_gum_value)
     curve = next(line for line in ax.lines if len(line.get_xdata()) > 2)
     assert np.max(curve.get_ydata()) == pytest.approx(1 / (u * np.sqrt(2 * np.pi)), rel=1e-3)
@@ -102,7 +103,7 @@ def test_histogram_draws_the_runs_own_trials_and_both_intervals(single):
 def test_any_1d_and_2d_sweep_gets_figures(sweeps):
     assert [stem for stem, _ in figure_plan(sweeps[1])] == ["uncertainty_against_sweep"]
     stems = [stem for stem, _ in figure_plan(sweeps[2])]
-    assert stems == ["maps_wind_speed", "maps_wind_direction"]    # no vertical-wind u here
+    assert stems == ["uncertainty_against_sweep"]        # 3 x 3 scenes: lines, not maps
     for k in (1, 2):
         for _, function in figure_plan(sweeps[k]):
             figure = function(sweeps[k])
@@ -125,8 +126,7 @@ def test_more_dimensions_name_the_select_that_gives_figures(sweeps, tmp_path):
     reason = no_figure_reason(sweeps[4])
     assert "--select ship_sog=1" in reason and "--select wind_speed=4" in reason
     written = make_figures(sweeps[4], tmp_path, select={"ship_sog": "4", "wind_speed": 8})
-    assert sorted(p.name for p in written) == ["maps_wind_direction_ship_sog_4_wind_speed_8.png",
-                                               "maps_wind_speed_ship_sog_4_wind_speed_8.png"]
+    assert [p.name for p in written] == ["uncertainty_against_sweep_ship_sog_4_wind_speed_8.png"]
     assert no_figure_reason(sweeps[2]) is None
     with pytest.raises(ScenarioError, match="no such sweep dimension"):
         figure_plan(sweeps[4], select={"ship_cog": 0})
@@ -153,7 +153,7 @@ def test_report_of_many_dimensions_says_how_to_get_figures(sweeps):
     page = render_report(sweeps[4])
     assert "--select" in page.split("<h2>Figures</h2>")[1] and "<img" not in page
     page = render_report(sweeps[4], select={"ship_sog": 4, "wind_speed": 8})
-    assert page.count("<img") == 2
+    assert page.count("<img") == 1
 
 
 def test_flat_panels_do_not_force_a_scale_each():
@@ -164,10 +164,115 @@ def test_flat_panels_do_not_force_a_scale_each():
 
 
 def test_monte_carlo_error_bars_fall_back_to_the_normal_standard_error(sweeps):
-    """2000 trials make no two batches of 2^14: the stored standard error of u is NaN and
+    """2000 trials make no two batches of 2^10: the stored standard error of u is NaN and
     the error bars use that of the standard deviation of N normal draws, u/sqrt(2(N-1))."""
     from uq.outputs.plots import u_standard_error
     ds = sweeps[1]
     assert np.isnan(ds["wind_speed_mc_u_standard_error"]).all()
     np.testing.assert_allclose(u_standard_error(ds, "wind_speed"),
                                ds["wind_speed_mc_u"] / np.sqrt(2 * (2000 - 1)), rtol=1e-15)
+
+
+def _mesh_of(figure, title):
+    ax = next(ax for ax in figure.axes if ax.get_title().startswith(title))
+    return ax, next(c for c in ax.collections if isinstance(c, QuadMesh))
+
+
+@pytest.mark.parametrize("effect, averaged", [(0.9, True), (6.0, False)])
+def test_monte_carlo_noise_draws_no_structure(sweeps, effect, averaged):
+    """Issue 27, item 3: common random numbers make the Monte Carlo noise of
+    neighbouring scenes alike, and a colour map stretched over it drew "blobs" over
+    misalignment where the model has no effect. A Monte Carlo variation along a swept
+    key within +-2 standard errors (here a smooth one of `effect` x 2 SE peak to peak
+    over misalignment: 0.9 x 2 = 1.8 SE < 4 SE) is averaged away, and the panel says so;
+    a larger one (6 x 2 SE = 12 SE) is drawn."""
+    from uq.outputs.plots import plot_maps
+    ds = sweeps[2].copy()
+    se = ds["wind_speed_mc_u_standard_error"].fillna(
+        ds["wind_speed_mc_u"] / np.sqrt(2 * (ds["mc_n_samples"] - 1)))
+    shape = np.sin(np.deg2rad(2 * ds["lidar_misalignment"]))       # 0 .. 1 .. 0
+    ds["wind_speed_mc_u"] = ds["wind_speed_gum_u"] + effect * 2 * se * shape
+    figure = plot_maps(ds, "wind_speed", "lidar_misalignment", "wind_direction")
+    ax, mesh = _mesh_of(figure, "Monte Carlo")
+    drawn = np.asarray(mesh.get_array()).reshape(ds.sizes["wind_direction"],
+                                                 ds.sizes["lidar_misalignment"])
+    along = np.ptp(drawn, axis=1)                    # spread over misalignment, per row
+    notes = [t.get_text() for t in ax.texts]
+    if averaged:
+        # the mean of each row, to rounding of the float64 mean (1e-12 relative)
+        np.testing.assert_allclose(along, 0, atol=1e-12 * float(np.max(drawn)))
+        assert notes and "±2 Monte Carlo standard errors" in notes[0]
+        assert "lidar misalignment" in notes[0]
+    else:
+        assert np.all(along > 0) and not notes
+    plt.close(figure)
+
+
+def test_a_small_sweep_draws_lines_not_maps(sweeps):
+    """Issue 27, item 7: a small sweep (here 3 x 3 scenes) drew maps of 3-valued axes.
+    It draws u against one key with a line per value of the other, each line the
+    result's own numbers."""
+    ds = sweeps[2]
+    (stem, function), = figure_plan(ds)
+    figure = function(ds)
+    ax = figure.axes[0]
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    for value in ds["lidar_misalignment"].values:
+        label = f"GUM, physical model, lidar misalignment {value:g}"
+        np.testing.assert_array_equal(lines[label].get_ydata(), ds["wind_speed_gum_u"].sel(
+            lidar_misalignment=value).values)
+        np.testing.assert_array_equal(lines[label].get_xdata(), ds["wind_direction"].values)
+    texts = [t.get_text() for legend in figure.legends for t in legend.get_texts()]
+    assert "MC u ±2 Monte Carlo standard errors" in texts          # the bars say what they are
+    plt.close(figure)
+
+
+def test_the_motion_is_named_in_words_with_units():
+    """Issue 27, item 5: a measured motion record was titled "harmonic motion: ;"."""
+    from uq.outputs.motionfigures import _sea
+    record = {"motion": {"series": {"file": "data/buoy_imu.csv", "components": 128}}}
+    assert _sea(record).startswith("measured motion record buoy_imu.csv (128 harmonics")
+    harmonic = {"motion": {"pitch": {"amplitude": 5.0, "period": 6.0, "phase": "random"},
+                           "heave": {"amplitude": 0.5, "period": 8.0, "phase": 0}}}
+    assert _sea(harmonic) == "harmonic motion: pitch 5 deg at 6 s, heave 0.5 m at 8 s"
+
+
+def test_a_selection_is_in_the_figure_title(sweeps):
+    """Issue 27, item 5: `--select` figures did not say which scenes they show."""
+    from uq.outputs.figures import figure_plan, mark_selection, select_scenes
+    select = {"ship_sog": "4", "wind_speed": 7}
+    chosen = select_scenes(sweeps[4], select)
+    (stem, function), = figure_plan(chosen)
+    figure = mark_selection(function(chosen), chosen, select)
+    title = figure._suptitle.get_text()
+    assert "selected: ship speed over ground = 4" in title and "wind speed = 8" in title
+    plt.close(figure)
+
+
+def test_the_bench_figure_fits_lines_above_the_reference_floor():
+    """Issue 27, item 5: the bench figure joined medians of a few repeats (a zig-zag)
+    and showed no floor where the reference's own error is reached. Runs with errors
+    exactly e = 1e-4 (t / 1 s)^-1/2 above the floor give a line of slope -1/2 (to
+    rounding, 1e-9), runs at the floor are left out of the fit, and the floor is drawn."""
+    import xarray as xr
+    from uq.outputs.plots import plot_bench
+    times = np.array([1e-3, 1e-2, 1e-1, 1.0, 10.0])
+    floor = 2e-5
+    errors = np.maximum(1e-4 * times ** -0.5, floor)          # at the floor from 10 s on
+    shape = (1, 1, times.size, 2)
+    ds = xr.Dataset({"relative_error": (("scene", "method", "n", "repeat"),
+                                        np.broadcast_to(errors[:, None], shape[2:])[None, None]),
+                     "time_s": (("scene", "method", "n", "repeat"),
+                                np.broadcast_to(times[:, None], shape[2:])[None, None]),
+                     "reference_relative_error": ("scene", [floor])},
+                    coords={"scene": ["s"], "method": ["mc"], "n": range(times.size),
+                            "repeat": range(2)})
+    figure = plot_bench(ds)
+    ax = figure.axes[0]
+    fit = next(line for line in ax.get_lines() if line.get_linestyle() == "-"
+               and len(line.get_xdata()) > 2)
+    x, y = np.log(fit.get_xdata()), np.log(fit.get_ydata())
+    assert np.polyfit(x, y, 1)[0] == pytest.approx(-0.5, abs=1e-9)
+    assert fit.get_xdata().max() == pytest.approx(1.0)           # 10 s is at the floor
+    assert any(np.allclose(line.get_ydata(), floor) for line in ax.get_lines())
+    plt.close(figure)

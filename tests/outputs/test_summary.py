@@ -44,3 +44,25 @@ def test_a_direction_at_north_is_one_value_not_a_sweep():
     assert _cell(_shown(north, "wind_direction", "true"), "true") == "0"
     assert _cell(_shown(np.array([359.97]), "wind_direction", "mc_mean"), "mc_mean") == "-0.03"
     assert _cell(_shown(np.array([359.97]), "wind_speed", "mc_mean"), "mc_mean") == "360"
+
+
+def test_a_fixed_motion_phase_explains_its_zero_ti_increment():
+    """Issue 27, item 6: tiana2017_vad (a buoy pitching up to 15 deg at a fixed phase)
+    reported "motion-induced TI 0.00 %" without a word. Every scan sees the same motion:
+    the summary and the report say so, and give the systematic error the motion makes
+    instead; with a random phase the scatter is sampled (TI > 1 %) and no note."""
+    from pathlib import Path
+    from uq.outputs.report import render_report
+    path = Path(__file__).resolve().parents[2] / "scenarios" / "tiana2017_vad.yaml"
+    sweep = {"wind.direction": [0.0], "motion.pitch.amplitude": [15.0]}
+    fixed = uq.run(uq.load_scenario(path, {"sweep": sweep}))
+    line = next(l for l in summary_table(fixed).splitlines() if "turbulence-intensity" in l)
+    assert "increment [%]: 0 (every motion phase is fixed (motion.pitch.phase: 180)" in line
+    error = float(np.abs(fixed["wind_speed_nominal"] - fixed["wind_speed_true"]).max())
+    assert error > 0.1 and f"{error:.3g} m/s" in line
+    assert "Every motion phase is fixed" in render_report(fixed)
+    sampled = uq.run(uq.load_scenario(path, {"sweep": sweep, "motion.pitch.phase": "random",
+                                             "sampling.n": 2000}))
+    assert float(sampled["wind_speed_motion_ti"].min()) > 0.01
+    line = next(l for l in summary_table(sampled).splitlines() if "turbulence-intensity" in l)
+    assert "fixed" not in line

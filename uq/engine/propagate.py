@@ -20,10 +20,11 @@ from uq.engine import controlvariate
 from uq.engine import gum
 from uq.constants import (ADAPTIVE_MAX_SAMPLES, BATCH_SIZE, COVERAGE_PROBABILITY,
                         DEFAULT_BLOCKS_PER_CHUNK, DEFAULT_DIGITS, FULL_CIRCLE_DEG,
-                        MODEL_SLICE_VALUES, RNG_BLOCK_SIZE, VALIDATION_TOLERANCE_FRACTION)
+                        MIN_STANDARD_ERROR_BATCH, MODEL_SLICE_VALUES, RNG_BLOCK_SIZE,
+                        STANDARD_ERROR_BATCHES, VALIDATION_TOLERANCE_FRACTION)
 from uq.engine.inputs import input_set
 from uq.engine.sampling import PROPAGATION_METHODS, new_seed, normal_scores
-from uq.engine.stopping import STOPPING_RULES, gum_validated, may_stop
+from uq.engine.stopping import STOPPING_RULES, coverage_factor, gum_validated, may_stop
 from uq.engine.statistics import (INTERVALS, CoMoments, Moments, StreamingStatistics,
                                   tail_capacity)
 
@@ -95,14 +96,15 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     xarray.Dataset
         For each output q: ``q_mc_mean``, ``q_mc_u``, ``q_mc_low``, ``q_mc_high``,
         ``q_mc_n_invalid`` (non-finite trials, excluded), ``q_mc_numerical_error``
-        (twice the largest standard deviation of the block means of mean, u and the
-        endpoints: the JCGM 101 7.9 stability measure), ``q_gum_value`` (model at the
+        (the largest standard error of mean, u and the endpoints times
+        max(2, t_{0.975}(h - 1)): JCGM 101 7.9's 2 s where the h batches are many,
+        Student's t where they are few), ``q_gum_value`` (model at the
         input means), ``q_gum_u``, ``q_gum_valid`` (clause 8), ``q_gum_validation_conclusive`` (the Monte Carlo
         numerical error is within the tolerance of clause 8, so the verdict is not
         decided by sampling noise), ``q_budget`` (dimension
         ``input``), ``q_mc_u_standard_error`` (standard error of ``q_mc_u`` from its
-        spread over independent batches: 2^14 trials for mc, whole RNG blocks, i.e.
-        independent randomisations, for lhs and sobol), ``q_mc_numerical_tolerance``
+        spread over independent batches, :func:`standard_error_batch`),
+        ``q_mc_numerical_tolerance``
         (delta of the requested digits, JCGM 101 7.9.2); circular outputs also
         ``q_mc_circular_std``.
 
@@ -225,6 +227,17 @@ def model_slice_size(dimension):
     return int(np.clip(size, 2**10, RNG_BLOCK_SIZE))
 
 
+def standard_error_batch(n, method="mc"):
+    """Trials per batch of the standard errors of a fixed-n run: BATCH_SIZE, or the
+    largest power of two that gives STANDARD_ERROR_BATCHES batches of n trials (not
+    below MIN_STANDARD_ERROR_BATCH). lhs and sobol: whole RNG blocks (within a block the
+    points are not independent); they have few batches, and Student's t then."""
+    if method != "mc":
+        return RNG_BLOCK_SIZE
+    size = 2 ** int(np.floor(np.log2(max(n // STANDARD_ERROR_BATCHES, 1))))
+    return int(np.clip(size, MIN_STANDARD_ERROR_BATCH, BATCH_SIZE))
+
+
 def _joined(pieces):
     """Dicts of arrays, joined along the trials."""
     if len(pieces) == 1:
@@ -243,6 +256,9 @@ class _Runner:
         self.blocks_per_chunk = max(1, blocks)
         # independent batches: within an lhs or sobol block the points are not independent
         self.batch_size = BATCH_SIZE if method == "mc" else RNG_BLOCK_SIZE
+        # batches of the summaries (standard errors, stopping): the moments' batches,
+        # or smaller ones in a fixed-n run (standard_error_batch)
+        self.summary_size = self.batch_size
         self.stats, self.batches, self.n_done = None, {}, 0
         self.stopped_by = "fixed n"
         self.control, self.linear = None, {}
@@ -308,7 +324,7 @@ class _Runner:
         floating-point merges, and the result, is the same for every chunk size."""
         for q, values in outputs.items():
             summaries = self.stats[q].add(values, self.batch_size, summarize=True,
-                                          kind=self.interval)
+                                          kind=self.interval, summary_size=self.summary_size)
             if q in self.comoments or linear is not None:
                 for start in range(0, len(values), self.batch_size):
                     batch = values[start:start + self.batch_size]
@@ -317,11 +333,12 @@ class _Runner:
                     if linear is not None:
                         self.linear[q].update(linear[q][start:start + self.batch_size],
                                               np.isfinite(batch))
+            size = self.summary_size
             for start, summary in summaries:
                 if linear is not None:
-                    batch = values[start:start + self.batch_size]
+                    batch = values[start:start + size]
                     summary.update(self._controlled(q, summary, batch,
-                                                    linear[q][start:start + self.batch_size]))
+                                                    linear[q][start:start + size]))
                 for key in _BATCH_KEYS:
                     self.batches[q][key].append(summary[key])
         self.n_done += len(next(iter(outputs.values())))
@@ -366,6 +383,7 @@ class _Runner:
         Each block has its own generator and the chunks are accumulated in order, so the
         result is the same as drawing them in turn (and for any chunk size)."""
         total_blocks = -(-n // RNG_BLOCK_SIZE)
+        self.summary_size = standard_error_batch(n, self.method)
         chunks = [(first, min(self.blocks_per_chunk, total_blocks - first),
                    min(n - first * RNG_BLOCK_SIZE, self.blocks_per_chunk * RNG_BLOCK_SIZE))
                   for first in range(0, total_blocks, self.blocks_per_chunk)]
@@ -437,7 +455,7 @@ class _Runner:
             return np.full(self.stats[q].shape, np.nan)
         spread = [np.std(np.array(batches[key]), axis=0, ddof=1) / np.sqrt(h)
                   for key in _BATCH_KEYS]
-        return 2 * np.max(spread, axis=0)
+        return coverage_factor(h) * np.max(spread, axis=0)
 
 
 def _gum_dataset(gum_value, jacobian, inputs, output_dims):

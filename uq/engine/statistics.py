@@ -278,11 +278,13 @@ class StreamingStatistics:
         are computed from the element-major copy)."""
         self.add(values, max(len(values), 1))
 
-    def add(self, values, batch_size, summarize=False, kind="symmetric"):
+    def add(self, values, batch_size, summarize=False, kind="symmetric", summary_size=None):
         """Add samples (m, *shape) batch by batch: each batch's moments are merged in
         order (so the result does not depend on how the samples were chunked, when
         chunks start on batch boundaries). With `summarize`, returns the mean, u, low
-        and high of every full batch, ``[(start, summary), ...]`` (JCGM 101, 7.9)."""
+        and high of every full batch, ``[(start, summary), ...]`` (JCGM 101, 7.9), or of
+        every full sub-batch of `summary_size` (a divisor of `batch_size`): more, smaller
+        batches for the standard errors, with the same merges, hence the same results."""
         values = np.asarray(values, dtype=float)
         m = len(values)
         flat = values.reshape(m, self.size)          # (a view where the layout allows)
@@ -301,9 +303,9 @@ class StreamingStatistics:
             if circular:
                 statkernels.resultant(columns, offset + start, offset + stop,
                                       self.reference, self._cos, self._sin)
-            if summarize and stop - start == batch_size:
-                summaries.append((start, self._summary(columns, offset + start, offset + stop,
-                                                       count, mean, m2, kind)))
+            if summarize:
+                summaries.extend(self._summaries(columns, offset, start, stop, (count, mean, m2),
+                                                 kind, summary_size or batch_size, batch_size))
         if self._stored:
             self._count += m
             if self._count * self.size > self._budget:
@@ -311,6 +313,22 @@ class StreamingStatistics:
         else:
             self._add_to_tails(columns[:, :m].T)
         return summaries
+
+    def _summaries(self, columns, offset, start, stop, moments, kind, size, batch_size):
+        """``[(start, summary), ...]`` of the full sub-batches of `size` of the batch
+        [start, stop) (a partial batch, at the end of a run, may hold some), or of the
+        batch itself (with its own `moments`) where `size` is the batch's and it is full."""
+        if size >= batch_size:
+            return [] if stop - start < batch_size else \
+                [(start, self._summary(columns, offset + start, offset + stop, *moments, kind))]
+        count, mean, m2 = (np.empty_like(m) for m in moments)
+        out = []
+        for first in range(start, stop - size + 1, size):
+            statkernels.moments(columns, offset + first, offset + first + size, count, mean,
+                                m2)
+            out.append((first, self._summary(columns, offset + first, offset + first + size,
+                                             count, mean, m2, kind)))
+        return out
 
     def _room(self, m):
         """(columns, offset) to write m more samples into: the store (grown by
@@ -339,8 +357,7 @@ class StreamingStatistics:
         """Coverage interval of every element from columns[:, start:stop]."""
         low, high = np.empty(self.size), np.empty(self.size)
         if kind == "symmetric":
-            ranks = np.array([_symmetric_ranks(int(c), probability) or (-1, -1)
-                              for c in count], dtype=np.int64).reshape(-1, 2)
+            ranks = _rank_pairs(count, probability)
             parts = element_parts(self.size)
             length = statkernels.scratch_length(stop - start)
             if len(self._scratch) != len(parts) or self._scratch[0].shape[1] < length:
@@ -472,6 +489,16 @@ class _Tail:
 #: Up to this many columns a batch's endpoints come from bracketed selection, column by
 #: column (2-4x faster than numpy.partition per column, but a Python loop over them).
 _SELECTION_COLUMNS = 8
+
+
+def _rank_pairs(counts, probability):
+    """(elements, 2) int64 ranks of :func:`_symmetric_ranks` per element's count ((-1, -1)
+    where there is no interval), computed once per distinct count."""
+    counts = np.asarray(counts).reshape(-1)
+    distinct, where = np.unique(counts, return_inverse=True)
+    pairs = np.array([_symmetric_ranks(int(c), probability) or (-1, -1) for c in distinct],
+                     dtype=np.int64).reshape(-1, 2)
+    return pairs[where.reshape(-1)]
 
 
 def _symmetric_ranks(m, probability):

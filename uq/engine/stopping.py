@@ -32,6 +32,7 @@ References
 """
 import numpy as np
 from scipy.stats import chi2
+from scipy.stats import t as student_t
 
 STOPPING_RULES = ("jcgm101", "confident")
 #: What may end a Monte Carlo run; its index is the CF flag value of ``mc_stopped_by``.
@@ -47,6 +48,15 @@ def standard_error(batch_values):
     """s_y: standard deviation of the average of the h batch values (axis 0)."""
     values = np.asarray(batch_values)
     return np.std(values, axis=0, ddof=1) / np.sqrt(len(values))
+
+
+def coverage_factor(h):
+    """Factor on the standard error s_y of h batches for a 95 % statement about the
+    true value: JCGM 101 7.9's 2 where the batches are many, Student's t_{0.975}(h - 1)
+    where they are few (s_y is then itself uncertain: t_{0.975}(3) = 3.18); NaN < 2."""
+    if h < 2:
+        return np.nan
+    return max(2.0, float(student_t.ppf(0.975, h - 1)))
 
 
 def upper_bound_factor(h, check):

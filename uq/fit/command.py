@@ -12,8 +12,8 @@ import yaml
 from uq.constants import MAX_FIT_TABLE_BYTES
 from uq.errors import DataFileError, ScenarioError
 from uq.fit.bayesfit import NotConverged
-from uq.fit.fitting import (MAX_FIT_POINTS, combine_fits, fit_profile, profile_from_results,
-                            profile_from_table, true_parameters)
+from uq.fit.fitting import (MAX_FIT_POINTS, combine_fits, fit_notes, fit_profile,
+                            profile_from_results, profile_from_table, true_parameters)
 from uq.files import check_target, save_figure, write_netcdf
 from uq.pipeline.inputfile import read_csv
 from uq.pipeline.metadata import history
@@ -144,6 +144,15 @@ def fit_table(dataset):
                 f"{float(p.least_squares_value):>15.4g}"
                 f"{_interval(p.least_squares_low95, p.least_squares_high95):>24}"
                 f"{truth:>9.4g}")
+    if "least_squares_basis" in dataset.coords:
+        for fit in dataset["fit"].values:
+            basis = str(dataset["least_squares_basis"].sel(fit=fit).values)
+            extra = float(dataset["least_squares_extra_scatter"].sel(fit=fit)) \
+                if "least_squares_extra_scatter" in dataset else np.nan
+            scatter = f" (extra scatter {extra:.3g} m s-1)" if extra > 0 else ""
+            lines.append(f"least squares, {fit}: {basis}{scatter}")
+    for note in fit_notes(dataset):
+        lines.append(f"note: {note}")
     return "\n".join(lines)
 
 

@@ -32,7 +32,7 @@ import xarray as xr
 from uq.errors import DataFileError
 from uq.fit.bayesfit import (ProfilePosterior, posterior_summary, profile_data, sample_posterior,
                              variances)
-from uq.fit.profilefit import least_squares_profile
+from uq.fit.profilefit import INTERVAL_BASES, least_squares_profile
 from uq.physics.profiles import PROFILES
 from uq.pipeline.metadata import cf_encode, history
 
@@ -129,13 +129,14 @@ def fit_profile(data, config, seed=None):
                               walkers=config.walkers, ensembles=config.ensembles,
                               max_steps=config.max_steps)
     grid = np.linspace(data.heights.min(), data.heights.max(), GRID_POINTS)
-    known = np.all(variances(data.speed_covariance) > 0) and not config.scatter
-    # with a free scatter the least-squares reference estimates it from the residuals;
+    known = bool(np.all(variances(data.speed_covariance) > 0))
+    # the data's covariance where it is given (plus, with a free scatter, the extra
+    # scatter estimated from the residuals), else the residuals' scatter alone;
     # curve_fit takes standard deviations (1-D) or a covariance matrix (2-D)
     sigma = data.speed_covariance if np.ndim(data.speed_covariance) == 2 else \
         np.sqrt(data.speed_covariance)
     least = least_squares_profile(config.profile, data.heights, data.speeds,
-                                  sigma=sigma if known else None,
+                                  sigma=sigma if known else None, scatter=config.scatter,
                                   fixed=config.fixed, grid=grid)
     return _fit_dataset(data, posterior, chains, least, grid)
 
@@ -170,8 +171,9 @@ def _fit_dataset(data, posterior, chains, least, grid):
     ds["tau"] = ("parameter", chains["tau"])
     ds["rhat"] = ("parameter", chains["rhat"])
     ds["maximum_a_posteriori"] = ("parameter", chains["map"])
+    ds["least_squares_extra_scatter"] = least["extra_scatter"]
     ds.attrs.update(burn=chains["burn"], thin=chains["thin"], profile=posterior.name,
-                    profile_parameters=k)
+                    profile_parameters=k, least_squares_basis=least["interval_basis"])
     return ds
 
 
@@ -234,10 +236,59 @@ def combine_fits(fits, truth=None):
     combined = combined.assign_coords(fit=list(fits))
     combined["burn"] = ("fit", [ds.attrs["burn"] for ds in fits.values()])
     combined["thin"] = ("fit", [ds.attrs["thin"] for ds in fits.values()])
+    combined.coords["least_squares_basis"] = (
+        "fit", [INTERVAL_BASES[ds.attrs["least_squares_basis"]] for ds in fits.values()])
+    combined.attrs.pop("least_squares_basis", None)
     if truth is not None:
         combined["true_value"] = ("parameter", [truth.get(p, np.nan)
                                                 for p in combined["parameter"].values])
+    notes = fit_notes(combined)
+    if notes:
+        combined.attrs["comment"] = " ".join(notes)
     return annotate(combined)
+
+
+#: Two fits' 95 % intervals whose widths differ by less than this share are "the same"
+#: to a reader: less than a line's width in the figure, the third digit of the table.
+SAME_WIDTH = 0.1
+
+
+def fit_notes(dataset):
+    """Sentences a reader of the fits needs (list of str): where a free scatter's
+    posterior reaches beyond the gates' own uncertainty, it dominates the likelihood, and
+    fits that differ only in the gates' covariance (propagated, naive) come out the same.
+
+    With n gates and k profile parameters the data hold n - k residual degrees of freedom
+    for the scatter; with few of them (3 gates: 1) its posterior stays wide, up to values
+    well above the measurement uncertainty, whatever the covariance.
+    """
+    if "ln_sigma" not in dataset["parameter"].values or "posterior_high95" not in dataset:
+        return []
+    notes = []
+    k = int(dataset.attrs.get("profile_parameters", dataset.sizes["parameter"] - 1))
+    n = int(np.isfinite(dataset["observed_speed"].isel(fit=0)).sum())
+    reach = float(np.exp(dataset["posterior_high95"].sel(parameter="ln_sigma")).max())
+    own = float(dataset["observed_speed_u"].max())
+    if reach > own:
+        notes.append(f"The free scatter (fit.scatter: true) reaches {reach:.3g} m s-1 at its "
+                     f"97.5 % quantile, above the gates' own uncertainty ({own:.3g} m s-1): "
+                     f"with {n} points and {k} parameters the data hold {n - k} residual "
+                     "degree(s) of freedom and cannot bound it, so the posterior is wider "
+                     "than the least-squares interval, which rests on the data's "
+                     "covariance.")
+    fits = list(dataset["fit"].values)
+    if {"propagated", "naive"} <= set(fits):
+        first = dataset["parameter"].values[0]
+        width = (dataset["posterior_high95"] - dataset["posterior_low95"]).sel(parameter=first)
+        a, b = float(width.sel(fit="propagated")), float(width.sel(fit="naive"))
+        if abs(a - b) < SAME_WIDTH * max(a, b):
+            why = "the free scatter, common to both, widens both alike" if reach > own else \
+                "the gates' errors are nearly independent"
+            notes.append(f"The propagated and naive posteriors are the same ({first}'s 95 % "
+                         f"widths {a:.3g} and {b:.3g}): {why}; "
+                         + ("set fit.scatter: false to compare the covariances alone."
+                            if reach > own else "the covariance adds nothing here."))
+    return notes
 
 
 #: Marks a variable whose unit is its parameter's (``parameter_units``): one netCDF
@@ -271,6 +322,14 @@ FIT_METADATA = {
     "least_squares_high95": (PER_PARAMETER, "upper end of the 95 % confidence interval "
                              "(delta method; on ln z0 for the roughness length)"),
     "least_squares_fit": ("m s-1", "least-squares profile at grid_height"),
+    "least_squares_basis": ("", "what the least-squares intervals rest on (the speeds' "
+                            "given covariance, an extra scatter estimated from the "
+                            "residuals, or both) and their quantiles"),
+    "least_squares_extra_scatter": ("m s-1", "extra scatter of the least-squares fit "
+                                    "estimated from the residuals (Paule-Mandel; 0 where "
+                                    "the given covariance explains them, missing where no "
+                                    "covariance is given: then the whole scatter is "
+                                    "estimated)"),
     "least_squares_confidence_low": ("m s-1", "lower end of the 95 % confidence band of "
                                      "the least-squares profile"),
     "least_squares_confidence_high": ("m s-1", "upper end of the 95 % confidence band of "

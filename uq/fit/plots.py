@@ -1,4 +1,6 @@
 """Figures of a finished fit Dataset (:mod:`uq.fit.fitting`): the profile and a corner plot."""
+import textwrap
+
 import corner
 import matplotlib
 
@@ -16,6 +18,8 @@ TITLES = {"reference_speed": "$U_{ref}$", "shear": r"$\alpha$", "friction_veloci
 LOGARITHMIC = ("roughness_length",)
 #: Share of the draws each corner axis spans (central): the bulk, not a far tail.
 CORNER_RANGE = 0.995
+#: Share of the profile figure's height below the panels for the legend (off the data).
+LEGEND_SPACE = 0.12
 #: Bounds of the number of histogram bins of the corner plot.
 MIN_CORNER_BINS, MAX_CORNER_BINS = 15, 50
 
@@ -38,15 +42,24 @@ def plot_profile_fit(dataset):
         ax.plot(fit.least_squares_fit, z, "--", color="C3", label="least squares")
         ax.plot(fit.least_squares_confidence_low, z, ":", color="C3")
         ax.plot(fit.least_squares_confidence_high, z, ":", color="C3",
-                label="95 % confidence (delta method)")
+                label="95 % confidence (least squares, delta method)")
         ax.errorbar(fit.observed_speed, fit.observed_height, xerr=fit.observed_speed_u,
                     fmt="o", color="k", ms=4, label="observed $\\pm 1u$")
         ax.set_title(f"{name}: {_parameter_text(dataset, name)}", fontsize=9)
-        ax.set_xlabel("wind speed [m s$^{-1}$]")
+        ax.set_xlabel("wind speed [m s$^{-1}$]" + _basis_text(fit))
     axes[0, 0].set_ylabel("height above sea level [m]")
-    axes[0, 0].legend(fontsize=7, loc="upper left")
-    figure.tight_layout()
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    figure.tight_layout(rect=(0, LEGEND_SPACE, 1, 1))
+    figure.legend(handles, labels, fontsize=7, loc="lower center", ncol=3, frameon=False)
     return figure
+
+
+def _basis_text(fit):
+    """What the least-squares band rests on, wrapped for a legend."""
+    if "least_squares_basis" not in fit.coords:
+        return ""
+    return "\n" + "\n".join(textwrap.wrap("least-squares band on "
+                                          f"{fit['least_squares_basis'].values}", 60))
 
 
 def _parameter_text(dataset, name):

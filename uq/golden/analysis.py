@@ -231,6 +231,11 @@ def _reference_terms(config, ds, reference, verified):
         own["classification"].drop_vars("comparison", errors="ignore")
 
 
+#: Marks a variable along ``variable`` whose unit is each environmental variable's own
+#: (degC, percent, m s-1, ...): one netCDF variable holds several, and the configuration
+#: names columns, not units, so it carries no ``units`` attribute (a wrong one, "1" or
+#: "percent", would mislead) and its long_name says so.
+PER_VARIABLE = ""
 #: units and long names of the result variables (verdicts and flags are dimensionless).
 METADATA = {
     "height": ("m", "measurement height above sea level"),
@@ -257,14 +262,16 @@ METADATA = {
                                     "class number / sqrt(3) %"),
     "classification": ("m s-1", "classification uncertainty of the unit (chosen route)"),
     "total": ("m s-1", "calibration and classification uncertainty of the unit"),
-    "verification_mean": ("1", "bin mean of the variable in the verification campaign "
-                          "(units of the variable)"),
-    "smc_mean": ("1", "bin mean of the variable in the SMC (units of the variable)"),
+    "verification_mean": (PER_VARIABLE, "bin mean of the variable in the verification "
+                          "campaign, in the variable's own units (those of its column)"),
+    "smc_mean": (PER_VARIABLE, "bin mean of the variable in the SMC, in the variable's own "
+                 "units (those of its column)"),
     "smc_n_records": ("1", "SMC records in the bin"),
-    "slope": ("percent", "sensitivity slope of the percentage deviation (per unit of the "
-              "variable)"),
+    "slope": (PER_VARIABLE, "sensitivity slope of the percentage deviation, in percent per "
+              "unit of the variable (its column's unit)"),
     "slope_intercept": ("percent", "intercept of the sensitivity regression"),
-    "slope_standard_error": ("percent", "standard error of the sensitivity slope"),
+    "slope_standard_error": (PER_VARIABLE, "standard error of the sensitivity slope, in "
+                             "percent per unit of the variable (its column's unit)"),
     "slope_p_value": ("1", "two-sided p-value of the slope (t-test of zero slope)"),
     "slope_r_squared": ("1", "R^2 of the sensitivity regression"),
     "slope_n_records": ("1", "records in the sensitivity regression"),
@@ -285,7 +292,8 @@ METADATA = {
     "paired_reference_direction": ("degree", "reference wind direction (from, clockwise "
                                    "from north)"),
     "paired_unit_direction": ("degree", "unit wind direction (from, clockwise from north)"),
-    "paired_environment": ("1", "environmental variables of the reference (their units)"),
+    "paired_environment": (PER_VARIABLE, "environmental variables of the reference, each "
+                           "in its own units (those of its column)"),
     "time": ("", "start of the paired 10-min record"),
     "comparison": ("", "comparison: unit-reference"),
     "framework": ("", "framework of the deviation term: iec (IEC 61400-12-1) or lusr"),

@@ -36,16 +36,16 @@ from matplotlib.lines import Line2D  # noqa: E402
 from uq.errors import ScenarioError  # noqa: E402
 from uq.files import check_target, output_folder, save_figure  # noqa: E402
 from uq.outputs import motionfigures, plots  # noqa: E402
-from uq.outputs.labels import model_style  # noqa: E402
+from uq.outputs.labels import MODELS as LABEL_MODELS  # noqa: E402
+from uq.outputs.labels import coordinate_label, model_style  # noqa: E402
 from uq.outputs.planning import VELOCITY_RATIOS, velocity_ratio_line  # noqa: E402
 from uq.outputs.planning import models as available_models  # noqa: E402
 from uq.outputs.plots import plot_uncertainty_against_direction  # noqa: E402
 from uq.outputs.samples import can_redraw, scene_trials  # noqa: E402
 
-#: Uncertainty variables: suffix -> (label, line style).
-MODELS = {"paper_u": ("Rubio & Gottschall (2022)", "-"),
-          "gum_u": ("GUM, physical model", "--"),
-          "mc_u": ("Monte Carlo, physical model", ":")}
+#: Uncertainty variables: suffix -> (label, ...): the one mapping of
+#: :data:`uq.outputs.labels.MODELS` (labels, line styles, markers and colours).
+MODELS = LABEL_MODELS
 UNITS = {"wind_speed": "m s$^{-1}$", "wind_direction": "deg", "radial_velocity": "m s$^{-1}$"}
 SYMBOLS = {"wind_speed": "$V_h$", "wind_direction": r"$\Theta$", "radial_velocity": "$v_r$"}
 BEAM_NAMES = {0.0: "N", 90.0: "E", 180.0: "S", 270.0: "W"}
@@ -318,10 +318,13 @@ CAPTIONS = {
     "fig7_half_cone": "u against the half-cone angle, averaged over wind direction.",
     "uncertainty_against_direction": "u(Vh) and u(wind direction) against wind direction: "
     "the paper's model (dashed), the physical GUM (line) and Monte Carlo (points).",
-    "uncertainty_against_sweep": "u of each model against the swept value; Monte Carlo "
+    "uncertainty_against_sweep": "u of each model against the swept value (with two "
+    "swept keys, a line per value of the shorter or categorical one); Monte Carlo "
     "with two standard errors of u (from independent batches, or u/sqrt(2(N-1)) for runs "
     "of fewer than two batches), so that its difference from the GUM can be told from "
     "sampling noise.",
+    "radial_velocity_per_beam": "u of each beam's radial velocity, a panel per beam, "
+    "against the range gate or the swept value; Monte Carlo with two standard errors of u.",
     "maps_": "u over the two swept keys, one column per model (one colour scale, or one "
     "per panel where a common one would hide a panel's variation); white: outside the "
     "model (the paper's model covers only its own cases).",
@@ -456,8 +459,14 @@ def figure_plan(dataset, select=None):
 def uncertainty_plan(dataset):
     """The figures of the uncertainties (:func:`figure_plan` without the probe's)."""
     plan = paper_plan(dataset)
-    if plan or not plots.sweep_quantities(dataset):
+    if plan:
         return plan
+    return (scalar_plan(dataset) if plots.sweep_quantities(dataset) else []) \
+        + beam_plan(dataset)
+
+
+def scalar_plan(dataset):
+    """The figures of the outputs with one value per scene and gate."""
     dims = sweep_dimensions(dataset)
     if not dims:
         return single_scene_plan(dataset)
@@ -466,7 +475,15 @@ def uncertainty_plan(dataset):
             {ds.attrs.get("ins_correlation", "physical"): ds}))]
     if len(dims) == 1:
         return [("uncertainty_against_sweep", plot_against_sweep)]
-    return map_plan(dataset)
+    return line_plan(dataset) or map_plan(dataset)
+
+
+def beam_plan(dataset):
+    """An output per beam (the radial velocity) of a single scene or a 1-D sweep: a
+    panel per beam (:func:`uq.outputs.plots.plot_beams`)."""
+    if not plots.beam_panels(dataset) or len(sweep_dimensions(dataset)) > 1:
+        return []
+    return [("radial_velocity_per_beam", plots.plot_beams)]
 
 
 def probe_plan(dataset):
@@ -489,6 +506,26 @@ def single_scene_plan(dataset):
         sampled = tuple(q for q in quantities if f"{q}_mc_low" in dataset)
         plan.append(("histogram", lambda ds: plots.plot_histogram(ds, scene_trials(ds, sampled))))
     return plan
+
+
+#: Most scenes of a 2-D sweep drawn as lines (a line per value of one key) instead of maps.
+MAX_LINE_SCENES = 48
+#: Most values of the key whose values get a line each.
+MAX_LINES = 6
+
+
+def line_plan(dataset):
+    """A small 2-D sweep (at most MAX_LINE_SCENES scenes) with a key of at most
+    MAX_LINES values (a categorical one, such as ``correction``, first): u against the
+    other key, a line per value of that one; [] otherwise (maps)."""
+    dims = sweep_dimensions(dataset)
+    if len(dims) != 2 or np.prod([dataset.sizes[d] for d in dims]) > MAX_LINE_SCENES:
+        return []
+    short = sorted(dims, key=lambda d: (dataset[d].dtype.kind in "iuf", dataset.sizes[d]))
+    lines, x = short[0], short[1]
+    if dataset.sizes[lines] > MAX_LINES:
+        return []
+    return [("uncertainty_against_sweep", lambda ds: plots.plot_against_sweep(ds, x, lines))]
 
 
 def map_plan(dataset):
@@ -517,10 +554,24 @@ def make_figures(dataset, directory, stem="", formats=("png",), select=None):
     output_folder(directory)
     written = []
     for name, function in plan:
-        figure = function(dataset)
+        figure = mark_selection(function(dataset), dataset, select)
         written += [save_figure(figure, path, dpi=130) for path in targets[name]]
         plt.close(figure)
     return written
+
+
+def mark_selection(figure, dataset, select):
+    """The fixed sweep values of `select` (``--select``) in the figure's title, so that a
+    figure of some scenes says which; `dataset` is the selection. Returns the figure."""
+    if not select:
+        return figure
+    text = "selected: " + ", ".join(
+        f"{coordinate_label(dataset, dim).split(' [')[0]} = {_text(dataset[dim].values.item())}"
+        + (f" {dataset[dim].attrs['units']}" if dataset[dim].attrs.get("units") else "")
+        for dim in select)
+    title = figure._suptitle.get_text() if figure._suptitle is not None else ""
+    figure.suptitle(f"{title}\n{text}" if title else text, fontsize=9)
+    return figure
 
 
 def _text(value):

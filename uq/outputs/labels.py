@@ -19,7 +19,9 @@ QUANTITIES = {"wind_speed": ("wind speed", "$V_h$", "m s$^{-1}$"),
               "radial_velocity": ("radial velocity", "$v_r$", "m s$^{-1}$"),
               "gate_height": ("gate height", "$z$", "m")}
 #: The quantities a figure of a sweep shows, in this order, when the result has them.
-SWEEP_QUANTITIES = ("wind_speed", "wind_direction", "vertical_wind")
+SWEEP_QUANTITIES = ("wind_speed", "wind_direction", "vertical_wind", "gate_height")
+#: Requested outputs with a value per beam: a figure of their own (one panel per beam).
+BEAM_QUANTITIES = ("radial_velocity",)
 #: Words for the coordinates of swept scenario keys (others: the dotted key).
 KEY_WORDS = {"wind_direction": "wind direction", "wind_speed": "wind speed",
              "wind_shear": "shear exponent", "wind_vertical": "vertical wind",

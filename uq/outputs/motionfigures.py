@@ -16,6 +16,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from pathlib import Path  # noqa: E402
+
 import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
@@ -27,6 +29,9 @@ TILT_DIMENSIONS = ("motion_pitch_amplitude", "ship_pitch", "motion_roll_amplitud
 CONTOURS = (-1.0, -0.5, -0.25, -0.1, -0.05, -0.02, 0.02, 0.05, 0.1, 0.25, 0.5, 1.0)
 #: Histogram bins per correction model.
 HISTOGRAM_BINS = 70
+#: Units of the harmonic motion's degrees of freedom (docs/scenario.md, motion.<dof>).
+HARMONIC_UNITS = {"roll": "deg", "pitch": "deg", "yaw": "deg", "surge": "m", "sway": "m",
+                  "heave": "m"}
 CORRECTION_COLOURS = {"none": "tab:grey", "yaw": "tab:purple", "tilt2d": "tab:brown",
                       "full": "tab:red", "pointwise": "tab:blue"}
 
@@ -133,9 +138,14 @@ def _sea(scenario):
     if "spectrum" in motion:
         sea = motion["spectrum"]
         return f"JONSWAP sea, Hs {sea['hs']:g} m, Tp {sea['tp']:g} s"
-    parts = [f"{dof} {spec['amplitude']:g} at {spec['period']:g} s" for dof, spec in
-             motion.items() if isinstance(spec, dict) and "amplitude" in spec]
-    return "harmonic motion: " + ", ".join(parts)
+    if "series" in motion:
+        record = motion["series"]
+        return (f"measured motion record {Path(str(record.get('file', ''))).name} "
+                f"({record.get('components', '')} harmonics kept, random window per scan)")
+    parts = [f"{dof} {spec['amplitude']:g} {HARMONIC_UNITS.get(dof, '')} at "
+             f"{spec['period']:g} s" for dof, spec in motion.items()
+             if isinstance(spec, dict) and "amplitude" in spec]
+    return "harmonic motion: " + ", ".join(parts) if parts else "motion"
 
 
 def _at(dataset, name, correction):

@@ -12,6 +12,7 @@ References
 .. [1] Rubio, H. and Gottschall, J. (2022). J. Phys.: Conf. Ser. 2362 012034.
 """
 import numpy as np
+import yaml
 
 from uq.constants import FULL_CIRCLE_DEG, NUMERICAL_ZERO
 
@@ -320,3 +321,30 @@ def gum_validity_answer(dataset, quantity="wind_speed"):
     return {"valid": float(valid.mean()), "conclusive": float(conclusive.mean()),
             "valid_count": int(valid.sum()), "conclusive_count": int(conclusive.sum()),
             "compared": int(valid.size)}
+
+
+def fixed_phase_note(dataset):
+    """Why the motion-induced TI increment of a run is (near) zero although the platform
+    moves: every harmonic motion component has a fixed phase (no ``random``, no wave
+    spectrum or record), so every scan sees the same motion and its scatter over scans is
+    not sampled; the motion shows as a systematic error of the wind speed instead.
+    Returns the sentence, or '' when some phase is sampled (or there is no motion)."""
+    try:
+        raw = yaml.safe_load(dataset.attrs.get("scenario", "")) or {}
+    except yaml.YAMLError:
+        return ""
+    motion = raw.get("motion") if isinstance(raw, dict) else None
+    if not isinstance(motion, dict) or not motion:
+        return ""
+    harmonic = {k: v for k, v in motion.items() if isinstance(v, dict) and "amplitude" in v}
+    if len(harmonic) != len(motion) or any(str(v.get("phase", "random")) == "random"
+                                           for v in harmonic.values()):
+        return ""                      # a random phase, a spectrum or a record: sampled
+    phases = ", ".join(f"motion.{k}.phase: {v['phase']:g}" for k, v in harmonic.items())
+    text = (f"every motion phase is fixed ({phases}): each scan sees the same motion, so "
+            "its scatter over scans (the TI increment) is not sampled")
+    if "wind_speed_nominal" in dataset and "wind_speed_true" in dataset:
+        largest = _largest(dataset["wind_speed_nominal"] - dataset["wind_speed_true"])
+        text += ("; the motion shows as the systematic error of the wind speed instead "
+                 f"(error-free reconstruction minus true up to {largest['value']:+.3g} m/s)")
+    return text + "; set the phases to random to sample the scatter over the motion's phase"

@@ -21,6 +21,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 from scipy.stats import norm  # noqa: E402
 
@@ -42,8 +43,17 @@ SHOWN_GATES = 3
 MAP_MIN_RELATIVE_SPAN = 0.01
 #: Largest number of values of a numeric sweep axis that get a tick each [1].
 MAP_VALUE_TICKS = 12
+#: The bench figure fits its lines to the runs whose error is above this many times the
+#: reference's own relative error [1]: the observed error is ~sqrt(e^2 + floor^2), 5 %
+#: above e at 3x the floor.
+BENCH_FLOOR_FACTOR = 3.0
+#: Most columns of a legend under the panels.
+LEGEND_COLUMNS = 4
 #: Histogram bins of the Monte Carlo trials.
 HISTOGRAM_BINS = 80
+#: Height of a histogram panel over its tallest bar or curve [1]: room for the legend
+#: above the data.
+HISTOGRAM_HEADROOM = 1.45
 
 
 def plot_uncertainty_against_direction(results, axes_pair=None):
@@ -53,31 +63,45 @@ def plot_uncertainty_against_direction(results, axes_pair=None):
     ----------
     results : dict
         Label -> Dataset with a ``wind_direction`` sweep dimension (e.g. one per INS
-        correlation mode). Each is drawn as Monte Carlo (points), physical GUM (line) and,
-        from the first, the Rubio & Gottschall (2022) model (dashed).
+        correlation mode). Each is drawn as Monte Carlo (markers) and physical GUM
+        (dashed), and, from the first, the Rubio & Gottschall (2022) model: the models'
+        one style (:func:`uq.outputs.labels.model_style`); with several results a colour
+        per result.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    figure, axes = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True) \
+    figure, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True) \
         if axes_pair is None else (axes_pair[0].figure, axes_pair)
-    for (label, ds), colour in zip(results.items(), ("tab:blue", "tab:orange", "tab:green")):
+    several = len(results) > 1
+    for k, (label, ds) in enumerate(results.items()):
         x = ds["wind_direction"].values
-        for ax, q, unit in ((axes[0], "wind_speed", "m s$^{-1}$"), (axes[1], "wind_direction", "deg")):
-            ax.plot(x, ds[f"{q}_gum_u"], color=colour, label=f"GUM, physical ({label})")
-            ax.plot(x, ds[f"{q}_mc_u"], "o", ms=3, color=colour, label=f"Monte Carlo ({label})")
+        for ax, q in ((axes[0], "wind_speed"), (axes[1], "wind_direction")):
+            for model in ("gum_u", "mc_u"):
+                style = model_style(model)
+                if several:
+                    style.update(color=RESULT_COLOURS[k % len(RESULT_COLOURS)],
+                                 label=f"{style['label']} ({label})")
+                ax.plot(x, ds[f"{q}_{model}"], **style)
             ax.set_xlabel("wind direction [deg]")
-            ax.set_ylabel(f"u({q.replace('_', ' ')}) [{unit}]")
+            ax.set_ylabel(quantity_label(q))
     first = next(iter(results.values()))
     for ax, q in ((axes[0], "wind_speed"), (axes[1], "wind_direction")):
-        ax.plot(first["wind_direction"], first[f"{q}_paper_u"], "k--",
-                label="Rubio & Gottschall (2022)")
+        if f"{q}_paper_u" in first and np.isfinite(first[f"{q}_paper_u"].values).any():
+            ax.plot(first["wind_direction"], first[f"{q}_paper_u"], **model_style("paper_u"))
         ax.set_xlim(0, 360)
         ax.set_xticks(range(0, 361, 90))
         ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=7)
+    if axes_pair is None:
+        legend_below(figure, axes[0])
+    else:
+        axes[0].legend(fontsize=7)
     return figure
+
+
+#: Colours of several results in one figure (the models keep their line styles).
+RESULT_COLOURS = ("tab:blue", "tab:orange", "tab:green")
 
 
 def _two_and_five(value, _position):
@@ -89,17 +113,30 @@ def _two_and_five(value, _position):
 
 def plot_bench(dataset):
     """Relative error of u(wind speed) against wall time, one panel per scene: every
-    repeated run as a point, the median per method and sample size as a line."""
+    repeated run as a point, the median per method and sample size as a marker, and a
+    power law fitted per method to the runs whose error is above BENCH_FLOOR_FACTOR times
+    the reference's own relative error (the floor, drawn as a grey band): medians of a few
+    repeats zig-zag, and below the floor the error measured is the reference's."""
     scenes = list(dataset["scene"].values)
-    figure, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4),
+    figure, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4.2),
                                 constrained_layout=True, squeeze=False)
     for ax, scene in zip(axes[0], scenes):
+        floor = float(dataset["reference_relative_error"].sel(scene=scene)) \
+            if "reference_relative_error" in dataset else 0.0
         for method in dataset["method"].values:
             data = dataset.sel({"scene": scene, "method": method})
-            line, = ax.plot(data["time_s"].median("repeat"),
-                            data["relative_error"].median("repeat"), "-", label=str(method))
-            ax.plot(data["time_s"].values.ravel(), data["relative_error"].values.ravel(), ".",
-                    color=line.get_color(), alpha=0.4, ms=4)
+            times, errors = data["time_s"].values.ravel(), data["relative_error"].values.ravel()
+            points, = ax.plot(times, errors, ".", alpha=0.4, ms=4, label=str(method))
+            colour = points.get_color()
+            ax.plot(data["time_s"].median("repeat"), data["relative_error"].median("repeat"),
+                    "D", color=colour, ms=4, markerfacecolor="none")
+            fit = _power_law(times, errors, BENCH_FLOOR_FACTOR * floor)
+            if fit is not None:
+                ax.plot(*fit, "-", color=colour, lw=1.2)
+        if floor > 0:
+            ax.axhspan(ax.get_ylim()[0] if ax.get_yscale() == "log" else 0, floor,
+                       color="0.85", zorder=0)
+            ax.axhline(floor, color="0.5", lw=0.8)
         ax.axhline(1e-3, color="k", lw=0.8, ls="--")
         ax.set_xscale("log")
         ax.set_yscale("log")
@@ -110,10 +147,23 @@ def plot_bench(dataset):
         ax.grid(alpha=0.3, which="both")
     # below the panels: inside, the legend would cover runs' points
     figure.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside lower center",
-                  ncols=len(dataset["method"]), fontsize=8,
-                  title="method (points: runs; line: median); dashed: the 1e-3 target",
-                  title_fontsize=8)
+                  ncols=len(dataset["method"]), fontsize=8, markerscale=3,
+                  title="method (points: runs; diamonds: medians;\nlines: power law fitted "
+                  f"above {BENCH_FLOOR_FACTOR:g}x the floor); dashed: the 1e-3 target;\n"
+                  "grey: below the reference's own error (the floor)", title_fontsize=8)
     return figure
+
+
+def _power_law(times, errors, above):
+    """(times, fitted errors) of log error = a + b log time over the runs with an error
+    above `above`, across their time range; None with fewer than 3 such runs or one
+    time only."""
+    keep = np.isfinite(times) & np.isfinite(errors) & (errors > max(above, 0.0)) & (times > 0)
+    if np.count_nonzero(keep) < 3 or np.ptp(np.log(times[keep])) == 0:
+        return None
+    slope, intercept = np.polyfit(np.log(times[keep]), np.log(errors[keep]), 1)
+    span = np.geomspace(times[keep].min(), times[keep].max(), 20)
+    return span, np.exp(intercept + slope * np.log(span))
 
 
 def sweep_quantities(dataset):
@@ -185,41 +235,98 @@ def plot_budget(dataset):
     return figure
 
 
+def _gate_name(dataset, gate):
+    """``range gate 100 m`` of gate index `gate` ('' without a range coordinate)."""
+    if "range" not in dataset.coords:
+        return ""
+    ranges = np.atleast_1d(dataset["range"].values)
+    return f"range gate {float(ranges[gate]):g} m"
+
+
 def _gate_text(dataset, gate):
     if "range" not in dataset.dims:
         return "GUM"
     return f"range gate {float(dataset['range'].values[gate]):g} m"
 
 
-def plot_against_gate(dataset):
+def plot_against_gate(dataset, panels=None):
     """Single scene with several range gates: u of each model (Monte Carlo with +-2
-    standard errors of u) against the range gate; one panel per output."""
-    quantities = sweep_quantities(dataset)
-    figure, axes = plt.subplots(1, len(quantities), figsize=(4.2 * len(quantities), 4),
+    standard errors of u) against the range gate; one panel per output (`panels`:
+    (quantity, {dim: index}, title) each, default :func:`output_panels`)."""
+    panels = output_panels(dataset) if panels is None else panels
+    figure, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 4),
                                 sharey=True, constrained_layout=True, squeeze=False)
     gates = dataset["range"].values
-    for ax, quantity in zip(axes[0], quantities):
-        for model in available_models(dataset, quantity):
-            values = dataset[f"{quantity}_{model}"].values
+    for ax, (quantity, where, title) in zip(axes[0], panels):
+        at = dataset.isel(where)
+        for model in available_models(at, quantity):
+            values = at[f"{quantity}_{model}"].values
             ax.plot(values, gates, **model_style(model))
             if model == "mc_u":
-                ax.errorbar(values, gates, xerr=2 * u_standard_error(dataset, quantity),
-                            fmt="none", ecolor="k", elinewidth=0.8, zorder=4)
+                ax.errorbar(values, gates, xerr=2 * u_standard_error(at, quantity),
+                            fmt="none", ecolor="k", elinewidth=0.8, zorder=4,
+                            label=ERROR_BAR_LABEL)
         ax.set_xlabel(quantity_label(quantity))
+        if title:
+            ax.set_title(title, fontsize=9)
         ax.grid(alpha=0.3)
     axes[0, 0].set_ylabel(coordinate_label(dataset, "range"))
-    axes[0, 0].legend(fontsize=7)
+    legend_below(figure, axes[0, 0])
     return figure
+
+
+def output_panels(dataset):
+    """(quantity, {}, None) per output a sweep figure shows (:func:`sweep_quantities`)."""
+    return [(quantity, {}, None) for quantity in sweep_quantities(dataset)]
+
+
+def beam_panels(dataset, quantity="radial_velocity"):
+    """(quantity, {"beam": k}, "radial velocity, beam at 90 deg") per beam of an output
+    with a beam dimension; [] when the result has no uncertainty of it."""
+    if f"{quantity}_gum_u" not in dataset or "beam" not in dataset[f"{quantity}_gum_u"].dims \
+            or not uncertain(dataset, quantity):
+        return []
+    azimuths = dataset["beam_azimuth"].values if "beam_azimuth" in dataset.coords else \
+        dataset["beam"].values.astype(float)
+    return [(quantity, {"beam": k}, f"{QUANTITIES[quantity][0]}, "
+             + ("vertical beam" if np.isnan(azimuth) else f"beam at {azimuth:g} deg"))
+            for k, azimuth in enumerate(azimuths)]
+
+
+def plot_beams(dataset, quantity="radial_velocity"):
+    """An output with a value per beam (radial velocity): a panel per beam, u against
+    the range gate (a single scene) or the swept key (a 1-D sweep)."""
+    panels = beam_panels(dataset, quantity)
+    if dataset["mc_n_samples"].ndim == 0:
+        return plot_against_gate(dataset, panels)
+    return plot_against_sweep(dataset, panels=panels)
+
+
+def legend_below(figure, ax, fontsize=7):
+    """The legend of `ax`'s lines under the panels, off the data."""
+    handles, labels = ax.get_legend_handles_labels()
+    if handles:
+        figure.legend(handles, labels, loc="outside lower center", fontsize=fontsize,
+                      ncols=min(len(handles), LEGEND_COLUMNS), frameon=False)
+
+
+#: Legend entry of the error bars on the Monte Carlo u: what they are, in the PNG.
+ERROR_BAR_LABEL = "MC u ±2 Monte Carlo standard errors"
 
 
 def u_standard_error(dataset, quantity):
     """Standard error of the Monte Carlo u: the run's own, from independent batches
     (``q_mc_u_standard_error``), or, where it has fewer than two batches (NaN), that of
     the standard deviation of N normal draws, u / sqrt(2 (N - 1))."""
+    return u_standard_error_array(dataset, quantity).values
+
+
+def u_standard_error_array(dataset, quantity):
+    """:func:`u_standard_error` as a DataArray (the result's dimensions)."""
     u = dataset[f"{quantity}_mc_u"]
     normal = u / np.sqrt(2 * (dataset["mc_n_samples"] - 1))
     stored = dataset.get(f"{quantity}_mc_u_standard_error")
-    return (normal if stored is None else stored.fillna(normal)).values
+    return normal if stored is None else stored.fillna(normal)
 
 
 def plot_histogram(dataset, trials):
@@ -233,21 +340,38 @@ def plot_histogram(dataset, trials):
     trials : dict
         output -> (n, n_gates) trials (:func:`uq.outputs.samples.scene_trials`).
     """
-    at, gate_text = middle_gate(dataset)
     quantities = [q for q in sweep_quantities(dataset) if q in trials]
-    figure, axes = plt.subplots(1, len(quantities), figsize=(4.6 * len(quantities), 3.8),
+    figure, axes = plt.subplots(1, len(quantities), figsize=(4.6 * len(quantities), 4.0),
                                 constrained_layout=True, squeeze=False)
-    gate = dataset.sizes["range"] // 2 if "range" in dataset.dims else 0
     for ax, quantity in zip(axes[0], quantities):
-        _histogram_panel(ax, at, quantity, trials[quantity].reshape(len(trials[quantity]), -1)
-                         [:, gate])
+        gate = histogram_gate(dataset, quantity)
+        at = dataset.isel(range=gate) if "range" in dataset.dims else dataset
+        values = trials[quantity].reshape(len(trials[quantity]), -1)[:, gate]
+        _histogram_panel(ax, at, quantity, values, _gate_name(dataset, gate))
     n = len(next(iter(trials.values())))
-    figure.suptitle(f"Monte Carlo ({n:,} trials) against the GUM"
-                    + (f", {gate_text}" if gate_text else ""), fontsize=10)
+    figure.suptitle(f"Monte Carlo ({n:,} trials) against the GUM; each panel at the range "
+                    "gate where the GUM fails, else the middle one", fontsize=10)
     return figure
 
 
-def _histogram_panel(ax, at, quantity, values):
+def histogram_gate(dataset, quantity):
+    """Index of the range gate a histogram shows: the first where clause 8 refuses the
+    GUM conclusively, else the first where it refuses it, else the middle gate (0
+    without gates)."""
+    if "range" not in dataset.dims:
+        return 0
+    valid = dataset.get(f"{quantity}_gum_valid")
+    if valid is not None:
+        failed = ~valid.values.astype(bool)
+        conclusive = dataset.get(f"{quantity}_gum_validation_conclusive")
+        sure = failed & (conclusive.values.astype(bool) if conclusive is not None else True)
+        for candidates in (sure, failed):
+            if candidates.any():
+                return int(np.flatnonzero(candidates)[0])
+    return dataset.sizes["range"] // 2
+
+
+def _histogram_panel(ax, at, quantity, values, where=""):
     value, u = float(at[f"{quantity}_gum_value"]), float(at[f"{quantity}_gum_u"])
     low, high = float(at[f"{quantity}_mc_low"]), float(at[f"{quantity}_mc_high"])
     if quantity == "wind_direction":                 # on the circle: about the GUM value
@@ -269,9 +393,10 @@ def _histogram_panel(ax, at, quantity, values):
                    if end < value else None)
     ax.set_xlabel(f"{QUANTITIES[quantity][0]} [{QUANTITIES[quantity][2]}]")
     ax.set_ylabel("probability density")
-    ax.set_title(_validation_text(at, quantity, value - k * u - low, value + k * u - high),
-                 fontsize=8)
-    ax.legend(fontsize=6, loc="upper left")
+    ax.set_title(_validation_text(at, quantity, value - k * u - low, value + k * u - high)
+                 + (f"\n{where}" if where else ""), fontsize=8)
+    ax.set_ylim(top=ax.get_ylim()[1] * HISTOGRAM_HEADROOM)      # the legend above the bars
+    ax.legend(fontsize=6, loc="upper left", ncols=2)
 
 
 def _near(values, centre):
@@ -292,79 +417,174 @@ def _validation_text(at, quantity, d_low, d_high):
             f"endpoint differences {d_low:+.2g}, {d_high:+.2g}{tolerance}")
 
 
-def plot_against_sweep(dataset, dim=None):
-    """Any 1-D sweep: u of each model against the swept value, one panel per output;
-    with range gates, a colour per shown gate (model by line style and marker); Monte
-    Carlo with +-2 standard errors of u."""
+def plot_against_sweep(dataset, dim=None, lines=None, panels=None):
+    """u of each model against a swept value, one panel per output (`panels`, see
+    :func:`plot_against_gate`), Monte Carlo with +-2 standard errors of u.
+
+    A colour per value of `lines` (a second, short sweep dimension, e.g. ``correction``:
+    one line per value; then at the middle range gate), else per shown range gate; the
+    model by line style and marker."""
     dim = dim or dataset["mc_n_samples"].dims[0]
-    quantities = sweep_quantities(dataset)
-    figure, axes = plt.subplots(1, len(quantities), figsize=(4.5 * len(quantities), 3.6),
+    panels = output_panels(dataset) if panels is None else panels
+    figure, axes = plt.subplots(1, len(panels), figsize=(4.5 * len(panels), 3.6),
                                 constrained_layout=True, squeeze=False)
-    gates = shown_gates(dataset)
-    x = dataset[dim].values
-    for ax, quantity in zip(axes[0], quantities):
-        for k, gate in enumerate(gates):
-            at = dataset.isel(range=gate) if "range" in dataset.dims else dataset
+    curves = _curves(dataset, lines)
+    for ax, (quantity, where, title) in zip(axes[0], panels):
+        for k, (at, name) in enumerate(curves):
+            at = at.isel(where)
             for model in available_models(dataset, quantity):
                 style = model_style(model)
                 style.setdefault("marker", ".")          # a value alone still shows
-                if len(gates) > 1:
-                    style.update(color=f"C{k}", label=f"{style['label']}, "
-                                 f"{_gate_text(dataset, gate)}")
-                ax.plot(x, at[f"{quantity}_{model}"].values, **style)
+                if len(curves) > 1:
+                    style.update(color=f"C{k}", label=f"{style['label']}, {name}")
+                ax.plot(_positions(dataset[dim]), at[f"{quantity}_{model}"].values, **style)
                 if model == "mc_u":                     # +-2 standard errors of u
-                    ax.errorbar(x, at[f"{quantity}_mc_u"].values,
+                    ax.errorbar(_positions(dataset[dim]), at[f"{quantity}_mc_u"].values,
                                 yerr=2 * u_standard_error(at, quantity), fmt="none",
-                                ecolor=style["color"], elinewidth=0.7, zorder=4)
+                                ecolor=style["color"], elinewidth=0.7, zorder=4,
+                                label=ERROR_BAR_LABEL if k == 0 else None)
+        _name_ticks(ax.xaxis, dataset[dim])
         ax.set_xlabel(coordinate_label(dataset, dim))
         ax.set_ylabel(quantity_label(quantity))
+        if title:
+            ax.set_title(title, fontsize=9)
         ax.grid(alpha=0.3)
-    axes[0, 0].legend(fontsize=6)
+    if lines is not None and "range" in dataset.dims:
+        figure.suptitle(middle_gate(dataset)[1], fontsize=9)
+    if len(curves) > 1:          # colours for the lines, styles for the models: a short key
+        _key_below(figure, [name for _, name in curves],
+                   available_models(dataset, panels[0][0]))
+    else:
+        legend_below(figure, axes[0, 0])
     return figure
+
+
+def _key_below(figure, names, models):
+    """A legend under the panels: a colour per line (C0, C1, ...), then each model's
+    style in black, then the error bars."""
+    handles = [Line2D([], [], color=f"C{k}", label=name) for k, name in enumerate(names)]
+    for model in models:
+        style = {**model_style(model), "color": "k"}
+        style.setdefault("marker", ".")
+        handles.append(Line2D([], [], **style))
+    if "mc_u" in models:
+        handles.append(Line2D([], [], color="k", marker="|", linestyle="none", markersize=8,
+                              label=ERROR_BAR_LABEL))
+    figure.legend(handles=handles, loc="outside lower center", fontsize=7, frameon=False,
+                  ncols=min(len(handles), LEGEND_COLUMNS))
+
+
+def _curves(dataset, lines):
+    """(data, name) per line of :func:`plot_against_sweep`: per value of `lines` (at
+    the middle gate), else per shown gate."""
+    if lines is not None:
+        at = middle_gate(dataset)[0]
+        return [(at.sel({lines: value}), f"{coordinate_label(dataset, lines).split(' [')[0]}"
+                 f" {_format(value)}") for value in dataset[lines].values]
+    if "range" not in dataset.dims:
+        return [(dataset, "")]
+    return [(dataset.isel(range=gate), _gate_text(dataset, gate))
+            for gate in shown_gates(dataset)]
 
 
 def plot_maps(dataset, quantity, x, y, facet=None):
     """Maps of u(`quantity`) over the sweep dimensions `x` and `y`, one column per model
     and one row per value of `facet` (a third sweep dimension); a shared colour scale or
-    one per panel (:func:`shared_scale`). With range gates, the middle gate."""
+    one per panel (:func:`shared_scale`). With range gates, the middle gate.
+
+    Monte Carlo noise draws nothing: a Monte Carlo panel whose values all lie within +-2
+    of their standard errors of one value is drawn flat, at its mean, and says so
+    (common random numbers make the noise of neighbouring scenes alike, so it would
+    look like structure); no colour scale spans less than the panels' +-2 standard
+    errors (nor MAP_MIN_RELATIVE_SPAN of their mean)."""
     at, gate_text = middle_gate(dataset)
     models = available_models(at, quantity)
     rows = [None] if facet is None else list(at[facet].values)
+    noise = _map_noise(at, quantity)
     panels = [[at[f"{quantity}_{m}"].sel({facet: r}) if facet else at[f"{quantity}_{m}"]
                for m in models] for r in rows]
-    shared = shared_scale([p.values for row in panels for p in row])
+    bands = [[_panel_noise(noise, m, facet, r) for m in models] for r in rows]
+    smoothed = [[_without_noise(panel, band, (x, y), at) for panel, band in zip(row, band_row)]
+                for row, band_row in zip(panels, bands)]
+    drawn = [[panel for panel, _ in row] for row in smoothed]
+    flats = [[note for _, note in row] for row in smoothed]
+    flat = [p.values for row in drawn for p in row]
+    band = max([b for row in bands for b in row], default=0.0)
+    shared = shared_scale(flat)
     figure, axes = plt.subplots(len(rows), len(models),
                                 figsize=(4.3 * len(models) + 0.8, 3.3 * len(rows) + 0.5),
                                 constrained_layout=True, squeeze=False, sharex=True,
                                 sharey=True)
-    flat = [p.values for row in panels for p in row]
-    limits = (min(np.nanmin(v) for v in flat), max(np.nanmax(v) for v in flat))
-    for i, (row, value) in enumerate(zip(panels, rows)):
+    limits = _panel_limits(np.concatenate([v.ravel() for v in flat]), band)
+    for i, (row, value) in enumerate(zip(drawn, rows)):
         for j, (panel, model) in enumerate(zip(row, models)):
             ax = axes[i, j]
             mesh = ax.pcolormesh(_positions(at[x]), _positions(at[y]),
                                  panel.transpose(y, x).values, shading="nearest",
                                  cmap="viridis", **dict(zip(("vmin", "vmax"), limits if shared
-                                                            else _panel_limits(panel.values))))
+                                                            else _panel_limits(panel.values,
+                                                                               bands[i][j]))))
             _name_ticks(ax.xaxis, at[x])
             _name_ticks(ax.yaxis, at[y])
+            if flats[i][j]:
+                ax.text(0.5, 0.02, flats[i][j], transform=ax.transAxes, ha="center",
+                        va="bottom", fontsize=7, bbox={"facecolor": "white", "alpha": 0.8,
+                                                       "edgecolor": "none"})
             if not shared:
                 bar = figure.colorbar(mesh, ax=ax, label=quantity_label(quantity))
                 bar.formatter.set_useOffset(False)           # the values, not an offset
             title = model_style(model)["label"]
             if facet is not None:
-                title += f"\n{coordinate_label(at, facet)} = {value:g}"
+                title += f"\n{coordinate_label(at, facet)} = {_format(value)}"
             ax.set_title(title, fontsize=9)
             if i == len(rows) - 1:
                 ax.set_xlabel(coordinate_label(at, x))
             if j == 0:
                 ax.set_ylabel(coordinate_label(at, y))
     if shared:
-        figure.colorbar(mesh, ax=axes, label=quantity_label(quantity))
+        bar = figure.colorbar(mesh, ax=axes, label=quantity_label(quantity))
+        bar.formatter.set_useOffset(False)
     scale = "one colour scale" if shared else "one colour scale per panel"
     figure.suptitle(f"u({QUANTITIES[quantity][0]}), {scale}"
                     + (f", {gate_text}" if gate_text else ""), fontsize=10)
     return figure
+
+
+def _map_noise(at, quantity):
+    """Twice the standard error of the Monte Carlo u of every scene (a DataArray), or
+    None without Monte Carlo."""
+    if f"{quantity}_mc_u" not in at:
+        return None
+    return 2 * u_standard_error_array(at, quantity)
+
+
+def _panel_noise(noise, model, facet, value):
+    """The largest +-2 standard errors of a panel [units of u]: 0 for a model without
+    sampling noise (GUM, the paper's)."""
+    if noise is None or not model.startswith("mc_"):
+        return 0.0
+    panel = noise.sel({facet: value}) if facet else noise
+    return float(panel.max()) if np.isfinite(panel).any() else 0.0
+
+
+def _without_noise(panel, band, dims, dataset):
+    """(panel to draw, note): a Monte Carlo panel averaged along each of its `dims` whose
+    variation (the largest spread along it) lies within 2 `band`, i.e. within +-2 standard
+    errors of one value, with a note saying so; unchanged, '' otherwise."""
+    if not band or not np.isfinite(panel.values).any():
+        return panel, ""
+    mean = float(np.nanmean(np.abs(panel.values)))
+    notes = []
+    for dim in dims:
+        spread = float((panel.max(dim) - panel.min(dim)).max())
+        if NUMERICAL_ZERO * mean < spread <= 2 * band:
+            panel = panel * 0 + panel.mean(dim)
+            notes.append(f"{coordinate_label(dataset, dim).split(' [')[0]} "
+                         f"({100 * spread / mean:.2g} %)")
+    if not notes:
+        return panel, ""
+    return panel, (f"averaged over {' and '.join(notes)}: the spread is within\n"
+                   f"±2 Monte Carlo standard errors (±{100 * band / mean:.2g} %)")
 
 
 def _positions(coordinate):
@@ -374,11 +594,12 @@ def _positions(coordinate):
     return values if values.dtype.kind in "iuf" else np.arange(values.size)
 
 
-def _panel_limits(values):
-    """(vmin, vmax) of a panel with its own colour scale: its range, widened about its
-    middle to at least MAP_MIN_RELATIVE_SPAN of its mean magnitude."""
+def _panel_limits(values, band=0.0):
+    """(vmin, vmax) of a colour scale: the values' range, widened about its middle to at
+    least MAP_MIN_RELATIVE_SPAN of their mean magnitude and to +-`band` (the Monte Carlo
+    noise, twice the standard error), so that noise takes few colours."""
     low, high = float(np.nanmin(values)), float(np.nanmax(values))
-    span = MAP_MIN_RELATIVE_SPAN * float(np.nanmean(np.abs(values)))
+    span = max(MAP_MIN_RELATIVE_SPAN * float(np.nanmean(np.abs(values))), 2 * band)
     if high - low >= span:
         return low, high
     middle = (low + high) / 2

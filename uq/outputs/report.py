@@ -16,14 +16,21 @@ import io
 import matplotlib.pyplot as plt
 import numpy as np
 
-from uq.constants import NUMERICAL_ZERO
+from scipy.stats import norm
+
+from uq.constants import COVERAGE_PROBABILITY, NUMERICAL_ZERO
 from uq.files import SIGNATURE, write_text
 from uq.outputs import planning
-from uq.outputs.figures import (caption, figure_plan, no_figure_reason, select_scenes,
-                                sweep_dimensions)
+from uq.outputs.figures import (caption, figure_plan, mark_selection, no_figure_reason,
+                                select_scenes, sweep_dimensions)
 from uq.outputs.labels import KEY_WORDS
 
-QUANTITY_UNITS = {"wind_speed": "m/s", "wind_direction": "deg", "vertical_wind": "m/s"}
+QUANTITY_UNITS = {"wind_speed": "m/s", "wind_direction": "deg", "vertical_wind": "m/s",
+                  "gate_height": "m", "radial_velocity": "m/s"}
+#: Most scenes of a sweep whose numbers the report lists scene by scene.
+MAX_TABLE_SCENES = 48
+#: Coverage factor of the GUM's 95 % interval of a Gaussian (JCGM 100, G.1.3).
+GUM_COVERAGE_FACTOR = float(norm.ppf((1 + COVERAGE_PROBABILITY) / 2))
 #: NUMERICAL_ZERO as the text writes it (1e-9).
 _ZERO = f"{NUMERICAL_ZERO:.0e}".replace("e-0", "e-")
 #: Units as the report's text writes them.
@@ -60,7 +67,8 @@ def render_report(dataset, source="", targets=planning.DEFAULT_TARGETS, select=N
              f"<style>{STYLE}</style></head><body><h1>{_e(name)}</h1>",
              _run_table(dataset, source), _answers(dataset, targets),
              _apparent_ti(dataset, true_ti), _findings(dataset),
-             _summary_tables(dataset), _figures(select_scenes(dataset, select)),
+             _summary_tables(dataset), _scene_tables(dataset),
+             _figures(select_scenes(dataset, select), select),
              _scenario(dataset),
              "</body></html>"]
     return "\n".join(parts)
@@ -123,7 +131,7 @@ def _answers(dataset, targets):
         out += ["<h3>Largest velocity ratio that keeps u(Vh) under a target</h3><p>VR = sog / "
                 "Vh on the swept grid, for every swept wind speed (direction-averaged u).</p>",
                 _table(("target u(Vh) [m/s]", "model", "largest VR", "limiting Vh [m/s]"), rows)]
-    for quantity in ("wind_speed", "wind_direction", "vertical_wind"):
+    for quantity in QUANTITY_UNITS:
         if f"{quantity}_budget" not in dataset:
             continue
         if not planning.uncertain(dataset, quantity):
@@ -155,8 +163,10 @@ def _apparent_ti(dataset, true_ti):
     else:
         rows.append(("as run", _percent_range(motion), _percent_range(apparent_ti(
             true_ti, motion.values))))
+    note = planning.fixed_phase_note(dataset)
     return "\n".join([
         "<h3>Apparent turbulence intensity</h3>",
+        f"<p><b>Note:</b> {_e(note[0].upper() + note[1:])}.</p>" if note else "",
         f"<p>A true turbulence intensity of {100 * true_ti:g} % reads as sqrt(TI^2 + "
         "TI_motion^2): the motion-induced increment (u of Vh from the motion alone, over Vh) "
         "adds in quadrature (<code>--true-ti</code> sets the true TI).</p>",
@@ -331,8 +341,9 @@ def _summary_tables(dataset):
         if single:
             gates = np.atleast_1d(dataset["range"].values)
             header = ("model",) + tuple(f"range gate {g:g} m" for g in gates)
-            rows = [(label,) + tuple(_number(v) for v in np.atleast_1d(dataset[name].values))
-                    for label, name in names]
+            rows = [(label + beam,) + tuple(_number(v) for v in np.atleast_1d(values))
+                    for label, name in names
+                    for beam, values in _per_beam(dataset, dataset[name])]
         else:
             header = ("model", "min", "median", "max", "outside the model")
             rows = [(label, _number(np.nanmin(v)), _number(np.nanmedian(v)),
@@ -343,18 +354,123 @@ def _summary_tables(dataset):
     return "\n".join(out)
 
 
+#: Outputs listed scene by scene (one value per scene and gate).
+SCENE_QUANTITIES = ("wind_speed", "wind_direction", "vertical_wind", "gate_height")
+#: Most range gates listed per scene (else the lowest, middle and highest).
+MAX_TABLE_GATES = 3
+
+
+def _scene_tables(dataset):
+    """The answer as a table, for a sweep of at most MAX_TABLE_SCENES scenes: per output,
+    a row per scene (and range gate) with u, the 95 % interval, the bias and, for the
+    wind speed of a run with motion, the turbulence-intensity increment."""
+    dims = sweep_dimensions(dataset)
+    scenes = int(np.prod([dataset.sizes[d] for d in dims])) if dims else 1
+    if not dims or scenes > MAX_TABLE_SCENES:
+        return ""
+    out = ["<h2>Scene by scene</h2><p>u: Monte Carlo where sampled, else the GUM; the 95 % "
+           "interval likewise (the GUM's y ± 1.96 u); bias: Monte Carlo mean minus true "
+           "(else the error-free reconstruction minus true).</p>"]
+    gates = _table_gates(dataset)
+    for quantity in SCENE_QUANTITIES:
+        if f"{quantity}_gum_u" not in dataset or not planning.uncertain(dataset, quantity):
+            continue
+        unit = QUANTITY_UNITS[quantity]
+        columns = _scene_columns(dataset, quantity, unit)
+        header = tuple(_key_header(dataset, d) for d in dims) + (
+            ("range gate [m]",) if gates else ()) + tuple(name for name, _ in columns)
+        rows = []
+        for index in np.ndindex(*[dataset.sizes[d] for d in dims]):
+            scene = dataset.isel(dict(zip(dims, index)))
+            keys = tuple(_e(_value_text(scene[d].values)) for d in dims)
+            for gate in gates or [None]:
+                at = scene if gate is None else scene.isel(range=gate)
+                rows.append(keys + ((f"{float(at['range']):g}",) if gates else ())
+                            + tuple(cell(at) for _, cell in columns))
+        out += [f"<h3>{quantity.replace('_', ' ').capitalize()}</h3>", _table(header, rows)]
+    return "\n".join(out)
+
+
+def _table_gates(dataset):
+    """Gate indices listed per scene ([] without a range dimension)."""
+    if "range" not in dataset.dims:
+        return []
+    n = dataset.sizes["range"]
+    return list(range(n)) if n <= MAX_TABLE_GATES else sorted({0, n // 2, n - 1})
+
+
+def _scene_columns(dataset, quantity, unit):
+    """(header, cell function of one scene and gate) of an output's scene table."""
+    sampled = f"{quantity}_mc_u" in dataset
+    u_name = f"{quantity}_mc_u" if sampled else f"{quantity}_gum_u"
+    columns = [(f"u [{unit}]", lambda at: _number(float(at[u_name]))),
+               (f"95 % interval [{unit}]", lambda at: _interval(at, quantity, sampled)),
+               (f"bias [{unit}]", lambda at: _scene_bias(at, quantity))]
+    if f"{quantity}_gum_valid" in dataset:
+        columns.append(("GUM validated", lambda at: "yes" if bool(at[f"{quantity}_gum_valid"])
+                        else "<span class='no'>no</span>"))
+    if quantity == "wind_speed" and "wind_speed_motion_ti" in dataset:
+        columns.append(("TI increment from motion",
+                        lambda at: f"{100 * float(at['wind_speed_motion_ti']):.2f} %"))
+    return columns
+
+
+def _interval(at, quantity, sampled):
+    if sampled:
+        low, high = float(at[f"{quantity}_mc_low"]), float(at[f"{quantity}_mc_high"])
+    else:
+        value, u = float(at[f"{quantity}_gum_value"]), float(at[f"{quantity}_gum_u"])
+        low, high = value - GUM_COVERAGE_FACTOR * u, value + GUM_COVERAGE_FACTOR * u
+    return f"[{low:.4g}, {high:.4g}]"
+
+
+def _scene_bias(at, quantity):
+    name = f"{quantity}_mc_bias"
+    if name in at:
+        return _number(float(at[name]))
+    difference = float(at[f"{quantity}_nominal"] - at[f"{quantity}_true"])
+    if quantity == "wind_direction":
+        difference = (difference + 180.0) % 360.0 - 180.0
+    return _number(difference)
+
+
+def _key_header(dataset, dim):
+    """A swept key in words with its unit, as the report writes them."""
+    units = dataset[dim].attrs.get("units")
+    words = KEY_WORDS.get(dim) or str(dataset[dim].attrs.get("long_name", dim)).replace(
+        "swept scenario key ", "")
+    units = HTML_UNITS.get(units, units)
+    return f"{words} [{units}]" if units else words
+
+
+def _value_text(value):
+    value = value.item() if hasattr(value, "item") else value
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def _per_beam(dataset, variable):
+    """[(", beam at 90 deg", values over the gates), ...] of a variable with a beam
+    dimension, else [("", its values)]."""
+    if "beam" not in variable.dims:
+        return [("", variable.values)]
+    azimuths = dataset["beam_azimuth"].values if "beam_azimuth" in dataset.coords else \
+        variable["beam"].values.astype(float)
+    return [(", vertical beam" if np.isnan(a) else f", beam at {a:g} deg",
+             variable.isel(beam=k).values) for k, a in enumerate(azimuths)]
+
+
 def _number(value):
     """A value with 4 significant digits; 0 within NUMERICAL_ZERO (rounding)."""
     return "0" if abs(value) <= NUMERICAL_ZERO else f"{value:.4g}"
 
 
-def _figures(dataset):
+def _figures(dataset, select=None):
     out = ["<h2>Figures</h2>"]
     reason = no_figure_reason(dataset)
     if reason:
         out.append(f"<p>{_e(reason)}.</p>")
     for name, function in figure_plan(dataset):
-        figure = function(dataset)
+        figure = mark_selection(function(dataset), dataset, select)
         buffer = io.BytesIO()
         figure.savefig(buffer, format="png", dpi=100)
         plt.close(figure)

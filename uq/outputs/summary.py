@@ -2,6 +2,7 @@
 import numpy as np
 
 from uq.constants import FULL_CIRCLE_DEG, NUMERICAL_ZERO
+from uq.outputs.planning import fixed_phase_note
 from uq.pipeline.metadata import QUANTITIES
 
 _COLUMNS = ("true", "nominal", "mc_mean", "mc_u", "gum_u", "paper_u")
@@ -74,7 +75,9 @@ def _motion_line(dataset):
     if "wind_speed_motion_ti" not in dataset:
         return []
     ti = _cell(100 * dataset["wind_speed_motion_ti"].values, "mc_u")
-    return [f"motion-induced turbulence-intensity increment [%]: {ti}"]
+    note = fixed_phase_note(dataset)
+    return [f"motion-induced turbulence-intensity increment [%]: {ti}"
+            + (f" ({note})" if note else "")]
 
 
 def _shown(values, quantity, column):

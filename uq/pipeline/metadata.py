@@ -51,12 +51,15 @@ STATISTICS = {
     "mc_low": ("lower end of the 95 % coverage interval (Monte Carlo)", None),
     "mc_high": ("upper end of the 95 % coverage interval (Monte Carlo)", None),
     "mc_circular_std": ("Monte Carlo circular standard deviation sqrt(-2 ln R)", None),
-    "mc_numerical_error": ("numerical error of the Monte Carlo results: twice the standard "
-                           "deviation of batch averages (JCGM 101 7.9)", None),
+    "mc_numerical_error": ("numerical error of the Monte Carlo results: the largest standard "
+                           "error of mean, u and interval ends over independent batches (at "
+                           "least 32 in a fixed-n run) times max(2, Student t 97.5 % of the "
+                           "batches' degrees of freedom) (JCGM 101 7.9)", None),
     "mc_numerical_tolerance": ("numerical tolerance of the requested significant digits "
                                "(JCGM 101 7.9.2)", None),
     "mc_u_standard_error": ("standard error of the Monte Carlo standard uncertainty, from "
-                            "its spread over independent batches", None),
+                            "its spread over independent batches (at least 32 in a fixed-n "
+                            "run of 2^15 trials or more)", None),
     "mc_n_invalid": ("Monte Carlo trials outside the model's domain (non-finite, excluded)", None),
     "gum_u": ("first-order GUM standard uncertainty of the physical model", "standard_error"),
     "gum_valid": ("GUM interval validated by Monte Carlo (JCGM 101 clause 8)", None),

@@ -382,13 +382,21 @@ def _global_attributes(scenario, seed, dataset, started, model):
             "n_samples": int(np.max(dataset["mc_n_samples"].values)),
             "scenes": int(dataset["mc_n_samples"].size),
             "seed": seed,
-            "correction": scenario.settings["correction"],
+            "correction": _swept_or(scenario, "correction", scenario.settings["correction"]),
             "correction_description": describe_corrections(
                 dict(scenario.sweep).get("correction", (scenario.settings["correction"],))),
-            "ins_correlation": scenario.settings["ins"]["correlation"],
+            "ins_correlation": _swept_or(scenario, "ins.correlation",
+                                         scenario.settings["ins"]["correlation"]),
             "runtime_s": time.perf_counter() - started, **_probe_attributes(scenario),
             **({"model": "numpy: the numpy reference model throughout (uq run --model "
                          "numpy)"} if model == "numpy" else {})}
+
+
+def _swept_or(scenario, key, value):
+    """A global attribute of a scenario key: its value, or "swept: a, b, c" where the
+    sweep varies it (its coordinate holds the value of each scene)."""
+    swept = dict(scenario.sweep).get(key)
+    return value if swept is None else "swept: " + ", ".join(str(v) for v in swept)
 
 
 def _probe_attributes(scenario):
