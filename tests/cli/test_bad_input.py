@@ -925,7 +925,7 @@ def _(d):
     lines = ["a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
     lines += [f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 10) + "]" for i in range(1, 9)]
     return fit_config(d, "\n".join(lines) + "\nfit: {walkers: *a8}\n",
-                      "a4", "expands to more than")
+                      "a4", "aliases are expanded")
 
 
 @case("fit -c with a python tag")
@@ -1083,7 +1083,8 @@ def _(d):
 def _(d):
     lines = ["wind:", "  a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
     lines += [f"  a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 10) + "]" for i in range(1, 9)]
-    return check_and_run(scenario(d, "\n".join(lines) + "\n"), "wind.a4", "expands")
+    return check_and_run(scenario(d, "\n".join(lines) + "\n"), "wind.a4",
+                         "aliases are expanded")
 
 
 @case("a python tag in a scenario")
@@ -1102,7 +1103,7 @@ def _(d):
 def _(d):
     return check_and_run(scenario(d, with_good(motion={
         "spectrum": {"hs": 1.0, "tp": 1e-300}, "response": {"heave": {"factor": 1.0}}})),
-        "motion.spectrum.tp", "band")
+        "motion.spectrum.tp", "shorter than any platform motion")
 
 
 # --- outputs -------------------------------------------------------------------------
@@ -1334,7 +1335,7 @@ HOSTILE = textwrap.dedent("""
     import json, resource, sys, io, contextlib, tempfile, pathlib, time
     resource.setrlimit(resource.RLIMIT_AS, ({memory}, {memory}))
     resource.setrlimit(resource.RLIMIT_CPU, ({total_cpu}, {total_cpu}))
-    sys.path.insert(0, {tests!r})
+    sys.path[:0] = [{tests!r}, {conftest!r}]     # the corpus, and the helpers it imports
     import test_bad_input as corpus
     from uq.cli import main
     results = []
@@ -1366,7 +1367,8 @@ def test_every_input_kind_refuses_a_fifo_dev_zero_and_a_sparse_file_cheaply():
     caught by the subprocess's limit, not timed)."""
     names = [name for name in CASES if " that is a " in name]
     assert len(names) >= 18
-    code = HOSTILE.format(tests=str(Path(__file__).parent), names=names,
+    code = HOSTILE.format(tests=str(Path(__file__).parent), conftest=str(ROOT / "tests"),
+                          names=names,
                           memory=HOSTILE_MEMORY, total_cpu=int(HOSTILE_CPU * len(names)))
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             timeout=1800, cwd=ROOT)
@@ -1375,3 +1377,12 @@ def test_every_input_kind_refuses_a_fifo_dev_zero_and_a_sparse_file_cheaply():
     for name, command, status, cpu in report["results"]:
         assert status == 2 and cpu < HOSTILE_CPU, (name, command, status, cpu)
     assert report["peak"] < HOSTILE_MEMORY
+
+
+@case("motion spectrum tp whose default band is beyond the motion limit")
+def _(d):
+    # tp 0.02 s: its default band 0.5/tp to 4/tp = [25, 200] Hz reaches past the 100 Hz
+    # of the shortest motion period (0.01 s); the problem is tp's, not the band's
+    return check_and_run(scenario(d, with_good(motion={
+        "spectrum": {"hs": 1.0, "tp": 0.02}, "response": {"heave": {"factor": 1.0}}})),
+        "motion.spectrum.tp", "default band")
