@@ -59,7 +59,7 @@ def _basis_text(fit):
     if "least_squares_basis" not in fit.coords:
         return ""
     return "\n" + "\n".join(textwrap.wrap("least-squares band on "
-                                          f"{fit['least_squares_basis'].values}", 60))
+                                          f"{fit['least_squares_basis'].values}", 48))
 
 
 def _parameter_text(dataset, name):
