@@ -11,6 +11,16 @@ import pytest
 from conftest import cpu_limited
 
 
+def as_from_a_terminal():
+    """In the child before exec: Ctrl-C as a shell leaves it (default action, not
+    blocked), whatever the test process's state (a pytest-xdist worker that ran other
+    tests may have SIGINT ignored or blocked: both are inherited across exec, and an
+    ignored Ctrl-C lets the run finish with status 0); CPU time bounded."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    cpu_limited()()
+
+
 def interrupt(args, cwd, after, wait_for=None, number=signal.SIGINT):
     """Start ``uq ARGS``, wait until `wait_for()` holds (if given) and `after` seconds
     more, send signal `number` (Ctrl-C by default); (status, stderr). The child is bounded
@@ -18,7 +28,7 @@ def interrupt(args, cwd, after, wait_for=None, number=signal.SIGINT):
     wait."""
     child = subprocess.Popen([sys.executable, "-m", "uq.cli", *args], cwd=cwd, text=True,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                             start_new_session=True, preexec_fn=cpu_limited())
+                             start_new_session=True, preexec_fn=as_from_a_terminal)
     try:
         while wait_for is not None and not wait_for():
             assert child.poll() is None, child.communicate()[1]
@@ -26,7 +36,9 @@ def interrupt(args, cwd, after, wait_for=None, number=signal.SIGINT):
         time.sleep(after)
         os.killpg(child.pid, number)
         _, err = child.communicate()
-        return child.returncode, err
+        state = (f"; this process: SIGINT {signal.getsignal(signal.SIGINT)}, blocked "
+                 f"{signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, set())}")
+        return child.returncode, err + (state if child.returncode == 0 else "")
     finally:                                   # never leave a process group behind
         try:
             os.killpg(child.pid, signal.SIGKILL)
