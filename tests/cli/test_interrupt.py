@@ -110,3 +110,21 @@ def test_timeout_of_golden_leaves_nothing(tmp_path):
             break
         assert done.returncode == 124, done.stderr      # timeout's code after its SIGTERM
         assert list(tmp_path.iterdir()) == [], seconds
+
+
+def test_an_interrupt_raised_inside_a_callback_is_not_lost():
+    """SIGTERM's exception raised where Python cannot propagate it (a weakref callback,
+    a finaliser) is neither printed as 'Exception ignored' with a traceback nor dropped:
+    the signal comes again and ends the block at the next safe point."""
+    import types
+    from uq.cli.common import stop_on_sigterm
+    from uq.errors import Terminated
+    unraisable = types.SimpleNamespace(exc_type=Terminated, exc_value=Terminated(),
+                                       exc_traceback=None, err_msg=None, object=None)
+    before = sys.unraisablehook
+    with pytest.raises(Terminated):
+        with stop_on_sigterm():
+            sys.unraisablehook(unraisable)           # as Python does inside a callback
+            for _ in range(1000):                    # the redelivered signal lands here
+                time.sleep(0.001)
+    assert sys.unraisablehook is before                  # restored after the block

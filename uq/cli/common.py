@@ -29,10 +29,33 @@ def stop_on_sigterm():
         yield
         return
     previous = signal.signal(signal.SIGTERM, terminate)
+    previous_hook = sys.unraisablehook
+    sys.unraisablehook = _redeliver(previous_hook)
     try:
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
+        sys.unraisablehook = previous_hook
+
+
+def _redeliver(previous_hook):
+    """An unraisable-exception hook that does not lose an interrupt: a signal handler's
+    exception raised inside a callback Python cannot propagate from (a weakref's, a
+    finaliser's) would be printed as "Exception ignored in ..." with a traceback and then
+    dropped, so the run would go on. The hook sends the signal again instead, to be
+    raised at the next point that can (silently); other exceptions go to `previous_hook`."""
+    import os
+    import signal
+    from uq.errors import Terminated
+
+    def hook(unraisable):
+        if issubclass(unraisable.exc_type, KeyboardInterrupt):
+            number = signal.SIGTERM if issubclass(unraisable.exc_type, Terminated) \
+                else signal.SIGINT
+            os.kill(os.getpid(), number)
+            return
+        previous_hook(unraisable)
+    return hook
 
 
 def interrupted_status(error):
