@@ -96,15 +96,10 @@ def _signature(kind, dtype):
 
 
 @njit(inline="always")
-def _taylor(x):
-    """(cos x, sin x) of a small angle x [rad] from their Taylor polynomials."""
-    return taylor_cos_sin(x)
-
-
-@njit(inline="always")
 def _angle(base, cos_base, sin_base, x, cos_x, sin_x):
     """cos and sin of base + x [rad]: the addition theorem with the error's (cos_x,
-    sin_x) from :func:`_taylor` where |x| <= SMALL_ANGLE, libm beyond (and for NaN)."""
+    sin_x) from :func:`~uq.physics.kernelbase.taylor_cos_sin` where |x| <= SMALL_ANGLE,
+    libm beyond (and for NaN)."""
     if abs(x) <= SMALL_ANGLE:
         return cos_base * cos_x - sin_base * sin_x, sin_base * cos_x + cos_base * sin_x
     return np.cos(base + x), np.sin(base + x)
@@ -174,7 +169,7 @@ def ins_trig(ins, table, s0, s1, t0, t1, per_scene, cos_out, sin_out, scratch):
                 for j in range(count):            # gather the (strided) column first:
                     scratch[j] = _pick(error, t0 + j, s, k) * _DEG   # unit stride: SIMD
                 for j in range(count):            # no calls, unit stride: SIMD
-                    cos_x, sin_x = _taylor(scratch[j])
+                    cos_x, sin_x = taylor_cos_sin(scratch[j])
                     cos_out[a, k, at + j] = cos_x
                     sin_out[a, k, at + j] = sin_x
 
@@ -236,7 +231,7 @@ def _angle_block(error, s, t0, count, base, cos_base, sin_base, out, row):
     for j in range(count):                        # gather the (strided) column first:
         out[row, j] = _pick(error, t0 + j, s, 0) * _DEG    # unit stride: SIMD next
     for j in range(count):                        # no calls, unit stride: SIMD
-        cos_x, sin_x = _taylor(out[row, j])
+        cos_x, sin_x = taylor_cos_sin(out[row, j])
         out[row, j] = cos_base * cos_x - sin_base * sin_x          # cos(b + x)
         out[row + 1, j] = sin_base * cos_x + cos_base * sin_x      # sin(b + x)
     for j in range(count):                        # large errors (and NaN): libm

@@ -201,7 +201,7 @@ def error_keys(section):
     ``ins`` -> the INS readings' errors (``ins.heading`` ... ``ins.heave``), ``lidar`` ->
     the keys of ``lidar.errors``."""
     if section == "ins":
-        return tuple(row.short_key for row in INPUTS if row.shape == "reading")
+        return navigation_keys()
     return tuple(row.short_key for row in INPUTS if row.key.startswith(f"{section}.errors."))
 
 
@@ -227,9 +227,9 @@ def label(name):
 def check_names(model, given):
     """Refuse input names `model` does not implement: ValueError naming them and the
     model (a name no model knows is named as such)."""
-    known = set(names(model))
-    unknown = [name for name in given if name not in known]
+    unknown = lacks(model, given)
     if unknown:
+        known = names(model)
         declared = {row.name for row in INPUTS}
         what = ", ".join(f"{name!r}" + ("" if name in declared else " (not a declared "
                                          "model input)") for name in unknown)

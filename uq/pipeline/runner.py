@@ -24,8 +24,7 @@ from uq.pipeline.modelsetup import (MOTION_INPUTS, error_inputs, input_label, sc
 from uq.physics.correction import describe_corrections
 from uq.physics import probe as probe_volume
 from uq.physics.measurement import measurement_model, true_values
-from uq.physics.modelinputs import error_keys, navigation_keys
-from uq.physics.scene import OUTPUTS
+from uq.physics.scene import ANGULAR_NAVIGATION, NAVIGATION, OUTPUTS
 from uq.pipeline.metadata import (COORDINATES, QUANTITIES, ancillary_variables, cf_encode,
                                   history, swept_key_attributes, variable_attributes)
 from uq.engine.propagate import propagate
@@ -278,8 +277,8 @@ def _beam_coordinates(scene):
 def _paper_uncertainty(scene, settings, gate_speeds):
     """Rubio & Gottschall (2022) u per output; NaN outside their model."""
     ins = settings["ins"]
-    u = {key: _standard_uncertainty(ins.get(key)) for key in error_keys("ins")}
-    u = {key: np.deg2rad(value) if key in navigation_keys(angular_only=True) else value
+    u = {key: _standard_uncertainty(ins.get(key)) for key in NAVIGATION}
+    u = {key: np.deg2rad(value) if key in ANGULAR_NAVIGATION else value
          for key, value in u.items()}
     per_gate = [rubio2022_scene_uncertainty(scene, gate_speeds[..., i], u["heading"],
                                             u["pitch"], u["roll"], u["sog"], u["cog"])
