@@ -6,7 +6,8 @@ import pytest
 
 #: Modules whose docstrings carry runnable examples.
 MODULES = ("uq.engine.propagate", "uq.engine.inputs", "uq.physics.wind",
-           "uq.physics.correction", "uq.pipeline.modelsetup", "uq.physics.kernelbase")
+           "uq.physics.correction", "uq.pipeline.modelsetup", "uq.physics.kernelbase",
+           "uq.physics.scangeometry")
 
 
 @pytest.mark.parametrize("name", MODULES)
