@@ -4,6 +4,8 @@
     python scripts/shipped_digest.py --compare before.json   # on the new one
     python scripts/shipped_digest.py --values-only > before.json   # values, not metadata
     python scripts/shipped_digest.py --model numpy --agree   # numpy against compiled
+    python scripts/shipped_digest.py --save before/          # every value, one .nc each
+    python scripts/shipped_digest.py --close before/         # largest relative difference
 
 
 Each scenario runs as shipped (``uq run``'s code path, ``uq golden`` for golden
@@ -85,6 +87,33 @@ def shipped(digest=digest, model="compiled"):
     return results
 
 
+def results(model="compiled"):
+    """Name -> Dataset of every shipped scenario as :func:`shipped` runs it."""
+    return shipped(lambda dataset: dataset, model)
+
+
+def closeness(before, now):
+    """(scenario, variable, largest |now - before| / max(|before|, tiny)) of every float
+    variable, the worst first; a direction [deg] compared on the circle."""
+    rows = []
+    for name, old in before.items():
+        new = now.get(name)
+        for variable in old.data_vars:
+            a = old[variable].values
+            if a.dtype.kind != "f" or new is None or variable not in new:
+                continue
+            b = new[variable].values
+            if a.shape != b.shape:
+                rows.append((name, variable, np.inf))
+                continue
+            both_nan = np.isnan(a) & np.isnan(b)
+            gap = np.where(both_nan, 0.0, _gap(variable, a, b))
+            scale = np.maximum(np.abs(a), np.finfo(float).tiny)
+            worst = np.nanmax(np.where(np.isnan(gap), np.inf, gap / scale), initial=0.0)
+            rows.append((name, variable, float(worst)))
+    return sorted(rows, key=lambda row: -row[2])
+
+
 def _gap(name, one, two):
     """|one - two|; for a direction [deg] on the circle (359.99... and 0 are 0.01 apart)."""
     gap = np.abs(one - two)
@@ -120,7 +149,25 @@ def main():
     parser.add_argument("--agree", action="store_true",
                         help="run every scenario with --model and with the compiled model "
                         "and print the largest difference of each")
+    parser.add_argument("--save", help="write every scenario's results into this folder")
+    parser.add_argument("--close", help="folder of --save: print the largest relative "
+                        "difference of each float variable (exit 1 above --rtol)")
+    parser.add_argument("--rtol", type=float, default=1e-12)
     args = parser.parse_args()
+    if args.save:
+        Path(args.save).mkdir(parents=True, exist_ok=True)
+        for name, dataset in results(args.model).items():
+            dataset.to_netcdf(Path(args.save) / f"{name}.nc")
+        return 0
+    if args.close:
+        before = {path.stem: xr.load_dataset(path) for path in Path(args.close).glob("*.nc")}
+        rows = closeness(before, results(args.model))
+        for name, variable, worst in rows[:15]:
+            print(f"{name} {variable}: {worst:.3g}")
+        bad = [row for row in rows if not row[2] <= args.rtol]
+        print(f"{len(rows)} variables: {'all' if not bad else f'{len(bad)} not'} within "
+              f"{args.rtol:g} relative")
+        return 1 if bad else 0
     if args.agree:
         for name, (variable, gap) in agreement(args.model).items():
             print(f"{name}: largest difference {gap:.3g} ({variable})")
