@@ -56,6 +56,9 @@ FUSED_OUTPUTS = OUTPUTS
 _INS = tuple(f"ins_{key}" for key in kernels.INS_ORDER)
 _GEOMETRY = tuple(f"lidar_{key}" for key in kernels.GEO_ORDER)
 _NOISE = "lidar_radial_velocity"
+#: The errors of a probe's parameters (``lidar_gate_length`` ...), laid as the geometry's.
+_PROBE = tuple(f"lidar_{key}" for key in ("gate_length", "pulse_fwhm", "wavelength",
+                                          "beam_radius"))
 
 
 def applicable(scene, outputs, errors, scene_draws=False):
@@ -72,12 +75,11 @@ def applicable(scene, outputs, errors, scene_draws=False):
 
 def declined(scene, outputs, errors, scene_draws=False):
     """Why the compiled model does not take this call, in words ('' where it does): a
-    time-resolved scene or a probe volume (models of their own), an output or an input
-    it does not implement, or an input of a shape it does not take."""
+    time-resolved scene (a model of its own), an output or an input it does not
+    implement, or an input of a shape it does not take (or a probe volume's complex
+    step, which the numpy model differentiates)."""
     if scene.time_resolved is not None:
         return "a time-resolved scene"
-    if scene.probe is not None:
-        return "a probe volume"
     if not set(outputs) <= _OUTPUT_SET:
         return f"output(s) {', '.join(sorted(set(outputs) - _OUTPUT_SET))}"
     lacked = modelinputs.lacks(STATIC_COMPILED, errors)
@@ -106,7 +108,7 @@ def evaluate(scene, outputs, scene_draws, errors):
     return None if prepared is None else _run(scene, outputs, scene_draws, *prepared)
 
 
-def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype):
+def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype, probe_errors):
     n_gates, n_beams = len(scene.ranges), scene.n_beams
     scenes = math.prod(shape)
     (table, shapes), kept = scene_table(scene, shape)
@@ -117,7 +119,8 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype):
                        + (n_gates, n), dtype=dtype) if q in outputs else _UNUSED[dtype][q]
            for q in OUTPUTS}             # element-major: each element's trials contiguous
     from_east = np.empty_like(out["wind_direction"])
-    per_trial = any(g.shape[0] > 1 for g in geo)          # geometry errors: truth per trial
+    per_trial = any(g.shape[0] > 1 for g in geo) or (     # geometry or probe errors:
+        scene.probe is not None and _probe_varies(scene.probe, probe_errors))  # per trial
     block = FUSED_BLOCK_TRIALS
     trials = min(n, block)
     group = max(1, block // trials) if (scene_draws or per_trial) else scenes
@@ -134,7 +137,8 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype):
         beams = np.empty((truth_rows, n_beams, 3), dtype=dtype)
         profile = np.empty((truth_rows, n_beams, n_gates), dtype=dtype)
     else:                                   # every scene's truth, common to its trials
-        beams, profile = _scene_truth(table, shapes, structure, geo, scenes, dtype, kept)
+        beams, profile = _scene_truth(table, shapes, structure, geo, scenes, dtype, kept,
+                                      (scene.probe, probe_errors))
     for t0 in range(0, n, trials):
         t1 = min(n, t0 + trials)
         if not scene_draws:                 # the draws' trigonometry, shared by the scenes
@@ -146,7 +150,7 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype):
                                      scratch)
             if per_trial:
                 _truth(compiled, table, shapes, structure, geo, s0, s1, t0, t1, True, beams,
-                       profile, exponent)
+                       profile, exponent, (scene.probe, probe_errors))
             wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile, geo[2],
                  s0, s1, t0, t1, scene_draws, per_trial, out["wind_speed"],
                  out["vertical_wind"], out["wind_direction"], from_east,
@@ -163,15 +167,17 @@ _UNUSED = {dtype: {q: np.empty((1, 1, 1) + ((1,) if q == "radial_velocity" else 
                    for q in OUTPUTS} for dtype in (float, complex)}
 
 
-def _scene_truth(table, shapes, structure, geo, scenes, dtype, kept):
+def _scene_truth(table, shapes, structure, geo, scenes, dtype, kept, probe=(None, {})):
     """True beams and profile of every scene (no geometry error varies them over the
     trials). Errors that are constants (absent, or the GUM's real means): computed once
     in float64 and kept with the table (a GUM evaluates the same scenes three times); a
     complex-step call gets an exact complex copy (its geometry is not perturbed, so
     the imaginary parts are zero)."""
     n_beams, n_gates = structure[0] + structure[1], structure[2]
-    constant = all(g.shape == (1, 1, 1) and g[0, 0, 0].imag == 0 for g in geo)
-    key = tuple(float(g[0, 0, 0].real) for g in geo)
+    constant = all(g.shape == (1, 1, 1) and g[0, 0, 0].imag == 0 for g in geo) and \
+        all(e.shape == (1, 1, 1) for e in probe[1].values())
+    key = tuple(float(g[0, 0, 0].real) for g in geo) + tuple(
+        float(e[0, 0, 0]) for _, e in sorted(probe[1].items()))
     if constant and key in kept:
         beams, profile = kept[key]
     else:
@@ -181,7 +187,7 @@ def _scene_truth(table, shapes, structure, geo, scenes, dtype, kept):
         profile = np.empty((scenes, n_beams, n_gates), dtype=number)
         _truth(kernels.compiled(number), table, shapes, structure,
                tuple(g.real.copy() for g in geo) if real else geo, 0, scenes, 0, 1, False,
-               beams, profile, np.empty(scenes))
+               beams, profile, np.empty(scenes), probe)
         if constant:
             kept[key] = (beams, profile)
     if np.dtype(dtype).kind == "c" and beams.dtype.kind != "c":
@@ -194,13 +200,17 @@ def _scene_truth(table, shapes, structure, geo, scenes, dtype, kept):
 
 
 def _truth(compiled, table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams,
-           profile, exponent):
+           profile, exponent, probe=(None, {})):
     """True beams and the power-law profile U(z) / U_ref (z / z_ref)^alpha of the rows
     of a rectangle (:func:`uq.physics.fusedkernels.geometry`); numpy's SIMD log and exp,
     NaN stays NaN (1 where there is no shear: exp(0 log 1) is exactly 1)."""
     compiled["geometry"](table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams,
                          profile, exponent)
     rows = (s1 - s0) * ((t1 - t0) if per_trial else 1)
+    if probe[0] is not None:                # the weighted speed along the true beams
+        _probe_truth(probe, table, shapes, structure, geo[2], s0, s1, t0, t1, per_trial,
+                     beams, profile, exponent)
+        return
     if not np.any(exponent[:rows]):         # no shear: the kernel set 1 (or NaN) already
         return
     ratio = profile[:rows]
@@ -210,6 +220,80 @@ def _truth(compiled, table, shapes, structure, geo, s0, s1, t0, t1, per_trial, b
     else:
         ratio *= exponent[:rows, None, None]
     np.exp(ratio, out=ratio)
+
+
+#: Rows of the probe's truth per pass (nodes x items x rows doubles of scratch each).
+_PROBE_ROWS = 256
+
+
+def _probe_varies(probe, probe_errors):
+    """Do the errors of the probe's own parameters vary over the trials?"""
+    return any(probe_errors[name].shape[0] > 1 for name in probe.PARAMETERS
+               if name in probe_errors)
+
+
+def _probe_truth(probe, table, shapes, structure, height_error, s0, s1, t0, t1, per_trial,
+                 beams, profile, exponent):
+    """profile[row] = the probe-weighted U / U_ref of every beam and gate of the rows of
+    a rectangle (:func:`geometry`'s rows and true beams), by
+    :func:`uq.physics.fusedprobe.profile`, in passes of :data:`_PROBE_ROWS` rows."""
+    from uq.physics import fusedprobe
+    probe, errors = probe
+    n_slanted, n_gates = int(structure[0]), int(structure[2])
+    n_beams = n_slanted + int(structure[1])
+    _, at_slant, _, _ = kernels.geometry_offsets(n_slanted, n_beams, n_gates)
+    count = t1 - t0 if per_trial else 1
+    rows = (s1 - s0) * count
+    scene = s0 + np.arange(rows) // count                             # each row's
+    trial = t0 + np.arange(rows) % count
+    shape = table[scene, kernels.TABLE_WIDTH - 1].astype(np.intp)       # geometry row
+    slant = shapes[shape, at_slant:at_slant + n_beams * n_gates]       # (rows, b g)
+    base = table[scene, kernels.TABLE.index("lidar_height")] + _rows_of(height_error, scene,
+                                                                        trial)
+    reference = table[scene, kernels.TABLE.index("reference_height")]
+    common = np.all(shape == shape[0])
+    if common:                               # one geometry: the distinct focus values
+        focus, item_focus = fusedprobe.distinct_focus(slant[0])
+    else:
+        focus, item_focus = None, np.arange(n_beams * n_gates, dtype=np.int64)
+    for a in range(0, rows, _PROBE_ROWS):
+        b = min(rows, a + _PROBE_ROWS)
+        part = slice(a, b)
+        centre = base[part, None] + slant[part] * np.repeat(beams[part, :, 2], n_gates, axis=1)
+        vertical = np.repeat(beams[part, :, 2], n_gates, axis=1)
+        first, second = (np.ascontiguousarray(_rows_of(errors.get(name), scene[part],
+                                                       trial[part]) * scale + value)
+                         for name, value, scale in _probe_parameters(probe))
+        out = np.empty((n_beams * n_gates, b - a))
+        fusedprobe.profile(probe, _compact(first), _compact(second),
+                           np.ascontiguousarray(centre.T), np.ascontiguousarray(vertical.T),
+                           focus if common else np.ascontiguousarray(slant[part].T),
+                           item_focus, _compact(reference[part]), _compact(exponent[part]),
+                           out)
+        profile[part] = out.T.reshape(b - a, n_beams, n_gates)
+
+
+def _probe_parameters(probe):
+    """(name, configured value [SI], scale of its error) of the probe's parameters."""
+    from uq.physics.probe import PARAMETER_SCALE
+    return [(name, getattr(probe, name), PARAMETER_SCALE.get(name, 1.0))
+            for name in probe.PARAMETERS]
+
+
+def _rows_of(error, scene, trial):
+    """The values of an error (n or 1, scenes or 1, 1) at rows (scene, trial); absent: 0."""
+    if error is None:
+        return np.zeros(len(scene))
+    return error[trial if error.shape[0] > 1 else np.zeros_like(trial),
+                 scene if error.shape[1] > 1 else np.zeros_like(scene), 0].real
+
+
+def _compact(values):
+    """A per-row array as (1,) where all rows hold the same value, else contiguous."""
+    values = np.asarray(values, dtype=float)
+    if values.size and np.all(values == values[0]):
+        return values[:1].copy()
+    return np.ascontiguousarray(values)
 
 
 def _direction(from_north, from_east, out):
@@ -229,7 +313,7 @@ def _prepared(scene, outputs, errors, scene_draws):
     takes, else None. The errors as 3-D arrays (trials, scenes, k) for the kernels, any
     axis of length 1 broadcasting: INS (k = 1 or beams), geometry (k = 1), noise
     (k = beams x gates); complex128 if any error is complex, else float64."""
-    if scene.time_resolved is not None or scene.probe is not None or \
+    if scene.time_resolved is not None or \
             not set(outputs) <= _OUTPUT_SET or \
             not set(errors) <= _ERROR_SET:
         return None
@@ -238,6 +322,8 @@ def _prepared(scene, outputs, errors, scene_draws):
     s_axis = shape if scene_draws else ()
     values = {name: np.asarray(value) for name, value in errors.items() if value is not None}
     dtype = complex if any(v.dtype.kind == "c" for v in values.values()) else float
+    if scene.probe is not None and (dtype is complex or not scene.probe.nodes):
+        return None                 # a probe's complex step (the GUM): the numpy model
     beams, gates = scene.n_beams, len(scene.ranges)
     n = max([v.shape[0] for v in values.values() if v.ndim], default=1)
     laid = {}
@@ -262,8 +348,10 @@ def _prepared(scene, outputs, errors, scene_draws):
             array = array.astype(dtype)
         laid[name] = array
     zero = _ZERO[dtype]
+    probe = {name[len("lidar_"):]: laid[name] for name in _PROBE if name in laid}
     return (shape, n, tuple(laid.get(name, zero) for name in _INS),
-            tuple(laid.get(name, zero) for name in _GEOMETRY), laid.get(_NOISE, zero), dtype)
+            tuple(laid.get(name, zero) for name in _GEOMETRY), laid.get(_NOISE, zero), dtype,
+            probe)
 
 
 _OUTPUT_SET = set(FUSED_OUTPUTS)
