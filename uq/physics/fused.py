@@ -82,6 +82,8 @@ def declined(scene, outputs, errors, scene_draws=False):
         return "a time-resolved scene"
     if not set(outputs) <= _OUTPUT_SET:
         return f"output(s) {', '.join(sorted(set(outputs) - _OUTPUT_SET))}"
+    if scene.probe is not None and any(np.iscomplexobj(v) for v in errors.values()):
+        return "a probe volume's complex step (the GUM)"
     lacked = modelinputs.lacks(STATIC_COMPILED, errors)
     if lacked:
         return f"input(s) {', '.join(lacked)}"

@@ -35,6 +35,7 @@ import numpy as np
 
 from uq.constants import FULL_CIRCLE_DEG, MOTION_BLOCK_TRIALS, MOTION_BLOCK_VALUES
 from uq.physics import fusedmotionkernels as kernels
+from uq.physics import fusedprobe
 from uq.physics.beams import least_squares_operator, slant_distances
 from uq.physics import modelinputs
 from uq.physics.modelinputs import MOTION_COMPILED, Correction
@@ -67,8 +68,8 @@ def declined(scene, outputs, errors, scene_draws=False):
     """Why the compiled model does not take this call, in words ('' where it does)."""
     if scene.time_resolved is None:
         return "a static scene"
-    if scene.probe is not None:
-        return "a probe volume"
+    if scene.probe is not None and not scene.probe.nodes:
+        return "a probe volume without its node count (uq.physics.probe.resolve)"
     if not set(outputs) <= set(FUSED_OUTPUTS):
         return f"output(s) {', '.join(sorted(set(outputs) - set(FUSED_OUTPUTS)))}"
     lacked = modelinputs.lacks(MOTION_COMPILED, errors)
@@ -104,7 +105,7 @@ def measurement_model(scene, outputs, scene_draws=False, **errors):
             name: value[(slice(None),) + index] if np.ndim(value) > 1 else value
             for name, value in errors.items()}
         into = {q: result[q][(slice(None),) + index] for q in result}      # (n, gates) views
-        _evaluate(scene_plan(_scene_at(scene, index)), mine, n, into)
+        _evaluate(scene_plan(_scene_at(scene, index)), mine, n, into, scene.probe)
     return result
 
 
@@ -232,7 +233,7 @@ def _scene_plan(scene):
             "course_cos": math.cos(scene.cog), "course_sin": math.sin(scene.cog),
             "arm_bow": arm[0], "arm_starboard": arm[1], "arm_up": arm[2],
             "static_arm_up": static[2], "moves_yaw": moves[2],
-            "has_arm": bool(np.any(arm != 0))}
+            "has_arm": bool(np.any(arm != 0)), "probe": scene.probe is not None}
     consts = np.array([head[name] if name in head else getattr(scene, name)
                        for name in kernels.HEAD], dtype=float)
     return Plan(consts=consts, pairs=np.array(pairs, dtype=np.int64).reshape(-1, 2),
@@ -250,18 +251,20 @@ def _scene_plan(scene):
                 and bool(np.array_equal(times[:, 0], stamps)))
 
 
-def block_trials(plan):
+def block_trials(plan, probe_nodes=0):
     """Trials per block: :data:`~uq.constants.MOTION_BLOCK_VALUES` doubles of node
-    scratch (beams x nodes x (gates + 2) per trial), a power of two within
+    scratch (beams x nodes x (gates + 2) per trial; with a probe of `probe_nodes` nodes
+    also twice that many per beam, node and gate), a power of two within
     :data:`~uq.constants.MOTION_BLOCK_TRIALS`."""
-    per_trial = plan.node_table.shape[2] * (plan.slant.shape[1] + 2)
+    per_trial = plan.node_table.shape[2] * (plan.slant.shape[1] * (1 + 2 * probe_nodes) + 2)
     low, high = MOTION_BLOCK_TRIALS
     size = 2 ** int(math.floor(math.log2(max(1, MOTION_BLOCK_VALUES // per_trial))))
     return int(np.clip(size, low, high))
 
 
-def _evaluate(plan, errors, n, into):
-    """The outputs of one scene into `into` (name -> (n, gates) view), block by block."""
+def _evaluate(plan, errors, n, into, probe=None):
+    """The outputs of one scene into `into` (name -> (n, gates) view), block by block
+    (with a `probe` volume: its weighted speed, :mod:`uq.physics.fusedprobe`)."""
     consts = plan.consts
     n_beams, n_gates = plan.slant.shape
     n_nodes = len(plan.weights)
@@ -275,7 +278,7 @@ def _evaluate(plan, errors, n, into):
     noise = np.zeros((1, 1, 1)) if noise is None else \
         np.require(np.reshape(noise, (1, 1, 1)) if np.ndim(noise) == 0 else noise,
                    dtype=float, requirements="W")
-    m = min(block_trials(plan), max(n, 1))
+    m = min(block_trials(plan, probe.nodes if probe is not None else 0), max(n, 1))
     n_components = max(1, len(plan.components))
     work = np.empty((kernels.WORK_ROWS, m))
     c, turned = np.empty((2, n_components, m)), np.empty((2, n_components, m))
@@ -288,13 +291,21 @@ def _evaluate(plan, errors, n, into):
     out = np.empty((3, n_gates, m))
     speed, vertical = np.empty((n_gates, m)), np.empty((n_gates, m))
     shear = consts[kernels.HEAD.index("shear")]
+    beam_up = np.empty((n_beams * n_nodes, m)) if probe is not None else np.empty((1, 1))
+    if probe is not None:
+        focus, item_focus = fusedprobe.distinct_focus(np.repeat(plan.slant, n_nodes,
+                                                                axis=0).ravel())
+        reference = np.array([consts[kernels.HEAD.index("reference_height")]])
     for start in range(0, n, m):
         count = min(m, n - start)
         kernels.kinematics(consts, plan.pairs, plan.amplitudes, plan.components, plan.sources,
                            phases, window, plan.node_table, plan.azimuths, plan.beams,
                            plan.slant, *geometry, start, count, work, c, states, ship_beams,
-                           parts, ratio)
-        if shear != 0.0:                            # (z / z_ref)^alpha, SIMD; NaN stays NaN
+                           parts, ratio, beam_up)
+        if probe is not None:                       # the weighted U / U_ref at each node
+            _probe_profile(probe, errors, start, count, ratio, beam_up, focus, item_focus,
+                           reference, shear)
+        elif shear != 0.0:                          # (z / z_ref)^alpha, SIMD; NaN stays NaN
             block = ratio[:, :, :count]
             np.log(block, out=block)
             block *= shear
@@ -312,6 +323,27 @@ def _evaluate(plan, errors, n, into):
         if "wind_direction" in into:
             into["wind_direction"][start:stop] = _direction(out[0, :, :count],
                                                             out[1, :, :count]).T
+
+
+def _probe_profile(probe, errors, start, count, ratio, beam_up, focus, item_focus,
+                   reference, shear):
+    """ratio[node, g, :count] = the probe-weighted U / U_ref at the gate-centre heights
+    kinematics wrote there (:func:`uq.physics.fusedprobe.profile`); a parameter's error
+    (n,) is one per scan."""
+    nodes, gates = ratio.shape[:2]
+    centre = np.ascontiguousarray(ratio[:, :, :count].reshape(nodes * gates, count))
+    up = np.ascontiguousarray(np.repeat(beam_up[:, :count], gates, axis=0))
+    given = {name: np.reshape(errors[f"lidar_{name}"], -1) for name in probe.PARAMETERS
+             if f"lidar_{name}" in errors}
+    rows = slice(start, start + count)
+    first, second = fusedprobe.parameters(probe, {name: value if value.shape[0] > 1 else
+                                                  value[0] for name, value in given.items()},
+                                          rows)
+    out = np.empty((nodes * gates, count))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fusedprobe.profile(probe, first, second, centre, up, focus, item_focus, reference,
+                           shear, out)
+    ratio[:, :, :count] = out.reshape(nodes, gates, count)
 
 
 def _direction(north, east):

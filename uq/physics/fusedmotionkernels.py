@@ -71,12 +71,12 @@ HEAD = ("n_beams", "n_gates", "n_nodes", "n_slanted", "model", "ins_mode", "rate
         "heading", "pitch", "roll", "lidar_height", "wind_speed", "reference_height", "shear",
         "to_north", "to_east", "vertical_wind", "ship_north", "ship_east", "ship_up",
         "level_cos", "level_sin", "course_cos", "course_sin", "arm_bow", "arm_starboard",
-        "arm_up", "static_arm_up", "half_cone", "misalignment", "moves_yaw", "has_arm")
+        "arm_up", "static_arm_up", "half_cone", "misalignment", "moves_yaw", "has_arm", "probe")
 (_N_BEAMS, _N_GATES, _N_NODES, _N_SLANTED, _MODEL, _INS_MODE, _RATE, _HEADING, _PITCH, _ROLL,
  _LIDAR_HEIGHT, _WIND_SPEED, _REFERENCE_HEIGHT, _SHEAR, _TO_NORTH, _TO_EAST, _VERTICAL_WIND,
  _SHIP_NORTH, _SHIP_EAST, _SHIP_UP, _LEVEL_COS, _LEVEL_SIN, _COURSE_COS, _COURSE_SIN,
  _ARM_BOW, _ARM_STARBOARD, _ARM_UP, _STATIC_ARM_UP, _HALF_CONE, _MISALIGNMENT, _MOVES_YAW,
- _HAS_ARM) = range(len(HEAD))
+ _HAS_ARM, _PROBE) = range(len(HEAD))
 
 #: Correction models: the codes NONE ... POINTWISE of
 #: :class:`uq.physics.modelinputs.Correction` (:mod:`uq.physics.kernelbase`); INS modes.
@@ -122,7 +122,7 @@ def _kernel(signature):
 def _head(consts):
     """The scalars of :data:`HEAD` as a tuple: values, not memory, so that loops reading
     them need no alias checks against the arrays they write."""
-    return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31])
+    return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31], consts[32])
 
 
 @_inline
@@ -339,10 +339,10 @@ _IM = "int64[:, ::1]"
 
 
 @_kernel(f"void({_CV}, {_IM}, {_CM}, {_CM}, {_IM}, {_T}, {_T}, {_CT}, {_CM}, {_CM}, {_CM}, "
-         f"{_V}, {_V}, {_V}, int64, int64, {_CM}, {_CT}, {_CT}, {_CT}, {_CT}, {_CT})")
+         f"{_V}, {_V}, {_V}, int64, int64, {_CM}, {_CT}, {_CT}, {_CT}, {_CT}, {_CT}, {_CM})")
 def kinematics(consts, pairs, amplitudes, components, sources, phases, window, node_table,
                azimuths, beams, slant, cone_error, misalignment_error, height_error, start,
-               count, work, c, states, ship_beams, parts, ratio):
+               count, work, c, states, ship_beams, parts, ratio, vertical):
     """The truth of trials [start, start + count) at every measurement time.
 
     Writes ``c`` (2, K, trials), the unit phases; ``parts[0, node]`` = ``n_h . e_wind`` and
@@ -351,7 +351,10 @@ def kinematics(consts, pairs, amplitudes, components, sources, phases, window, n
     parts[1]``; ``ratio[node, g]`` = z / z_ref of the gates (1 without shear; NaN at a
     height <= 0, outside the power law) for numpy's log and exp. With one state per beam
     (``states`` (b, STATE_ROWS, trials): the point-wise readings are at the nodes) the
-    platform state of beam b is kept in states[b]; else states[0] is scratch.
+    platform state of beam b is kept in states[b]; else states[0] is scratch. With a
+    probe volume (HEAD ``probe``) ``ratio[node, g]`` is the gate centre's height [m]
+    itself and ``vertical[node]`` the true beam's up component b_z, for
+    :mod:`uq.physics.fusedprobe`.
     """
     head = _head(consts)
     n_beams, n_gates, n_nodes = int(consts[_N_BEAMS]), int(consts[_N_GATES]), int(consts[_N_NODES])
@@ -359,6 +362,7 @@ def kinematics(consts, pairs, amplitudes, components, sources, phases, window, n
     _geometry(consts, azimuths, beams, cone_error, misalignment_error, height_error, start,
               count, work, ship_beams)
     reference, shear, yaw = consts[_REFERENCE_HEIGHT], consts[_SHEAR] != 0.0, consts[_MOVES_YAW] > 0
+    probe = consts[_PROBE] > 0
     for b in range(n_beams):
         state = states[b if states.shape[0] > 1 else 0]
         state[:_TRIG, :count] = 0.0                   # degrees of freedom that do not move
@@ -374,6 +378,14 @@ def kinematics(consts, pairs, amplitudes, components, sources, phases, window, n
             for j in range(count):                    # beyond the reduction (and NaN): libm
                 if not work[_BIG, j] <= SINCOS_REDUCTION_LIMIT:
                     _truth_at(head, state, work, ship_beams, parts, b, node, j, True, yaw)
+            if probe:                                 # the probe's quadrature: heights
+                for j in range(count):
+                    vertical[node, j] = work[_BEAM + 2, j]
+                for g in range(n_gates):
+                    distance = slant[b, g]
+                    for j in range(count):
+                        ratio[node, g, j] = work[_MEASURED, j] + distance * work[_BEAM + 2, j]
+                continue
             for g in range(n_gates):
                 distance = slant[b, g]
                 for j in range(count):

@@ -49,8 +49,6 @@ SHAPES = ("reading", "scan", "beam_gate", "phase")
 _ALL = frozenset(MODELS)
 _NUMPY = frozenset(NUMPY_MODELS)
 _MOTION = frozenset((MOTION, MOTION_COMPILED))
-#: The models with a probe volume (:mod:`uq.physics.probe`, :mod:`uq.physics.fusedprobe`).
-_PROBE_MODELS = frozenset((STATIC, STATIC_COMPILED, MOTION))
 
 
 class Correction(enum.IntEnum):
@@ -163,13 +161,13 @@ INPUTS = (
          False, _ALL, "noise of each radial velocity"),
     _row("lidar_height", "lidar.errors.height", "m", "scan", False, _ALL,
          "true minus configured height of the lidar above sea level (draft, ballast, tide)"),
-    _row("lidar_gate_length", "lidar.errors.gate_length", "m", "scan", False, _PROBE_MODELS,
+    _row("lidar_gate_length", "lidar.errors.gate_length", "m", "scan", False, _ALL,
          "true minus configured range-gate length of a pulsed probe"),
-    _row("lidar_pulse_fwhm", "lidar.errors.pulse_fwhm", "m", "scan", False, _PROBE_MODELS,
+    _row("lidar_pulse_fwhm", "lidar.errors.pulse_fwhm", "m", "scan", False, _ALL,
          "true minus configured pulse FWHM of a pulsed probe"),
-    _row("lidar_wavelength", "lidar.errors.wavelength", "um", "scan", False, _PROBE_MODELS,
+    _row("lidar_wavelength", "lidar.errors.wavelength", "um", "scan", False, _ALL,
          "true minus configured wavelength of a CW probe"),
-    _row("lidar_beam_radius", "lidar.errors.beam_radius", "mm", "scan", False, _PROBE_MODELS,
+    _row("lidar_beam_radius", "lidar.errors.beam_radius", "mm", "scan", False, _ALL,
          "true minus configured beam radius at the lens of a CW probe"),
     _row("motion_phases", "motion", "1", "phase", False, _MOTION,
          "unit phase vectors of the random-phase motion components (uniform on the circle)",
