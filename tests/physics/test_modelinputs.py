@@ -143,9 +143,11 @@ def test_the_tables_derive_from_the_declaration():
 def test_the_kernels_take_exactly_the_declared_inputs():
     """The kernels' argument orders name the inputs their models declare."""
     static = {f"ins_{k}" for k in fusedkernels.INS_ORDER} | \
-        {f"lidar_{k}" for k in fusedkernels.GEO_ORDER} | {"lidar_radial_velocity"}
+        {f"lidar_{k}" for k in fusedkernels.GEO_ORDER} | {"lidar_radial_velocity"} | \
+        set(fused._PROBE)
     assert static == set(modelinputs.names(STATIC_COMPILED))
     motion = set(fusedmotionkernels.INPUTS) | set(fusedmotion._GEOMETRY) | \
+        set(fusedmotion.PROBE_INPUTS) | \
         {"lidar_radial_velocity", "motion_phases", "motion_window"}
     assert motion == set(modelinputs.names(MOTION_COMPILED))
 
@@ -187,9 +189,10 @@ def test_a_static_model_refuses_an_input_of_the_time_resolved_model():
 
 #: The compiled paths' fall-backs: (model, scene kind, outputs, inputs) -> the reason.
 FALLBACKS = [
-    (STATIC_COMPILED, "probe", WIND, {}, "a probe volume"),
-    (STATIC_COMPILED, "static", WIND, {"lidar_gate_length": np.ones(3)},
-     "input(s) lidar_gate_length"),
+    (STATIC_COMPILED, "probe", WIND, {}, ""),
+    (STATIC_COMPILED, "static", WIND, {"lidar_gate_length": np.ones(3)}, ""),
+    (STATIC_COMPILED, "probe", WIND, {"lidar_gate_length": np.ones(3) * 1j},
+     "a probe volume's complex step (the GUM)"),
     (STATIC_COMPILED, "static", WIND, {"ins_heading": np.ones((3, 2, 2))},
      "an input of a shape it does not take"),
     (STATIC_COMPILED, "static", WIND + ("gate_height",), {}, ""),
@@ -199,9 +202,8 @@ FALLBACKS = [
     (MOTION_COMPILED, "motion", ("gate_height",), {}, "output(s) gate_height"),
     (MOTION_COMPILED, "motion", WIND, {"ins_sog": np.ones(3) * 1j},
      "complex inputs (the GUM's complex steps)"),
-    (MOTION_COMPILED, "motion", WIND, {"lidar_wavelength": np.ones(3)},
-     "input(s) lidar_wavelength"),
-    (MOTION_COMPILED, "motion probe", WIND, {}, "a probe volume"),
+    (MOTION_COMPILED, "motion", WIND, {"lidar_wavelength": np.ones(3)}, ""),
+    (MOTION_COMPILED, "motion probe", WIND, {}, ""),
     (MOTION_COMPILED, "motion", WIND, {"lidar_height": np.ones((3, 2))},
      "input lidar_height of 2 axes"),
 ]

@@ -387,7 +387,9 @@ def test_probe_parameter_errors_change_the_bias_as_the_closed_form_says():
         horizontal_speed(c) - true_values(c)["wind_speed"])
 
 
-def test_a_non_point_probe_never_runs_the_compiled_model(monkeypatch):
+def test_a_probe_runs_the_compiled_model_and_its_complex_step_the_numpy_model(monkeypatch):
+    """Real trials of a probe take the compiled loop (uq.physics.fusedprobe; compared
+    with this module's quadrature in test_fusedprobe.py); the GUM's complex step does not."""
     from uq.physics import fused
     calls = []
     original = fused.evaluate                 # counts the calls the compiled loop takes
@@ -404,7 +406,11 @@ def test_a_non_point_probe_never_runs_the_compiled_model(monkeypatch):
     for probe in (PULSED, CW):
         measurement_model(scene(probe), ("wind_speed",),
                           lidar_radial_velocity=np.zeros((3, 4, 5)))
-    assert calls == [1]
+    assert calls == [1, 1, 1]
+    for probe in (PULSED, CW):                # the complex step: numpy
+        measurement_model(scene(probe), ("wind_speed",),
+                          lidar_radial_velocity=np.zeros((3, 4, 5)) + 1e-20j)
+    assert calls == [1, 1, 1]
 
 
 def test_resolve_keeps_a_chosen_node_count_and_a_batch_takes_the_largest():

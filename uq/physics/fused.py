@@ -57,8 +57,7 @@ _INS = tuple(f"ins_{key}" for key in kernels.INS_ORDER)
 _GEOMETRY = tuple(f"lidar_{key}" for key in kernels.GEO_ORDER)
 _NOISE = "lidar_radial_velocity"
 #: The errors of a probe's parameters (``lidar_gate_length`` ...), laid as the geometry's.
-_PROBE = tuple(f"lidar_{key}" for key in ("gate_length", "pulse_fwhm", "wavelength",
-                                          "beam_radius"))
+_PROBE = ("lidar_gate_length", "lidar_pulse_fwhm", "lidar_wavelength", "lidar_beam_radius")
 
 
 def applicable(scene, outputs, errors, scene_draws=False):
@@ -106,6 +105,9 @@ def measurement_model(scene, outputs, scene_draws=False, **errors):
 def evaluate(scene, outputs, scene_draws, errors):
     """:func:`measurement_model` where :func:`applicable`, else None (one pass over the
     arguments for both: the model is called once per slice of ~2^13 trials)."""
+    if scene.probe is not None:             # its node count (the scene itself if chosen)
+        from uq.physics import probe as probe_volume
+        scene = probe_volume.resolve(scene)
     prepared = _prepared(scene, outputs, errors, scene_draws)
     return None if prepared is None else _run(scene, outputs, scene_draws, *prepared)
 
@@ -324,7 +326,7 @@ def _prepared(scene, outputs, errors, scene_draws):
     s_axis = shape if scene_draws else ()
     values = {name: np.asarray(value) for name, value in errors.items() if value is not None}
     dtype = complex if any(v.dtype.kind == "c" for v in values.values()) else float
-    if scene.probe is not None and (dtype is complex or not scene.probe.nodes):
+    if scene.probe is not None and dtype is complex:
         return None                 # a probe's complex step (the GUM): the numpy model
     beams, gates = scene.n_beams, len(scene.ranges)
     n = max([v.shape[0] for v in values.values() if v.ndim], default=1)

@@ -36,6 +36,7 @@ import numpy as np
 from uq.constants import FULL_CIRCLE_DEG, MOTION_BLOCK_TRIALS, MOTION_BLOCK_VALUES
 from uq.physics import fusedmotionkernels as kernels
 from uq.physics import fusedprobe
+from uq.physics import probe as probe_volume
 from uq.physics.beams import least_squares_operator, slant_distances
 from uq.physics import modelinputs
 from uq.physics.modelinputs import MOTION_COMPILED, Correction
@@ -49,6 +50,8 @@ FUSED_OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind")
 _INS_MODES = {None: kernels.CONTINUOUS, "nearest": kernels.NEAREST, "linear": kernels.LINEAR}
 #: Inputs per trial (n,) of the geometry.
 _GEOMETRY = ("lidar_half_cone", "lidar_misalignment", "lidar_height")
+#: Inputs per trial (n,) of a probe's parameters (:mod:`uq.physics.fusedprobe`).
+PROBE_INPUTS = fusedprobe.INPUTS
 
 
 def applicable(scene, outputs, errors, scene_draws=False):
@@ -68,8 +71,6 @@ def declined(scene, outputs, errors, scene_draws=False):
     """Why the compiled model does not take this call, in words ('' where it does)."""
     if scene.time_resolved is None:
         return "a static scene"
-    if scene.probe is not None and not scene.probe.nodes:
-        return "a probe volume without its node count (uq.physics.probe.resolve)"
     if not set(outputs) <= set(FUSED_OUTPUTS):
         return f"output(s) {', '.join(sorted(set(outputs) - set(FUSED_OUTPUTS)))}"
     lacked = modelinputs.lacks(MOTION_COMPILED, errors)
@@ -97,6 +98,8 @@ def measurement_model(scene, outputs, scene_draws=False, **errors):
     """The compiled :func:`uq.physics.timeresolved.measurement_model` (same inputs and
     outputs: each (n, *S, n_gates) for a batch of scenes of shape S, evaluated one scene
     after the other; with `scene_draws` each scene takes its own slice of the inputs)."""
+    if scene.probe is not None:             # its node count (the scene itself if chosen)
+        scene = probe_volume.resolve(scene)
     shape, gates = scene.shape, len(scene.ranges)
     n = sample_count(errors)
     result = {q: np.empty((n,) + shape + (gates,)) for q in FUSED_OUTPUTS if q in outputs}

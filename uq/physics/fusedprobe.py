@@ -41,6 +41,9 @@ PULSED, CW = 1, 2
 _KIND = {"pulsed": PULSED, "cw": CW}
 _SQRT_LN2 = math.sqrt(math.log(2.0))
 _SQRT2 = math.sqrt(2.0)
+#: The model inputs of the probe's parameters' errors (``lidar_gate_length`` ...), which
+#: both compiled models take (one draw per scan, like the geometry's errors).
+INPUTS = tuple(f"lidar_{name}" for name in probe_volume.PARAMETER_SCALE)
 
 _kernel = njit(cache=True, nogil=True, error_model="numpy")
 
