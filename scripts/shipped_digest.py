@@ -93,8 +93,10 @@ def results(model="compiled"):
 
 
 def closeness(before, now):
-    """(scenario, variable, largest |now - before| / max(|before|, tiny)) of every float
-    variable, the worst first; a direction [deg] compared on the circle."""
+    """(scenario, variable, largest |now - before| / the variable's scale) of every float
+    variable, the worst first; the scale is the largest |before| of the variable (so a
+    value that is zero up to rounding, a bias or a vertical wind of 1e-16, is held to the
+    variable's own size, not to itself); a direction [deg] compared on the circle."""
     rows = []
     for name, old in before.items():
         new = now.get(name)
@@ -108,7 +110,7 @@ def closeness(before, now):
                 continue
             both_nan = np.isnan(a) & np.isnan(b)
             gap = np.where(both_nan, 0.0, _gap(variable, a, b))
-            scale = np.maximum(np.abs(a), np.finfo(float).tiny)
+            scale = max(float(np.nanmax(np.abs(a), initial=0.0)), np.finfo(float).tiny)
             worst = np.nanmax(np.where(np.isnan(gap), np.inf, gap / scale), initial=0.0)
             rows.append((name, variable, float(worst)))
     return sorted(rows, key=lambda row: -row[2])

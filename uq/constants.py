@@ -360,12 +360,15 @@ SINCOS_REDUCTION_LIMIT = 2.0**19 * math.pi / 2
 #: slower than the motion) use libm.
 SLERP_SERIES_LIMIT = 0.25
 
-#: Doubles of node scratch per block of trials in the compiled time-resolved model [1]
-#: (beams x dwell nodes x (gates + 2) per trial, :mod:`uq.physics.fusedmotion`): 2^15
-#: doubles = 256 kB stay in the L2 cache (2 MB per core here) with the rest of a block's
-#: scratch; the block then holds 2^15 / (5 x 3) = 2048 trials of a DBS scan of one gate,
-#: 2^15 / (50 x 3) = 218 of a 50-beam conical scan.
-MOTION_BLOCK_VALUES = 2**15
+#: Doubles of scratch per block of trials in the compiled time-resolved model [1] (all
+#: of a block's rows: the kernels' work rows, the platform states, beams, radial-velocity
+#: parts, gate heights and least squares, :func:`uq.physics.fusedmotion.block_trials`):
+#: 2^16 doubles = 512 kB, half the L2 cache of a core here (1 MB), so that the rows a
+#: kernel's passes read again stay there; a point-wise DBS scan of one gate (~170
+#: doubles per trial) then has blocks of 256 trials: 0.26 us per trial against 0.36 us
+#: with the 2048 trials (1.4 MB of scratch) of a budget of node rows alone (measured on
+#: the benchmark's point-wise scan, 2^18 trials, thread CPU time, 2026-11-25).
+MOTION_BLOCK_VALUES = 2**16
 
 #: Fewest and most trials per block of the compiled time-resolved model [1]: at least
 #: 64 so that the per-block Python work (two kernel calls, numpy's log, exp and arctan2:

@@ -255,11 +255,16 @@ def _scene_plan(scene):
 
 
 def block_trials(plan, probe_nodes=0):
-    """Trials per block: :data:`~uq.constants.MOTION_BLOCK_VALUES` doubles of node
-    scratch (beams x nodes x (gates + 2) per trial; with a probe of `probe_nodes` nodes
-    also twice that many per beam, node and gate), a power of two within
-    :data:`~uq.constants.MOTION_BLOCK_TRIALS`."""
-    per_trial = plan.node_table.shape[2] * (plan.slant.shape[1] * (1 + 2 * probe_nodes) + 2)
+    """Trials per block: :data:`~uq.constants.MOTION_BLOCK_VALUES` doubles of a block's
+    scratch (per trial: the work rows, a platform state per beam, the true beams, beams x
+    nodes x (gates + 2) of node rows, with a probe of `probe_nodes` nodes twice that many
+    per beam, node and gate more, the least squares and the outputs, the phase vectors),
+    a power of two within :data:`~uq.constants.MOTION_BLOCK_TRIALS`."""
+    beams, gates = plan.slant.shape
+    nodes = plan.node_table.shape[2]
+    per_trial = (kernels.WORK_ROWS + beams * (kernels.STATE_ROWS + 3)
+                 + nodes * (gates * (1 + 2 * probe_nodes) + 2) + 6 + 8 * gates
+                 + 4 * max(1, len(plan.components)))
     low, high = MOTION_BLOCK_TRIALS
     size = 2 ** int(math.floor(math.log2(max(1, MOTION_BLOCK_VALUES // per_trial))))
     return int(np.clip(size, low, high))
