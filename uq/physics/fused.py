@@ -180,8 +180,8 @@ def _scene_truth(table, shapes, structure, geo, scenes, dtype, kept, probe=(None
     n_beams, n_gates = structure[0] + structure[1], structure[2]
     constant = all(g.shape == (1, 1, 1) and g[0, 0, 0].imag == 0 for g in geo) and \
         all(e.shape == (1, 1, 1) for e in probe[1].values())
-    key = tuple(float(g[0, 0, 0].real) for g in geo) + tuple(
-        float(e[0, 0, 0]) for _, e in sorted(probe[1].items()))
+    key = tuple(float(g[0, 0, 0].real) for g in geo) + (tuple(
+        float(e[0, 0, 0].real) for _, e in sorted(probe[1].items())) if probe[0] else ())
     if constant and key in kept:
         beams, profile = kept[key]
     else:
@@ -226,8 +226,9 @@ def _truth(compiled, table, shapes, structure, geo, s0, s1, t0, t1, per_trial, b
     np.exp(ratio, out=ratio)
 
 
-#: Rows of the probe's truth per pass (nodes x items x rows doubles of scratch each).
-_PROBE_ROWS = 256
+#: Doubles of the probe's node scratch per pass (items x nodes x rows, twice), and the
+#: fewest and most rows of a pass (a pass costs ~30 us of calls; see _probe_truth).
+PROBE_PASS_VALUES, PROBE_PASS_ROWS = 2**17, (32, 512)
 
 
 def _probe_varies(probe, probe_errors):
@@ -240,7 +241,8 @@ def _probe_truth(probe, table, shapes, structure, height_error, s0, s1, t0, t1, 
                  beams, profile, exponent):
     """profile[row] = the probe-weighted U / U_ref of every beam and gate of the rows of
     a rectangle (:func:`geometry`'s rows and true beams), by
-    :func:`uq.physics.fusedprobe.profile`, in passes of :data:`_PROBE_ROWS` rows."""
+    :func:`uq.physics.fusedprobe.profile`, in passes of rows whose node scratch stays in
+    the L2 cache (:data:`PROBE_PASS_VALUES`)."""
     from uq.physics import fusedprobe
     probe, errors = probe
     n_slanted, n_gates = int(structure[0]), int(structure[2])
@@ -260,8 +262,10 @@ def _probe_truth(probe, table, shapes, structure, height_error, s0, s1, t0, t1, 
         focus, item_focus = fusedprobe.distinct_focus(slant[0])
     else:
         focus, item_focus = None, np.arange(n_beams * n_gates, dtype=np.int64)
-    for a in range(0, rows, _PROBE_ROWS):
-        b = min(rows, a + _PROBE_ROWS)
+    per_pass = int(np.clip(PROBE_PASS_VALUES // (n_beams * n_gates * probe.nodes),
+                           *PROBE_PASS_ROWS))
+    for a in range(0, rows, per_pass):
+        b = min(rows, a + per_pass)
         part = slice(a, b)
         centre = base[part, None] + slant[part] * np.repeat(beams[part, :, 2], n_gates, axis=1)
         vertical = np.repeat(beams[part, :, 2], n_gates, axis=1)

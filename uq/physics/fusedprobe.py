@@ -49,7 +49,8 @@ _kernel = njit(cache=True, nogil=True, error_model="numpy")
 
 
 @_kernel
-def node_weights(kind, first, second, cut, tail_sigmas, x, w, focus, s_out, omega_out):
+def node_weights(kind, first, second, cut, tail_sigmas, x, w, focus, s_out, omega_out,
+                 scratch):
     """Nodes s[f, p, j] [m] and weights omega[f, p, j] of the quadrature at focus f.
 
     Parameters
@@ -67,8 +68,16 @@ def node_weights(kind, first, second, cut, tail_sigmas, x, w, focus, s_out, omeg
         Slant distance of each focus [m] (per trial or common).
     s_out, omega_out : ndarray, shape (F, P, m')
         m' = max of the trials of the parameters and of `focus`.
+    scratch : ndarray, shape (F, P + 1, m')
+        Pulsed: each focus's half length; CW: its angle atan(L / z_R) and the tangents.
+
+    A focus whose half length (pulsed: the probe's reach short of the lens) or angle
+    (CW: the tails' cut short of the lens, the same angle atan(c) at every focus) equals
+    an earlier one's in the same trial takes that one's erf or tan values (the same
+    numbers), so that erf and tan are evaluated once per distinct rule, not per gate.
     """
     count = s_out.shape[2]
+    n_nodes = x.shape[0]
     for f in range(focus.shape[0]):
         for j in range(count):
             p1 = first[j if first.shape[0] > 1 else 0]
@@ -78,8 +87,15 @@ def node_weights(kind, first, second, cut, tail_sigmas, x, w, focus, s_out, omeg
                 radius = p2 / (2.0 * _SQRT_LN2)
                 reach = p1 / 2.0 + tail_sigmas * (radius / _SQRT2)
                 half = reach if reach <= distance else distance
+                scratch[f, 0, j] = half
+                same = _earlier(scratch, f, j, half)
+                if same >= 0:           # the same rule: its nodes and weights
+                    for p in range(n_nodes):
+                        s_out[f, p, j] = s_out[same, p, j]
+                        omega_out[f, p, j] = omega_out[same, p, j]
+                    continue
                 h = p1 / 2.0
-                for p in range(x.shape[0]):
+                for p in range(n_nodes):
                     s = half * x[p]
                     weight = (math.erf((s + h) / radius) - math.erf((s - h) / radius)) \
                         / (2.0 * p1)                                   # Eq. 1
@@ -90,9 +106,23 @@ def node_weights(kind, first, second, cut, tail_sigmas, x, w, focus, s_out, omeg
                 tails = cut * rayleigh
                 half = tails if tails <= distance else distance
                 angle = math.atan(half / rayleigh)
-                for p in range(x.shape[0]):
-                    s_out[f, p, j] = rayleigh * math.tan(x[p] * angle)
+                scratch[f, 0, j] = angle
+                same = _earlier(scratch, f, j, angle)
+                for p in range(n_nodes):
+                    tangent = scratch[same, p + 1, j] if same >= 0 else \
+                        math.tan(x[p] * angle)
+                    scratch[f, p + 1, j] = tangent
+                    s_out[f, p, j] = rayleigh * tangent
                     omega_out[f, p, j] = w[p] / 2.0
+
+
+@njit(inline="always")
+def _earlier(scratch, f, j, value):
+    """The first focus before f whose scratch[., 0, j] equals `value` (-1 if none)."""
+    for g in range(f):
+        if scratch[g, 0, j] == value:
+            return g
+    return -1
 
 
 @_kernel
@@ -201,7 +231,7 @@ def profile(probe, first, second, centre, vertical, focus, item_focus, reference
     omega = np.empty_like(s)
     cut = probe_volume.cw_cut(probe.truncation) if probe.kind == "cw" else 0.0
     node_weights(_KIND[probe.kind], first, second, cut, probe_volume.PULSE_TAIL_SIGMAS, x, w,
-                 focus, s, omega)
+                 focus, s, omega, np.empty((focus.shape[0], len(x) + 1, wide)))
     exponent = np.asarray(exponent, dtype=float)
     scaled = bool(np.any(exponent != 0.0))
     ratio = np.empty((centre.shape[0], len(x), m))
