@@ -425,3 +425,8 @@ BOX_MARGIN_LENGTH_SCALES = 3.0
 #: at IEC's L = 33.6 m): a pulsed lidar's probe (~25-30 m) spans 6-7 cells; the variance
 #: the box's resolution keeps is what box_variance reports (tested).
 BOX_DEFAULT_CELLS_PER_LENGTH = 8.0
+
+#: Probe-quadrature points sampled at a time in a record (turbulencesampling) [1]: each
+#: point holds ~ 8 corners x 3 components of float64 temporaries, so 2^18 points keep a
+#: chunk's memory near 50 MB; records do not depend on it.
+SAMPLING_CHUNK_POINTS = 2**18
