@@ -388,15 +388,15 @@ MANN_ANISOTROPY_IEC = 3.9
 KAIMAL_LENGTH_RATIOS_IEC = (8.1, 2.7, 0.66)
 KAIMAL_SIGMA_RATIOS_IEC = (1.0, 0.8, 0.5)
 
-#: IEC 61400-1:2005 Annex B, Eq. B.1: exponential coherence exp(-a sqrt((f r / V)^2 +
+#: IEC 61400-1:2005 Annex B, exponential coherence model: exp(-a sqrt((f r / V)^2 +
 #: (b r / L_c)^2)) with a = 12 [1], b = 0.12 [1] and L_c = 8.1 Lambda_1 (ratio [1]).
 IEC_COHERENCE_DECREMENT = 12.0
 IEC_COHERENCE_OFFSET = 0.12
 IEC_COHERENCE_LENGTH_RATIO = 8.1
 
-#: Von Karman energy spectrum's high-wavenumber exponent 17/6 and the hypergeometric
-#: parameters of Mann's eddy lifetime, 2F1(1/3, 17/6; 4/3; -(kL)^-2) [1]: Mann (1994),
-#: Eqs. 3.11 and 3.13 (a property of the spectrum, not a tunable).
+#: Von Karman energy spectrum's exponent 17/6 [1], also the second parameter of Mann's
+#: eddy lifetime 2F1(1/3, 17/6; 4/3; -(kL)^-2): Mann (1994), Sec. 3 (a property of the
+#: spectrum, E ~ k^4 at small k and k^(-5/3) at large k, not a tunable).
 VON_KARMAN_EXPONENT = 17.0 / 6.0
 
 #: Nodes per decade of the tabulated eddy lifetime (log-linear interpolation of

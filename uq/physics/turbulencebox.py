@@ -29,10 +29,10 @@ spectral factor is written from the paper, independently of the spectral path's 
 that ``C C^T = Phi`` cross-checks the two. Measured speed: :mod:`uq.bench.turbulence`.
 
 Mann model ([1], [2]). The von Karman energy spectrum ``E(k) = alpha eps^(2/3) L^(5/3)
-(kL)^4 / (1 + (kL)^2)^(17/6)`` ([1], Eq. 3.11) is distorted by a uniform shear acting over
+(kL)^4 / (1 + (kL)^2)^(17/6)`` ([1], Sec. 3) is distorted by a uniform shear acting over
 the eddy lifetime ``beta(k) = Gamma (kL)^(-2/3) 2F1(1/3, 17/6; 4/3; -(kL)^-2)^(-1/2)``
-([1], Eq. 3.13, in units of the inverse shear). The field is ``u_k = i C(k) n_k
-sqrt(dk)`` with the factor ([2], Eq. 46; [1], Eqs. 3.15-3.16)::
+([1], Sec. 3.3, in units of the inverse shear). The field is ``u_k = i C(k) n_k
+sqrt(dk)`` with the factor ([2], Sec. 3; [1], Sec. 3.2)::
 
     C = sqrt(E(k0) / (4 pi)) / k0^2 [[ k2 z1,       k30 - k1 z1, -k2],
                                      [-k30 + k2 z2, -k1 z2,       k1],
@@ -46,13 +46,13 @@ k2^2)^(1/2)``. The printed ``C2`` writes the difference of the two arctangents a
 denominator ``kh^2 + k30 k3`` is negative; the difference is the integral itself (tested
 against the rapid-distortion equations integrated numerically). At ``k1 = 0`` the limits are
 ``z1 = -beta``, ``z2 = 0``. The factor ``i`` makes ``u_{-k} = u_k^*`` (C is real and odd),
-so the field is real; ``C C^T = Phi`` ([1], Eq. 3.16).
+so the field is real; ``C C^T = Phi`` (the sheared tensor of [1], Sec. 3.2).
 
 Kaimal model (IEC 61400-1 [3], Annex B). One-sided spectra ``f S_k(f) / sigma_k^2 = 4 f
-L_k / V / (1 + 6 f L_k / V)^(5/3)`` (Eq. B.13 of Ed. 3 [3]) with ``L_k = (8.1, 2.7,
+L_k / V / (1 + 6 f L_k / V)^(5/3)`` ([3], Annex B, Table B.1) with ``L_k = (8.1, 2.7,
 0.66) Lambda_1`` and ``sigma_k = (1, 0.8, 0.5) sigma_u`` (Table B.1), and the coherence
 ``exp(-a r sqrt((f / V)^2 + (b / L_c)^2))``, ``a = 12``, ``b = 0.12``, ``L_c = 8.1
-Lambda_1`` (Eq. B.14), here for all three components (the standard gives it for u; v and w
+Lambda_1`` (the annex's exponential coherence model), here for all three components (the standard gives it for u; v and w
 take the same form, an assumption, stated). The field is generated as Veers (1988) [4]
 does, with x in place of time through Taylor (``f = V k1 / (2 pi)``): per wavenumber k1, a
 Cholesky factor of the coherence matrix of the (y, z) grid's points colours independent
@@ -64,7 +64,8 @@ References
    turbulence. J. Fluid Mech. 273:141-168.
 .. [2] Mann, J. (1998). Wind field simulation. Prob. Eng. Mech. 13(4):269-282.
 .. [3] IEC 61400-1:2005 (Ed. 3). Wind turbines - Part 1: Design requirements. Annex B
-   (turbulence models), 6.3.1 (Lambda_1).
+   (stochastic turbulence models: Mann's uniform shear model, the Kaimal spectra and
+   the exponential coherence model), 6.3.1 (Lambda_1).
 .. [4] Veers, P. S. (1988). Three-dimensional wind simulation. SAND88-0152, Sandia.
 """
 from dataclasses import dataclass
@@ -159,7 +160,7 @@ class TurbulenceBox:
 
 
 def von_karman_energy_spectrum(k, alpha_epsilon, length_scale):
-    """Von Karman energy spectrum E(k) [m3 s-2], Mann (1994) Eq. 3.11.
+    """Von Karman energy spectrum E(k) [m3 s-2], Mann (1994) Sec. 3.
 
     Parameters
     ----------
@@ -172,11 +173,11 @@ def von_karman_energy_spectrum(k, alpha_epsilon, length_scale):
     """
     kl = k * length_scale
     return (alpha_epsilon * length_scale ** (5.0 / 3.0) * kl**4
-            / (1.0 + kl**2) ** constants.VON_KARMAN_EXPONENT)      # Eq. 3.11 [1]
+            / (1.0 + kl**2) ** constants.VON_KARMAN_EXPONENT)      # von Karman, Sec. 3 [1]
 
 
 def mann1994_eddy_lifetime(kl, anisotropy):
-    """Mann's eddy lifetime beta [1] (times the shear), Mann (1994) Eq. 3.13, exact.
+    """Mann's eddy lifetime beta [1] (times the shear), Mann (1994) Sec. 3.3, exact.
 
     Parameters
     ----------
@@ -187,7 +188,7 @@ def mann1994_eddy_lifetime(kl, anisotropy):
     """
     kl = np.asarray(kl, dtype=float)
     hyp = scipy.special.hyp2f1(1.0 / 3.0, constants.VON_KARMAN_EXPONENT, 4.0 / 3.0, -kl**-2.0)
-    return anisotropy * kl ** (-2.0 / 3.0) / np.sqrt(hyp)         # Eq. 3.13 [1]
+    return anisotropy * kl ** (-2.0 / 3.0) / np.sqrt(hyp)         # lifetime, Sec. 3.3 [1]
 
 
 def _lifetime_table():
@@ -223,7 +224,7 @@ def eddy_lifetime(kl, anisotropy, xp=np):
 
 
 def mann1998_spectral_factor(k1, k2, k3, alpha_epsilon, length_scale, anisotropy, xp=np):
-    """Mann's spectral factor C(k), with ``C C^T = Phi(k)``, Mann (1998) Eq. 46.
+    """Mann's spectral factor C(k), with ``C C^T = Phi(k)``, Mann (1998) Sec. 3.
 
     Parameters
     ----------
@@ -244,21 +245,21 @@ def mann1998_spectral_factor(k1, k2, k3, alpha_epsilon, length_scale, anisotropy
     zero = ksq == 0
     ksq = xp.where(zero, 1.0, ksq)
     beta = eddy_lifetime(xp.sqrt(ksq) * length_scale, anisotropy, xp)
-    k30 = k3 + beta * k1                                         # Eq. 3.14 [1]
+    k30 = k3 + beta * k1                          # k at the start of the distortion [1]
     k0sq = xp.where(zero, 1.0, k1**2 + k2**2 + k30**2)
     z1, z2 = _mann1994_zetas(k1, k2, k3, k30, k0sq, ksq, beta, xp)
     amplitude = xp.sqrt(von_karman_energy_spectrum(xp.sqrt(k0sq), alpha_epsilon, length_scale)
                         / (4.0 * np.pi)) / k0sq
     amplitude = xp.where(zero, 0.0, amplitude)
     ratio = k0sq / ksq
-    rows = ((k2 * z1, k30 - k1 * z1, -k2),                       # Eq. 46 [2]
+    rows = ((k2 * z1, k30 - k1 * z1, -k2),                       # C(k), Sec. 3 [2]
             (-k30 + k2 * z2, -k1 * z2, k1),
             (ratio * k2, -ratio * k1, xp.zeros_like(k1)))
     return xp.stack([xp.stack([amplitude * c for c in row]) for row in rows])
 
 
 def _mann1994_zetas(k1, k2, k3, k30, k0sq, ksq, beta, xp):
-    """zeta_1, zeta_2 of Mann (1994) Eq. 3.16 (module docstring for the branch)."""
+    """zeta_1, zeta_2 of Mann (1994) Sec. 3.2 (module docstring for the branch)."""
     khsq = k1**2 + k2**2
     flat = khsq == 0                       # k along z: zeta multiplies zero there
     khsq = xp.where(flat, 1.0, khsq)
@@ -375,7 +376,7 @@ def mann_box(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
 
 
 def kaimal_spectrum(frequency, sigma, length, speed):
-    """IEC 61400-1 Kaimal one-sided spectrum S(f) [m2 s-2 Hz-1], Ed. 3 Eq. B.13.
+    """IEC 61400-1 Kaimal one-sided spectrum S(f) [m2 s-2 Hz-1], Annex B, Table B.1.
 
     Parameters
     ----------
@@ -393,7 +394,7 @@ def kaimal_spectrum(frequency, sigma, length, speed):
 
 
 def iec_coherence(separation, frequency, speed, coherence_length):
-    """IEC 61400-1 exponential coherence [1], Ed. 3 Eq. B.14.
+    """IEC 61400-1 exponential coherence [1], Annex B (exponential coherence model).
 
     ``exp(-a sqrt((f r / V)^2 + (b r / L_c)^2))`` with ``a`` and ``b`` of
     :mod:`uq.constants`; ``separation`` r [m], ``frequency`` f [Hz], ``speed`` V [m s-1],
@@ -444,7 +445,7 @@ def kaimal_box(grid, sigma_u, speed, scale_parameter, rng, xp=np,
     velocity = []
     for c in range(3):
         half = fft.rfft(noise[c].reshape(nx, ny * nz), axis=0)
-        # two-sided density in k1 [m3 s-2]: S(f) df / dk1 / 2, Eq. B.13 [3] via Taylor
+        # two-sided density in k1 [m3 s-2]: S(f) df / dk1 / 2, Table B.1 [3] via Taylor
         density = kaimal_spectrum(frequency, sigmas[c], lengths[c], speed) * speed / (4 * np.pi)
         density[0] = 0.0                                    # the box's mean is zero
         per_slab = max(1, slab_cells // (ny * nz) ** 2)
