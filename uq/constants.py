@@ -430,3 +430,13 @@ BOX_DEFAULT_CELLS_PER_LENGTH = 8.0
 #: point holds ~ 8 corners x 3 components of float64 temporaries, so 2^18 points keep a
 #: chunk's memory near 50 MB; records do not depend on it.
 SAMPLING_CHUNK_POINTS = 2**18
+
+#: Cell averaging of the Mann tensor near the k1 axis (turbulencebox.cell_averaged_factors)
+#: [1]: cells with |k1| <= CELL_AVERAGE_K1 max(dk2, dk3), beyond which the tensor varies
+#: across a cell on scales >= the cell (point values suffice; the variance's change from
+#: doubling it is tested); Gauss nodes along k1; the graded rule's panel ratio and number
+#: of panels per side (down to 4^-6 = 1/4096 of a half cell, below dk1 / dk2 of any box
+#: within the cell limit's aspect ratios).
+CELL_AVERAGE_K1 = 4.0
+CELL_AVERAGE_K1_NODES = 3
+CELL_AVERAGE_GRADING = (0.25, 6)

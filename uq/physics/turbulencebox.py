@@ -301,6 +301,81 @@ def _x_slabs(grid, slab_cells):
     return [slice(a, min(a + per_slab, nx)) for a in range(0, nx, per_slab)]
 
 
+def _gauss_rule(centre, half_width, nodes):
+    """Gauss-Legendre nodes and weights (summing to 1) on [centre -+ half_width]."""
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    return centre + half_width * x, w / 2.0
+
+
+def _graded_rule(half_width):
+    """Nodes and weights (summing to 1) on [-h, h], graded geometrically towards 0.
+
+    Panels [h r^(j+1), h r^j] (r = 1/4, j < J) and [0, h r^J] on each side, each with a
+    two-point Gauss rule: the cell average of a tensor that varies on the scale of k1
+    near the k1 axis (module docstring).
+    """
+    ratio, panels = constants.CELL_AVERAGE_GRADING
+    edges = half_width * np.concatenate([ratio ** np.arange(panels + 1), [0.0]])
+    nodes, weights = [], []
+    for outer, inner in zip(edges[:-1], edges[1:]):
+        x, w = _gauss_rule((outer + inner) / 2.0, (outer - inner) / 2.0, 2)
+        nodes += [x, -x]
+        weights += [w * (outer - inner), w * (outer - inner)]
+    return np.concatenate(nodes), np.concatenate(weights) / (2.0 * half_width)
+
+
+def _axis_cells(grid):
+    """Half-spectrum indices of the cells whose tensor is cell-averaged (near the k1 axis).
+
+    |i2| <= 1, i3 in {0, 1}, |k1| <= CELL_AVERAGE_K1 max(dk2, dk3); the origin's cell
+    (the box's mean) is left out.
+    """
+    (nx, ny, nz), lengths = grid.shape, grid.lengths
+    dk = 2.0 * np.pi / np.asarray(lengths)
+    reach = min(nx // 2, int(np.ceil(constants.CELL_AVERAGE_K1 * max(dk[1], dk[2]) / dk[0])))
+    cells = [(i1, i2, i3) for i1 in range(-reach, reach + 1) for i2 in (-1, 0, 1)
+             for i3 in (0, 1) if (i1, i2, i3) != (0, 0, 0)]
+    return np.array(cells), dk
+
+
+def cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy):
+    """Square roots of the cell-averaged tensor near the k1 axis (Mann 1998, Sec. 3).
+
+    Mann's tensor is integrably singular at k = 0, and along the k1 axis it varies on
+    the scale of k1, far below a long box's dk2, dk3: sampled at the cells' centres it
+    gives the k1-axis cells many times their share of the variance (w's above all). In
+    those cells the generator uses the symmetric square root of the tensor averaged over
+    the cell (graded quadrature), as Mann (1998) averages it over each cell.
+
+    Returns
+    -------
+    cells : ndarray of int, shape (n, 3)
+        (i1, i2, i3) wavenumber indices (negative ones count from the end).
+    factors : ndarray, shape (3, 3, n)
+        Symmetric square root of the cell average of Phi [m5/2 s-1].
+    """
+    cells, dk = _axis_cells(grid)
+    graded = _graded_rule(0.5)
+    factors = np.empty((3, 3, len(cells)))
+    for on_axis in ((True, True), (True, False), (False, True), (False, False)):
+        group = np.flatnonzero(((cells[:, 1] == 0) == on_axis[0]) & ((cells[:, 2] == 0) == on_axis[1]))
+        if group.size == 0:
+            continue
+        rules = [_gauss_rule(0.0, 0.5, constants.CELL_AVERAGE_K1_NODES)]
+        rules += [graded if axis else _gauss_rule(0.0, 0.5, 4) for axis in on_axis]
+        k = [(cells[group, 0, None, None, None] + rules[0][0][None, :, None, None]) * dk[0],
+             (cells[group, 1, None, None, None] + rules[1][0][None, None, :, None]) * dk[1],
+             (cells[group, 2, None, None, None] + rules[2][0][None, None, None, :]) * dk[2]]
+        weight = (rules[0][1][:, None, None] * rules[1][1][None, :, None]
+                  * rules[2][1][None, None, :])
+        c = mann1998_spectral_factor(*k, alpha_epsilon, length_scale, anisotropy)
+        phi = np.einsum("iknabc,jknabc,abc->nij", c, c, weight)
+        values, vectors = np.linalg.eigh(phi)
+        roots = np.einsum("nik,nk,njk->ijn", vectors, np.sqrt(np.maximum(values, 0.0)), vectors)
+        factors[:, :, group] = roots
+    return cells, factors
+
+
 def box_variance(grid, alpha_epsilon, length_scale, anisotropy,
                  slab_cells=constants.BOX_SLAB_CELLS):
     """Expected variances of (u, v, w) and the u-w covariance of a Mann box [m2 s-2].
@@ -317,11 +392,20 @@ def box_variance(grid, alpha_epsilon, length_scale, anisotropy,
     k1, k2, k3 = box_wavenumbers(grid)
     weights = _half_weights(grid.shape[2], np)
     dk = (2.0 * np.pi) ** 3 / np.prod(grid.lengths)
+    cells, factors = cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy)
+    pairs = ((0, 0), (1, 1), (2, 2), (0, 2))
     total = np.zeros(4)
     for slab in _x_slabs(grid, slab_cells):
         c = mann1998_spectral_factor(k1[slab], k2, k3, alpha_epsilon, length_scale, anisotropy)
         phi = np.einsum("ik...,jk...->ij...", c, c)
-        total += [np.sum(phi[i, j] * weights) for i, j in ((0, 0), (1, 1), (2, 2), (0, 2))]
+        total += [np.sum(phi[i, j] * weights) for i, j in pairs]
+    index = tuple(cells.T)
+    point = mann1998_spectral_factor(k1[index[0], 0, 0], k2[0, index[1], 0], k3[0, 0, index[2]],
+                                     alpha_epsilon, length_scale, anisotropy)
+    point_phi = np.einsum("ikn,jkn->ijn", point, point)
+    averaged_phi = np.einsum("ikn,jkn->ijn", factors, factors)
+    total += [np.sum((averaged_phi[i, j] - point_phi[i, j]) * weights[index[2]])
+              for i, j in pairs]
     return total * dk
 
 
@@ -366,11 +450,16 @@ def mann_box(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
     del noise
     k1, k2, k3 = box_wavenumbers(grid, xp)
     scale = np.sqrt((2.0 * np.pi) ** 3 / np.prod(grid.spacing))    # sqrt(N dk)
+    cells, factors = cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy)
+    index = (slice(None),) + tuple(xp.asarray(i) for i in cells.T)
+    noise_cells = spectrum[index]                                   # (3, n): a copy
     for slab in _x_slabs(grid, slab_cells):
         c = mann1998_spectral_factor(k1[slab], k2, k3, alpha_epsilon, length_scale,
                                      anisotropy, xp)
         coloured = sum(c[:, j] * spectrum[j, slab] for j in range(3))   # u_k = i C n
         spectrum[:, slab] = (1j * scale) * coloured
+    # near the k1 axis: u_k = C_avg n, C_avg even, so u_-k = u_k^* (module docstring)
+    spectrum[index] = scale * xp.einsum("ijn,jn->in", xp.asarray(factors), noise_cells)
     velocity = fft.irfftn(spectrum, s=tuple(grid.shape), axes=axes, **kwargs)
     return TurbulenceBox(grid=grid, velocity=velocity)
 
