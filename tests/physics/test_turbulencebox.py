@@ -235,3 +235,152 @@ def test_one_dimensional_spectrum_and_the_inertial_slope():
     # and the box's: its resolution (|k2|, |k3| < pi / d = 75 / L) cuts the integral over
     # (k2, k3) at the decade's top, steepening the slope; at d = L / 24 by less than 0.2
     assert np.mean(slope) == pytest.approx(-5 / 3, abs=0.2)
+
+
+# --- Kaimal with IEC 61400-1 coherence -------------------------------------------------
+
+def _iec_kaimal(f, sigma, length, speed):
+    """IEC 61400-1 Annex B, Table B.1: f S(f) / sigma^2 = 4 f L / V / (1 + 6 f L / V)^(5/3)."""
+    return sigma**2 * 4 * length / speed / (1 + 6 * f * length / speed) ** (5 / 3)
+
+
+KAIMAL = dict(sigma_u=1.2, speed=10.0, scale_parameter=42.0)
+
+
+def _kaimal_boxes(grid, seeds):
+    return [tb.kaimal_box(grid, rng=np.random.default_rng(s), **KAIMAL).velocity for s in seeds]
+
+
+def test_kaimal_point_spectra_follow_iec():
+    speed, dx = KAIMAL["speed"], 2.5                    # 0.25 s per cell by Taylor
+    grid = tb.BoxGrid((2048, 3, 2), (dx, 15.0, 15.0), periodic_yz=False)
+    boxes = np.array(_kaimal_boxes(grid, range(8)))     # (seed, 3, nx, ny, nz)
+    k1 = 2 * np.pi * np.fft.rfftfreq(grid.shape[0], dx)
+    f = speed * k1 / (2 * np.pi)
+    periodogram = np.mean(np.abs(np.fft.rfft(boxes, axis=2)) ** 2, axis=(3, 4))
+    # E|FFT|^2 = nx^2 F(k1) dk1 with the two-sided F(k1) = S(f) V / (4 pi)
+    dk1 = 2 * np.pi / grid.lengths[0]
+    sigmas = KAIMAL["sigma_u"] * np.array([1.0, 0.8, 0.5])
+    lengths = KAIMAL["scale_parameter"] * np.array([8.1, 2.7, 0.66])
+    for c in range(3):
+        density = _iec_kaimal(f, sigmas[c], lengths[c], speed) * speed / (4 * np.pi)
+        expected = grid.shape[0] ** 2 * density * dk1
+        for low, high in ((0.005, 0.05), (0.05, 0.5), (0.5, 2.0)):      # Hz
+            band = (f >= low) & (f < high)
+            ratio = periodogram[:, c, band].mean(axis=1) / expected[band].mean()
+            # 8 seeds, 4 standard errors from their scatter
+            assert abs(ratio.mean() - 1) < 4 * ratio.std(ddof=1) / np.sqrt(8), (c, low, ratio)
+    # the variance: the spectrum's integral but for the box's mean (k1 = 0)
+    variance = boxes.var(axis=2).mean(axis=(2, 3))      # (seed, component)
+    for c in range(3):
+        density = _iec_kaimal(f[1:], sigmas[c], lengths[c], speed) * speed / (4 * np.pi)
+        weights = np.where(np.arange(1, f.size) == grid.shape[0] // 2, 1.0, 2.0)
+        kept = np.sum(density * weights) * dk1
+        assert abs(variance[:, c].mean() - kept) < 4 * variance[:, c].std(ddof=1) / np.sqrt(8)
+        # the record-length box keeps most of sigma^2 (int S df = sigma^2 exactly)
+        assert 0.7 * sigmas[c] ** 2 < kept < sigmas[c] ** 2
+
+
+def test_kaimal_coherence_follows_iec():
+    speed, dx, dy = KAIMAL["speed"], 2.5, 20.0
+    grid = tb.BoxGrid((2048, 2, 2), (dx, dy, dy), periodic_yz=False)
+    boxes = np.array(_kaimal_boxes(grid, range(8)))
+    spectra = np.fft.rfft(boxes[:, 0], axis=1)          # u: (seed, k1, y, z)
+    f = speed * np.fft.rfftfreq(grid.shape[0], dx)
+    coherence_length = 8.1 * KAIMAL["scale_parameter"]
+    for (a, b), r in ((((0, 0), (1, 0)), dy), (((0, 0), (1, 1)), dy * np.sqrt(2))):
+        xa, xb = spectra[:, :, a[0], a[1]], spectra[:, :, b[0], b[1]]
+        for low, high in ((0.002, 0.02), (0.02, 0.1)):
+            band = (f >= low) & (f < high)
+            co = np.mean(np.real(xa * np.conj(xb))[:, band])
+            gamma = co / np.sqrt(np.mean(np.abs(xa[:, band]) ** 2) * np.mean(np.abs(xb[:, band]) ** 2))
+            iec = np.mean(np.exp(-12 * np.sqrt((f[band] * r / speed) ** 2
+                                              + (0.12 * r / coherence_length) ** 2)))
+            # the co-coherence estimated from n periodogram ordinates has a standard
+            # error (1 - gamma^2) / sqrt(2 n) (Bendat & Piersol 2010, Eq. 9.73 for the
+            # coherence); 4 of them
+            n = band.sum() * len(boxes)
+            assert abs(gamma - iec) < 4 * (1 - iec**2) / np.sqrt(2 * n), (r, low, gamma, iec)
+
+
+# --- seeds, memory, sizing -------------------------------------------------------------
+
+def test_same_seed_same_box_whatever_the_slab():
+    grid = tb.BoxGrid((64, 16, 8), (2.0, 2.0, 2.0))
+    boxes = [tb.mann_box(grid, 0.1, 33.6, GAMMA, np.random.default_rng(7), slab_cells=cells)
+             .velocity for cells in (64, 1000, 2**20)]
+    assert np.array_equal(boxes[0], boxes[1]) and np.array_equal(boxes[0], boxes[2])
+    other = tb.mann_box(grid, 0.1, 33.6, GAMMA, np.random.default_rng(8)).velocity
+    assert not np.allclose(other, boxes[0])
+    kgrid = tb.BoxGrid((64, 4, 3), (2.0, 5.0, 5.0), periodic_yz=False)
+    kaimal = [tb.kaimal_box(kgrid, 1.0, 10.0, 42.0, np.random.default_rng(7), slab_cells=cells)
+              .velocity for cells in (144, 2**20)]
+    assert np.array_equal(kaimal[0], kaimal[1])
+
+
+def test_a_real_field():
+    grid = tb.BoxGrid((32, 16, 8), (2.0, 2.0, 2.0))
+    box = tb.mann_box(grid, 0.1, 33.6, GAMMA, np.random.default_rng(1))
+    assert box.velocity.shape == (3, 32, 16, 8) and box.velocity.dtype == np.float64
+
+
+def test_memory_bound_is_refused_with_a_clear_message():
+    with pytest.raises(ValueError, match=r"8192 x 1024 x 1024 = 8589934592 cells is above the limit"):
+        tb.BoxGrid((8192, 1024, 1024), (1.0, 1.0, 1.0))
+
+
+def _dbs(height=100.0, half_cone=30.0, speed=10.0, duration=600.0, dwell=1.0):
+    """A 5-beam DBS seen in the mean-wind frame, wind along beam 0's azimuth; pulsed
+    probe with 13 nodes over +-30 m."""
+    from uq.physics.scangeometry import ScanGeometry
+    a = np.radians(half_cone)
+    az = np.radians([0.0, 90.0, 180.0, 270.0])
+    d = np.array([[np.sin(a) * np.cos(q), np.sin(a) * np.sin(q), np.cos(a)] for q in az]
+                 + [[0.0, 0.0, 1.0]])
+    ranges = np.r_[[height / np.cos(a)] * 4, height]
+    gates = (np.array([0.0, 0.0, -height]) + ranges[:, None] * d)[:, None, :]
+    offsets = np.linspace(-30.0, 30.0, 13)
+    weights = np.exp(-(offsets / 15.0) ** 2)
+    return ScanGeometry(directions=d, gate_centres=gates, times=np.arange(5) * dwell + dwell / 2,
+                        dwell=dwell, scan_period=5 * dwell, probe_offsets=offsets,
+                        probe_weights=(weights / weights.sum())[None], speed=speed,
+                        reconstruction=np.linalg.pinv(d)[None], record_duration=duration)
+
+
+def test_box_for_holds_the_record():
+    geometry = _dbs()
+    grid = tb.box_for(geometry, 33.6)
+    lengths, points = np.array(grid.lengths), geometry.probe_points().reshape(-1, 3)
+    assert lengths[0] >= geometry.speed * 600.0 + np.ptp(points[:, 0])
+    # y and z: the points plus 3 L on each side
+    for axis in (1, 2):
+        assert lengths[axis] >= np.ptp(points[:, axis]) + 6 * 33.6
+        low = grid.origin[axis]
+        assert low <= points[:, axis].min() - 3 * 33.6 + 1e-9
+        assert low + (grid.shape[axis] - 1) * grid.spacing[axis] >= points[:, axis].max() + 3 * 33.6 - 1e-9
+    assert grid.spacing == (33.6 / 8,) * 3
+    kaimal = tb.box_for(geometry, 42.0, model="kaimal")
+    assert not kaimal.periodic_yz
+    with pytest.raises(ValueError, match="above the limit"):
+        tb.box_for(geometry, 33.6, record_duration=36000.0)
+    with pytest.raises(ValueError, match="finite duration"):
+        tb.box_for(_dbs(duration=np.inf), 33.6)
+
+
+def test_a_too_small_box_loses_variance():
+    """A box as small as the large eddies (4 L a side) holds a fraction of the point
+    variance, in expectation (box_variance) and in the generated fields; the box that
+    box_for sizes for a record keeps most of it."""
+    total = _tensor_integral(1.0, 1.0, GAMMA)
+    small = tb.BoxGrid((16, 16, 16), (0.25,) * 3)
+    small_kept = tb.box_variance(small, 1.0, 1.0, GAMMA)
+    assert np.all(small_kept[:3] < 0.65 * total[:3])
+    boxes = _seeds_box(small, range(24))
+    u_var = np.array([np.mean(v[0] ** 2) for v in boxes])
+    # the generated boxes hold that fraction: 24 seeds, 4 standard errors
+    assert abs(u_var.mean() - small_kept[0]) < 4 * u_var.std(ddof=1) / np.sqrt(24)
+    assert u_var.mean() + 4 * u_var.std(ddof=1) / np.sqrt(24) < 0.7 * total[0]
+    # the record's box (DBS at 100 m, U = 10 m/s, 600 s; lengths in units of L = 33.6 m)
+    grid = tb.box_for(_dbs(), 33.6)
+    scaled = tb.BoxGrid(grid.shape, tuple(np.array(grid.spacing) / 33.6))
+    assert np.all(tb.box_variance(scaled, 1.0, 1.0, GAMMA)[:3] > 0.8 * total[:3])
