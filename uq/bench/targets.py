@@ -13,7 +13,12 @@ Fig. 2 GUM grid, 518,400 scenes         the numpy model's complex step (before) 
 10^6 four-beam scans, radial noise      numpy: 4 x 10^6 normals, differences, hypot  <= 1x
 10^6 point-wise scans in motion         10^6 static scans                           <= 4x
 conical scan, 50 lines of sight         a 4-beam scan in motion, per trial          <= 15x
+pulsed probe, ``floating_lidar_full``   the compiled point model, ``uq.run``        <= 3x
 =====================================  ==========================================  ======
+
+The probe's figure (issue 26) is a whole ``uq.run`` of ``floating_lidar_full`` with a
+WindCube-like pulsed probe against the same run at a point, n trials each; the model's
+own ratio (the measurement model alone, the same draws) is reported beside it.
 
 The draw floor of a run is measured by replaying the engine's own draws: the run is
 made once with :func:`uq.engine.propagate.normal_scores` recorded (the shape of every
@@ -43,7 +48,8 @@ TARGETS = {"floating_lidar_full_mc_over_draw_floor": (3.0, "max"),
            "gum_grid_speedup": (5.0, "min"),
            "scans_over_numpy": (1.0, "max"),
            "pointwise_motion_over_static": (4.0, "max"),
-           "conical_over_four_beam": (15.0, "max")}
+           "conical_over_four_beam": (15.0, "max"),
+           "pulsed_probe_over_point": (3.0, "max")}
 #: Imports of ``uq run`` that a new process pays before any work.
 START_SCRIPT = ("import numpy, scipy.stats, xarray, netCDF4, numba, matplotlib.pyplot; "
                 "import uq.cli.run, uq.pipeline.runner, uq.physics.fused, uq.outputs.plots")
@@ -237,6 +243,32 @@ def conical_scans(n=2**17, repeats=5):
             median_time(lambda: run(four), repeats))
 
 
+def probe_against_point(n=2**16, repeats=5):
+    """(seconds of ``uq.run`` of ``floating_lidar_full`` with a pulsed probe, of the same
+    at a point; seconds of its measurement model alone with the probe, at a point) at n
+    trials, each compiled (:mod:`uq.physics.fusedprobe`)."""
+    from uq.constants import WINDCUBE_GATE_LENGTH, WINDCUBE_PULSE_FWHM
+    from uq.physics.measurement import measurement_model
+    from uq.physics.probe import resolve
+    from uq.pipeline.modelsetup import error_inputs, scene_from_settings
+    from uq.engine.inputs import input_set
+    point = load_scenario(scenario_path("floating_lidar_full"),
+                          {"sampling.n": n, "sampling.method": "mc"})
+    pulsed = load_scenario(point, {"lidar.probe": {
+        "kind": "pulsed", "gate_length": WINDCUBE_GATE_LENGTH,
+        "pulse_fwhm": WINDCUBE_PULSE_FWHM}})
+    times = [median_time(lambda: run(pulsed), repeats), median_time(lambda: run(point), repeats)]
+    for scenario in (pulsed, point):
+        scene = resolve(scene_from_settings(scenario.settings))
+        inputs = input_set(error_inputs(scenario.settings, scene.n_beams, len(scene.ranges)))
+        errors = inputs.values(np.random.default_rng(1).standard_normal((n, inputs.dimension)))
+        errors.update(inputs.constants)
+        outputs = ("wind_speed", "wind_direction", "vertical_wind")
+        times.append(median_time(lambda: measurement_model(scene, outputs, **errors),
+                                 repeats))
+    return tuple(times)
+
+
 def measure(quick=False, progress=None, scale=1):
     """Every figure of the table above as ``{name: value}`` (times [s], ratios [1]);
     `quick` leaves out the two slow ones (every shipped scenario end to end, the GUM
@@ -267,6 +299,13 @@ def measure(quick=False, progress=None, scale=1):
     figures.update(conical_2e17_s=seconds, four_beam_motion_2e17_s=four_s,
                    conical_over_four_beam=seconds / four_s)
     say(f"2^17 conical scans of 50 lines of sight: {seconds:.3f} s, 4-beam {four_s:.3f} s")
+    n = trials(2**16)
+    probe_s, point_s, probe_model_s, point_model_s = probe_against_point(n)
+    figures.update(pulsed_probe_n=n, pulsed_probe_s=probe_s, point_probe_s=point_s,
+                   pulsed_probe_over_point=probe_s / point_s,
+                   pulsed_probe_model_over_point=probe_model_s / point_model_s)
+    say(f"floating_lidar_full, pulsed probe, n = {n}: {probe_s:.3f} s, at a point "
+        f"{point_s:.3f} s (the model alone {probe_model_s:.3f} s, {point_model_s:.3f} s)")
     per_scene, floor = sweep_monte_carlo(trials(MC_DRAWS))
     figures.update(sweep_mc_s_per_scene=per_scene, sweep_draw_floor_s_per_scene=floor,
                    sweep_mc_over_draw_floor=per_scene / floor)
