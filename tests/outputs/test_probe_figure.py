@@ -60,3 +60,34 @@ def test_the_comparison_file_passes_the_cf_checker(tmp_path, cf_compliance, comp
     coordinate of the swept kind pass compliance-checker CF 1.10."""
     from uq.files import write_netcdf
     cf_compliance(write_netcdf(comparison, tmp_path / "probe.nc"))
+
+
+def test_a_probe_results_trials_are_drawn_again_compiled_with_its_stored_node_count(
+        monkeypatch):
+    """uq plot's histogram of a CW buoy: the trials drawn again are the run's own (their
+    mean and u are the stored ones, rtol 1e-12: the same numbers summed in another
+    order), through the compiled model, with the node count the run stored (the numpy
+    search of :func:`uq.physics.probe.node_count` is not run again)."""
+    from uq.outputs.samples import scene_trials
+    from uq.physics import fused, probe
+    result = uq.run(load_scenario(SHIPPED, {"sweep": {}, "lidar.probe.kind": "cw",
+                                            "sampling.n": 1000,
+                                            "lidar.ranges": [40.0, 200.0]}))
+    assert int(result["probe_nodes"]) > 1
+
+    def no_search(*args, **kwargs):
+        raise AssertionError("the node count was searched again")
+    monkeypatch.setattr(probe, "node_count", no_search)
+    compiled = []
+    original = fused.evaluate
+
+    def counted(*args):                       # the calls the compiled model takes
+        out = original(*args)
+        compiled.extend([1] if out is not None else [])
+        return out
+    monkeypatch.setattr(fused, "evaluate", counted)
+    trials = scene_trials(result, ("wind_speed",))["wind_speed"]
+    assert compiled and len(trials) == 1000
+    np.testing.assert_allclose(trials.mean(axis=0), result["wind_speed_mc_mean"], rtol=1e-12)
+    np.testing.assert_allclose(trials.std(axis=0, ddof=1), result["wind_speed_mc_u"],
+                               rtol=1e-12)

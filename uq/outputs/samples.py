@@ -4,8 +4,12 @@ A results file keeps statistics, not trials. Its scenario (the ``scenario`` attr
 as run) and seed give the trials back: the same random numbers block by block
 (:func:`uq.engine.sampling.normal_scores`), the same inputs and the same measurement
 model, so the first n trials are the run's own first n trials (to the 1e-12 m/s at which
-the compiled and the numpy model agree).
+the compiled and the numpy model agree). The trials go through the compiled model, a
+probe volume's too (:mod:`uq.physics.fusedprobe`), with the probe's node count the run
+stored (``probe_nodes``), not chosen again.
 """
+import dataclasses
+
 import numpy as np
 import yaml
 
@@ -53,7 +57,7 @@ def trials_with(dataset, assignments, outputs, n_max=HISTOGRAM_TRIALS):
     raw.pop("sweep", None)
     scenario = load_scenario(raw, assignments)
     settings = scenario.settings
-    scene = scene_from_settings(settings)
+    scene = _stored_nodes(scene_from_settings(settings), dataset)
     inputs = input_set(error_inputs(settings, scene.n_beams, len(scene.ranges)))
     n = min(int(np.max(dataset["mc_n_samples"])), n_max)
     scores = np.empty((n, inputs.dimension))
@@ -65,3 +69,15 @@ def trials_with(dataset, assignments, outputs, n_max=HISTOGRAM_TRIALS):
     with np.errstate(all="ignore"):                 # out-of-domain trials become NaN
         result = measurement_model(scene, tuple(outputs), **values, **inputs.constants)
     return {q: np.real(np.asarray(result[q])) for q in outputs}
+
+
+def _stored_nodes(scene, dataset):
+    """The scene with the probe's node count its single-scene run used (``probe_nodes``,
+    ``probe_quadrature_error``) instead of searching it again (a numpy quadrature search,
+    ~1 s); a sweep's scenes (one count per scene) are resolved as the run resolved them."""
+    if scene.probe is None or "probe_nodes" not in dataset or dataset["probe_nodes"].ndim:
+        return scene
+    nodes = int(dataset["probe_nodes"])
+    error = float(dataset["probe_quadrature_error"]) if "probe_quadrature_error" in \
+        dataset else 0.0
+    return dataclasses.replace(scene, probe=scene.probe.with_nodes(nodes, error))
