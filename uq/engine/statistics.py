@@ -290,8 +290,11 @@ class StreamingStatistics:
         flat = values.reshape(m, self.size)          # (a view where the layout allows)
         columns, offset = self._room(m)
         circular = self.reference is not None
-        statkernels.transpose(flat, self.reference if circular else _NO_REFERENCE,
-                              circular, columns, offset)
+        if not circular and flat.strides[0] == flat.itemsize:  # element-major (the
+            columns[:, offset:offset + m] = flat.T      # compiled models'): row copies
+        else:
+            statkernels.transpose(flat, self.reference if circular else _NO_REFERENCE,
+                                  circular, columns, offset)
         summaries = []
         count, mean, m2 = (np.empty(self.size, dtype=np.int64), np.empty(self.size),
                            np.empty(self.size))
