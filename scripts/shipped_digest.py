@@ -92,11 +92,12 @@ def results(model="compiled"):
     return shipped(lambda dataset: dataset, model)
 
 
-def closeness(before, now):
+def closeness(before, now, floor=0.01):
     """(scenario, variable, largest |now - before| / the variable's scale) of every float
-    variable, the worst first; the scale is the largest |before| of the variable (so a
-    value that is zero up to rounding, a bias or a vertical wind of 1e-16, is held to the
-    variable's own size, not to itself); a direction [deg] compared on the circle."""
+    variable, the worst first; the scale is the largest |before| of the variable, at
+    least `floor` of its unit (so a value that is zero up to rounding, the vertical wind
+    of a level lidar at 1e-16 m s-1 or a direction of 1e-30 deg, is held to 1e-12 x 0.01
+    = 1e-14 of its unit, not to itself); a direction [deg] compared on the circle."""
     rows = []
     for name, old in before.items():
         new = now.get(name)
@@ -110,7 +111,7 @@ def closeness(before, now):
                 continue
             both_nan = np.isnan(a) & np.isnan(b)
             gap = np.where(both_nan, 0.0, _gap(variable, a, b))
-            scale = max(float(np.nanmax(np.abs(a), initial=0.0)), np.finfo(float).tiny)
+            scale = max(float(np.nanmax(np.abs(a), initial=0.0)), floor)
             worst = np.nanmax(np.where(np.isnan(gap), np.inf, gap / scale), initial=0.0)
             rows.append((name, variable, float(worst)))
     return sorted(rows, key=lambda row: -row[2])
@@ -155,6 +156,8 @@ def main():
     parser.add_argument("--close", help="folder of --save: print the largest relative "
                         "difference of each float variable (exit 1 above --rtol)")
     parser.add_argument("--rtol", type=float, default=1e-12)
+    parser.add_argument("--floor", type=float, default=0.01,
+                        help="least scale of a variable, in its unit (see closeness)")
     args = parser.parse_args()
     if args.save:
         Path(args.save).mkdir(parents=True, exist_ok=True)
@@ -163,7 +166,7 @@ def main():
         return 0
     if args.close:
         before = {path.stem: xr.load_dataset(path) for path in Path(args.close).glob("*.nc")}
-        rows = closeness(before, results(args.model))
+        rows = closeness(before, results(args.model), args.floor)
         for name, variable, worst in rows[:15]:
             print(f"{name} {variable}: {worst:.3g}")
         bad = [row for row in rows if not row[2] <= args.rtol]
