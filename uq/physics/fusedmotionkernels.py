@@ -294,23 +294,48 @@ def _geometry(consts, azimuths, beams, cone_error, misalignment_error, height_er
         work[_LIDAR_Z, j] = height + height_error[start + j if height_error.shape[0] > 1 else 0]
 
 
+@_helper
+def _attitude_trig(consts, state, work, count, yaw):
+    """The (cos, sin) of the attitude's heading (with `yaw`; else the static heading's),
+    pitch and roll at a node from :func:`sincos` into the state's rows, each angle in a
+    loop of its own (no calls, few arrays: SIMD), for :func:`_truth_at`'s first pass."""
+    for i in range(3 if yaw else 2):
+        base, dof = (_PITCH, _ROLL, _HEADING)[i], (1, 0, 2)[i]
+        row = (_TRIG + 2, _TRIG + 4, _TRIG)[i]
+        angle = consts[base]
+        for j in range(count):
+            work[_ANGLE, j] = angle + state[_VALUE + dof, j]
+        for j in range(count):
+            sine, cosine = sincos(work[_ANGLE, j])
+            state[row, j] = cosine
+            state[row + 1, j] = sine
+    if not yaw:
+        state[_TRIG, :count] = consts[_LEVEL_COS]
+        state[_TRIG + 1, :count] = consts[_LEVEL_SIN]
+
+
 @_inline
 def _truth_at(head, state, work, ship_beams, parts, b, node, j, exact, yaw):
     """The true beam and radial-velocity parts of trial j at a node (see
-    :func:`kinematics`); the attitude's (cos, sin) into the state's rows; work[_BIG, j]
-    bounds the angles' size (for the libm pass)."""
+    :func:`kinematics`); the attitude's (cos, sin) from the state's rows
+    (:func:`_attitude_trig`), or with `exact` from libm into them; work[_BIG, j] bounds
+    the angles' size (for the libm pass)."""
     heading = head[_HEADING] + state[_VALUE + 2, j]
     pitch = head[_PITCH] + state[_VALUE + 1, j]
     roll = head[_ROLL] + state[_VALUE, j]
-    if yaw:
-        sh, ch = _trig(heading, exact)
-    else:                                       # cos, sin of the static heading
-        ch, sh = head[_LEVEL_COS], head[_LEVEL_SIN]
-    sp, cp = _trig(pitch, exact)
-    sr, cr = _trig(roll, exact)
+    if exact:
+        if yaw:
+            sh, ch = _trig(heading, exact)
+        else:                                   # cos, sin of the static heading
+            ch, sh = head[_LEVEL_COS], head[_LEVEL_SIN]
+        sp, cp = _trig(pitch, exact)
+        sr, cr = _trig(roll, exact)
+        state[_TRIG, j], state[_TRIG + 1, j], state[_TRIG + 2, j] = ch, sh, cp
+        state[_TRIG + 3, j], state[_TRIG + 4, j], state[_TRIG + 5, j] = sp, cr, sr
+    else:                                       # sincos's, SIMD (_attitude_trig)
+        ch, sh, cp = state[_TRIG, j], state[_TRIG + 1, j], state[_TRIG + 2, j]
+        sp, cr, sr = state[_TRIG + 3, j], state[_TRIG + 4, j], state[_TRIG + 5, j]
     work[_BIG, j] = abs(pitch) + abs(roll) + (abs(heading) if yaw else 0.0)
-    state[_TRIG, j], state[_TRIG + 1, j], state[_TRIG + 2, j] = ch, sh, cp
-    state[_TRIG + 3, j], state[_TRIG + 4, j], state[_TRIG + 5, j] = sp, cr, sr
     bx, by, bz = rotate(ch, sh, cp, sp, cr, sr, ship_beams[b, 0, j], ship_beams[b, 1, j],
                         ship_beams[b, 2, j])
     surge, sway = state[_RATE_ROW + 3, j], state[_RATE_ROW + 4, j]
@@ -369,6 +394,7 @@ def kinematics(consts, pairs, amplitudes, components, sources, phases, window, n
         for q in range(n_nodes):
             node = b * n_nodes + q
             _motion(pairs, amplitudes, node_table, node, c, state, count)
+            _attitude_trig(consts, state, work, count, yaw)
             if yaw:
                 for j in range(count):
                     _truth_at(head, state, work, ship_beams, parts, b, node, j, False, True)
