@@ -25,7 +25,9 @@ scenes' constants are rows of a table (:func:`scene_table`), the work that depen
 on the draws (the errors' sines and cosines) is done once per block of trials and shared
 by every scene that sees those draws; with independent draws per scene each scene has
 its own. The truth (true beams, gate heights, power law) is computed once per scene
-when no geometry error varies it, else per trial.
+when no geometry error varies it, else per trial. With a probe volume the truth's
+profile is the probe's weighted speed (:mod:`uq.physics.fusedprobe`, per trial where the
+probe's parameters have errors); a probe's complex step stays with the numpy model.
 
 Conventions (as in the modules named above): earth frame (north, east, up); ship frame
 (bow, starboard, up); body-to-earth ``Rz(heading) Ry(pitch) Rx(roll)``, pitch positive

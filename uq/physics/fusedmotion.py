@@ -18,8 +18,10 @@ It is a second implementation of the physics, written from the conventions of
 elementary ones, the lever-arm velocity by the product rule, the INS time shift as a
 turn of the phase vectors, Cholesky for the least squares), not from the array code;
 ``tests/physics/test_fusedmotion.py`` checks that the two agree to 1e-12 m/s. The numpy
-model stays the reference and alone runs complex-step (the GUM Jacobian), a probe volume
-and the outputs ``radial_velocity`` and ``gate_height``; :func:`applicable` says when
+model stays the reference and alone runs complex-step (the GUM Jacobian) and the outputs
+``radial_velocity`` and ``gate_height``; a probe volume's quadrature is
+:mod:`uq.physics.fusedprobe`'s (on the gate-centre heights kinematics writes);
+:func:`applicable` says when
 the compiled model is used. A batch of scenes is evaluated scene after scene.
 
 Conventions: those of :mod:`uq.physics.timeresolved` (earth frame north, east, up; ship
@@ -57,7 +59,7 @@ PROBE_INPUTS = fusedprobe.INPUTS
 def applicable(scene, outputs, errors, scene_draws=False):
     """Can the compiled model evaluate this call of the time-resolved model?
 
-    A time-resolved scene without a probe volume, only :data:`FUSED_OUTPUTS`, real
+    A time-resolved scene (with or without a probe volume), only :data:`FUSED_OUTPUTS`, real
     inputs (not the GUM's complex steps) that it implements
     (:data:`uq.physics.modelinputs.MOTION_COMPILED`), in the shapes the pipeline gives:
     INS errors (n,) or (n, k), phases (n, K, 2), radial noise (n, beams, gates) (each

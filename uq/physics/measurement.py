@@ -36,7 +36,8 @@ computed once per scene, not per sample.
 
 With a probe volume (``scene.probe``, :mod:`uq.physics.probe`) the horizontal wind
 speed in each true radial velocity is its weighted mean along the true beam (a
-quadrature; a probe never runs the compiled model).
+quadrature; the compiled models evaluate the same quadrature, :mod:`uq.physics.fusedprobe`,
+and leave a probe's complex step to this model).
 
 The output ``gate_height`` is the mean true height of the slanted beams at each range
 gate [m]: the height the reconstructed horizontal wind belongs to, which a tilted lidar
@@ -155,7 +156,7 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
         shape (n, *S, n_gates); ``radial_velocity`` [m s-1] (n, *S, n_beams, n_gates), the
         motion-corrected radial velocity along the beam the correction believes in.
     """
-    if scene.probe is not None:     # a probe volume: its quadrature; the numpy model only
+    if scene.probe is not None:     # a probe volume: its quadrature's node count, once
         scene = probe_volume.resolve(scene)
     if scene.time_resolved is not None:       # motion within the scan: its own model
         from uq.physics import timeresolved

@@ -71,7 +71,7 @@ def measurement_model(scene, outputs, scene_draws=False, compiled=True, **errors
     plus those of :data:`TIME_RESOLVED_INPUTS`.
 
     `compiled` (bool): where it applies (:func:`uq.physics.fusedmotion.applicable`: real
-    inputs, wind outputs, no probe volume), evaluate with the compiled loops of
+    inputs, wind outputs), evaluate with the compiled loops of
     :mod:`uq.physics.fusedmotion`, which give the same values to 1e-12 m/s; False forces
     the numpy arrays below.
     """
