@@ -253,12 +253,16 @@ def _ship_velocity(scene):
 
 
 def _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors):
-    result = wind.wind_outputs(wind_vector, outputs)
     nacelle_wanted = set(outputs) & set(NACELLE_OUTPUTS)
-    if "radial_velocity" in outputs or nacelle_wanted:
+    pair = nacelle.level_pair(scene.azimuths) if scene.tilt != 0 and \
+        not scene.horizontal_only else None
+    if "radial_velocity" in outputs or nacelle_wanted or pair:
         corrected, beams = _corrected_radial(scene, measured, navigation, unit_vectors)
-        if "radial_velocity" in outputs:
-            result["radial_velocity"] = corrected
+    if pair:                   # a nacelle lidar's hub-height wind: its level beams'
+        wind_vector = nacelle.hub_height_wind(wind_vector, beams, corrected, pair)
+    result = wind.wind_outputs(wind_vector, outputs)
+    if "radial_velocity" in outputs:
+        result["radial_velocity"] = corrected
     if nacelle_wanted:
         slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
                                 scene.vertical_beam)                    # (*S, b, g)

@@ -144,6 +144,9 @@ def single_scene(scene, outputs, **errors):
             wind_vector = scan_wind(measured, scene.correction, operator, rotation, velocity)
         believed = (rotation[:, None] @ unit_vectors[..., None])[..., 0]   # (n, b, 3)
         along = np.sum(believed * velocity[:, None, :], axis=-1)[..., None]
+    pair = nacelle.level_pair(scene.azimuths) if scene.tilt != 0 and not horizontal else None
+    if pair:                   # a nacelle lidar's hub-height wind: its level beams'
+        wind_vector = nacelle.hub_height_wind(wind_vector, believed, measured + along, pair)
     result = _outputs(scene, outputs, wind_vector, measured + along, heights)
     if set(outputs) & set(NACELLE_OUTPUTS):
         slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
