@@ -1,6 +1,6 @@
-"""Nacelle lidars through the pipeline: the issue's held-out keys through ``uq run``, the
-validation of ``lidar.mount`` and the nacelle outputs, and the GUM against Monte Carlo
-(JCGM 101 clause 8) for small and large pitch."""
+"""Nacelle lidars through the pipeline: the issue's held-out keys through ``uq run``, a
+two-beam lidar's w = 0, harmonics as a list, and the GUM against Monte Carlo (JCGM 101
+clause 8) for small and large pitch (validation: test_mountsection.py)."""
 import numpy as np
 import pytest
 import xarray as xr
@@ -8,7 +8,6 @@ import yaml
 
 import uq
 from uq.cli import main
-from uq.errors import ScenarioError
 
 #: The issue's held-out check: a 4-beam nacelle lidar (tilt 90, half-cone 15, clock
 #: positions 0/90/180/270, range 100 m) at 150 m, lever arm [0, 0, 150], 0.25 s per beam,
@@ -69,35 +68,6 @@ def test_a_static_pitch_of_2_deg(tmp_path, correction):
         assert abs(nominal - 10.0 * np.cos(np.deg2rad(2.0))) < 1e-9
     else:
         assert abs(nominal - 10.0) < 1e-12
-
-
-BAD = [
-    ({"lidar": {"mount": {"tilt": 95}}}, "lidar.mount.tilt"),
-    ({"lidar": {"mount": {"tilt": -1}}}, "lidar.mount.tilt"),
-    ({"lidar": {"mount": {"tilt": 90, "roll": 1}}}, "lidar.mount"),
-    ({"lidar": {"mount": {}}}, "lidar.mount.tilt"),
-    ({"lidar": {"mount": {"tilt": 90}, "vertical_beam": True}}, "lidar.vertical_beam"),
-    ({"lidar": {"mount": {"tilt": 90}, "azimuths": [0, 180]}}, "lidar.azimuths"),
-    ({"lidar": {"mount": {"tilt": 90}, "azimuths": [0, 180, 360.5]}}, "lidar.azimuths"),
-    ({"lidar": {"mount": {"tilt": 90}, "azimuths": [90, 270]}, "correction": "tilt2d"},
-     "correction"),
-    ({"outputs": ["shear_exponent"]}, "outputs"),
-    ({"lidar": {"mount": {"tilt": 90}, "azimuths": [90, 270]}, "outputs": ["shear_exponent"]},
-     "outputs"),
-    ({"motion": {"pitch": []}}, "motion.pitch"),
-    ({"motion": {"pitch": [{"amplitude": 1.0}]}}, "motion.pitch[0]"),
-]
-
-
-@pytest.mark.parametrize("changes, key", BAD)
-def test_bad_mounts_are_refused_naming_the_key(changes, key):
-    """One line naming the file and the key, with what is allowed."""
-    with pytest.raises(ScenarioError) as error:
-        uq.load_scenario({"name": "bad", **changes})
-    message = str(error.value)
-    assert key in message and "\n" not in message
-    # (the harmonic's own message, older, says what it needs instead of "allowed")
-    assert "allowed" in message or "needs" in message
 
 
 def test_a_tilted_two_beam_lidar_assumes_w_zero():
