@@ -250,3 +250,15 @@ def test_dispatch_and_cpu_work(tensor):
     assert lidar_variances(g, _kaimal()).true.shape == (3,)
     with pytest.raises(TypeError, match="unknown turbulence model"):
         lidar_variances(g, object())
+
+
+def test_beam_pairs_and_component_vectors_agree(tensor, monkeypatch):
+    # the two evaluations of Eq. (2)-(3) are algebraically equal: to rounding
+    from uq.physics import lidarspectral
+    g = dbs_geometry([60.0, 120.0], beam_duration=0.5, vertical=True)
+    transfer = probe_transfer_for(SATHE_PROBE, [60.0, 120.0])
+    grid = WavenumberGrid(33.6, (-4.0, 4.0), (-3.0, 3.0), 4, 4, 16)
+    by_pairs = mann_lidar_variances(g, tensor, transfer, grid).lidar
+    monkeypatch.setattr(lidarspectral, "_PAIR_BEAMS", 0)
+    np.testing.assert_allclose(mann_lidar_variances(g, tensor, transfer, grid).lidar, by_pairs,
+                               rtol=1e-10)
