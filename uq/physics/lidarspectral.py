@@ -317,6 +317,13 @@ def _flatten(distortion):
     return [factor, *k0, *zetas]
 
 
+def _flat(distortion):
+    """The (factor, k0, zetas) arguments of :func:`_form` from a flattened distortion,
+    each (P, 1) to broadcast over the components."""
+    factor, k01, k02, k03, zeta1, zeta2, ratio = (v[:, None] for v in distortion)
+    return factor, (k01, k02, k03), (zeta1, zeta2, ratio)
+
+
 def _form(vectors, factor, k0, zetas):
     """``g Phi g^H`` [m5 s-2] for complex rows g (..., 3): with ``q = g A``,
     ``E(k0)/(4 pi k0^4) (k0^2 |q|^2 - |q . k0|^2)`` (MannTensor.quadratic_form, unpacked)."""
