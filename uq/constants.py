@@ -410,3 +410,9 @@ SPECTRAL_ANGLE_NODES = 48
 #: Frequencies of the Kaimal path: f L_u / U from 1e-5 to 1e5 [1], nodes per decade.
 KAIMAL_FREQUENCY_DECADES = (-5.0, 5.0)
 KAIMAL_FREQUENCY_PER_DECADE = 40
+
+#: Golden TI (issue 24, item 5): a record is 10 min [s] (IEC 61400-12-1); the
+#: representative TI is the mean plus 1.28 standard deviations (IEC 61400-1:2005 Sec.
+#: 6.3.1: the 90 % quantile of a normal distribution of the 10-min TI).
+GOLDEN_RECORD_SECONDS = 600.0
+REPRESENTATIVE_TI_QUANTILE = 1.28
