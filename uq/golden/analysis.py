@@ -10,6 +10,8 @@ Dimensions: ``comparison`` (``unit-reference``), ``height`` [m], ``bin`` (centre
 [m s-1]), ``framework`` (``iec``, ``lusr``), ``variable`` (environmental), ``time``
 (the paired records, for the figures).
 """
+import functools
+
 import numpy as np
 import xarray as xr
 
@@ -83,8 +85,9 @@ def _env(ds):
 def _comparison(config, key, unit, reference, counts, centres, smc):
     """Tables of one comparison, dimensions (height, bin, framework, variable, time)."""
     heights = unit["height"].values
-    scenario = config.instruments[unit.attrs["instrument"]].scenario \
-        if unit.attrs.get("instrument") in config.instruments else None
+    scenario = tuple(config.instruments[ds.attrs["instrument"]].scenario
+                     if ds.attrs.get("instrument") in config.instruments else None
+                     for ds in (unit, reference))
     per_height = [_height_tables(config, unit.sel(height=h), reference.sel(height=h),
                                  centres, smc.sel(height=h) if smc is not None and h in
                                  smc["height"].values else None, scenario) for h in heights]
@@ -131,14 +134,30 @@ def _turbulence(config, unit, reference, centres, scenario):
     for kpi_name in turbulence.TI_KPIS:
         data[f"ti_{kpi_name}_verdict"] = ("bin", turbulence.band_verdicts(
             stats[kpi_name], config.ti_bands.get(kpi_name)))
+    unit_scenario, reference_scenario = scenario or (None, None)
     ratio = np.nan
-    if scenario is not None:
-        speed = float(np.mean(config.required))
-        ratio = turbulence.predicted_variance_ratio(scenario.settings,
-                                                    float(unit["height"]), speed)
+    if unit_scenario is not None:    # a lidar reference filters too: the ratio of the two
+        speed, height = float(np.mean(config.required)), float(unit["height"])
+        ratio = _predicted_ratio(unit_scenario, height, speed) / (
+            1.0 if reference_scenario is None else
+            _predicted_ratio(reference_scenario, height, speed))
     data["ti_predicted_ratio"] = ((), ratio)
     data["ti_predicted_mean"] = ("bin", stats["reference_mean"] * np.sqrt(ratio))
     return data
+
+
+@functools.lru_cache(maxsize=256)
+def _cached_ratio(source, text, height, speed):
+    from uq.pipeline.scenario import load_scenario
+    return turbulence.predicted_variance_ratio(load_scenario(source).settings, height, speed)
+
+
+def _predicted_ratio(scenario, height, speed):
+    """The unit's u-variance ratio (:func:`uq.golden.turbulence.predicted_variance_ratio`),
+    once per scenario file, height and speed."""
+    return turbulence.predicted_variance_ratio(scenario.settings, height, speed) \
+        if scenario.source is None else _cached_ratio(str(scenario.source), scenario.text,
+                                                      height, speed)
 
 
 def _in_required_range(config, speed):
@@ -333,7 +352,9 @@ METADATA = {
     "ti_representative_error": ("percent", "representative TI of the unit minus the "
                                 "reference's (percentage points)"),
     "ti_predicted_ratio": ("1", "u-variance ratio lidar / point predicted by the spectral "
-                           "path for the unit's lidar (IEC Mann field, fixed and level)"),
+                           "path for the unit's lidar (IEC Mann field, fixed and level), "
+                           "over the reference's own ratio where the reference is a lidar "
+                           "with a scenario"),
     "ti_predicted_mean": ("percent", "apparent TI the unit is predicted to read: reference "
                           "mean TI times sqrt(ti_predicted_ratio)"),
     "time": ("", "start of the paired 10-min record"),

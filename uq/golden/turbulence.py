@@ -23,7 +23,8 @@ instrument names its ``uq`` scenario (``golden.instruments.NAME.scenario``), the
 TI is predicted by the spectral path (:mod:`uq.physics.lidarspectral`) for that lidar,
 fixed and level (motion is left out), in an IEC 61400-1 Mann field at each height (L = 0.8
 Lambda_1, Gamma = 3.9), a 600-s record at the mid speed of the required range:
-``TI_predicted = TI_ref sqrt(var_lidar / var_true)`` per bin.
+``TI_predicted = TI_ref sqrt(var_lidar / var_true)`` per bin; where the reference is a
+lidar with a scenario too, the ratio is the unit's over the reference's.
 
 References
 ----------
