@@ -411,8 +411,14 @@ def box_variance(grid, alpha_epsilon, length_scale, anisotropy,
 
 def white_noise(rng, shape, xp=np):
     """Real standard normals of ``shape`` (3, nx, ny, nz), drawn on the host in C order
-    component by component, then moved to ``xp``'s device."""
-    return [xp.asarray(rng.standard_normal(shape[1:])) for _ in range(shape[0])]
+    component by component (the same numbers as one draw of ``shape``), on ``xp``'s
+    device."""
+    if xp is np:
+        out = np.empty(shape)
+        for c in range(shape[0]):
+            rng.standard_normal(out=out[c])
+        return out
+    return xp.stack([xp.asarray(rng.standard_normal(shape[1:])) for _ in range(shape[0])])
 
 
 def mann_box(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
@@ -445,7 +451,7 @@ def mann_box(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
     fft = _fft(xp)
     kwargs = {"workers": workers} if xp is np else {}
     axes = (1, 2, 3)
-    noise = xp.stack(white_noise(rng, (3,) + tuple(grid.shape), xp))
+    noise = white_noise(rng, (3,) + tuple(grid.shape), xp)
     spectrum = fft.rfftn(noise, axes=axes, **kwargs)
     del noise
     k1, k2, k3 = box_wavenumbers(grid, xp)
@@ -460,6 +466,8 @@ def mann_box(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
         spectrum[:, slab] = (1j * scale) * coloured
     # near the k1 axis: u_k = C_avg n, C_avg even, so u_-k = u_k^* (module docstring)
     spectrum[index] = scale * xp.einsum("ijn,jn->in", xp.asarray(factors), noise_cells)
+    if xp is np:
+        kwargs["overwrite_x"] = True
     velocity = fft.irfftn(spectrum, s=tuple(grid.shape), axes=axes, **kwargs)
     return TurbulenceBox(grid=grid, velocity=velocity)
 
