@@ -440,3 +440,41 @@ SAMPLING_CHUNK_POINTS = 2**18
 CELL_AVERAGE_K1 = 4.0
 CELL_AVERAGE_K1_NODES = 3
 CELL_AVERAGE_GRADING = (0.25, 6)
+
+# --- Turbulence spectra (issue 24) ----------------------------------------------------------
+
+#: IEC 61400-1:2005 (Ed. 3) Annex B, Eq. B.1 (Ed. 4, 2019: Annex C): the turbulence scale
+#: parameter Lambda_1 [m] is 0.7 z below 60 m and 42 m above (hub height z).
+IEC_SCALE_SLOPE = 0.7
+IEC_SCALE_HEIGHT = 60.0
+IEC_SCALE_MAX = 42.0
+
+#: IEC 61400-1:2005 Annex B.1 (Mann uniform-shear model): Gamma = 3.9 [1] and the length
+#: scale L = 0.8 Lambda_1 [m] (33.6 m above 60 m).
+IEC_MANN_ANISOTROPY = 3.9
+IEC_MANN_LENGTH_FACTOR = 0.8
+
+#: IEC 61400-1:2005 Annex B.2, Table B.1 (Kaimal): integral scale parameters L_k =
+#: (8.1, 2.7, 0.66) Lambda_1 [m] and standard deviations (1, 0.8, 0.5) sigma_1 [1] of
+#: (u, v, w); the exponential coherence's decrement 12 and scale L_c = 8.1 Lambda_1
+#: (Eq. B.13: Coh = exp(-12 sqrt((f r / V)^2 + (0.12 r / L_c)^2))).
+IEC_KAIMAL_LENGTH_FACTORS = (8.1, 2.7, 0.66)
+IEC_KAIMAL_SIGMA_RATIOS = (1.0, 0.8, 0.5)
+IEC_COHERENCE_DECREMENT = 12.0
+IEC_COHERENCE_SCALE_RATIO = 0.12
+IEC_COHERENCE_LENGTH_FACTOR = 8.1
+
+#: Quadrature of the spectral path (:class:`uq.physics.spectraltensor.WavenumberGrid`),
+#: tested for convergence in tests/physics/test_spectraltensor.py: k1 L from 1e-6 to 1e6
+#: and the polar radius rho / sqrt(k1^2 + L^-2) from 1e-5 to 1e4 (the sheared tensor keeps
+#: energy at rho << k1 for small k: 8e-4 of sigma_u^2 lies below 1e-3; the inertial tail
+#: beyond 1e6 holds (1e6)^(-2/3) = 1e-4); Gauss-Legendre nodes per decade of k1 and of
+#: rho; trapezoid nodes in the polar angle (periodic: spectral convergence).
+SPECTRAL_K_DECADES = (-6.0, 6.0)
+SPECTRAL_K1_PER_DECADE = 12
+SPECTRAL_RADIUS_DECADES = (-5.0, 4.0)
+SPECTRAL_RADIUS_PER_DECADE = 8
+SPECTRAL_ANGLE_NODES = 48
+#: Frequencies of the Kaimal path: f L_u / U from 1e-5 to 1e5 [1], nodes per decade.
+KAIMAL_FREQUENCY_DECADES = (-5.0, 5.0)
+KAIMAL_FREQUENCY_PER_DECADE = 40
