@@ -478,3 +478,9 @@ SPECTRAL_ANGLE_NODES = 48
 #: Frequencies of the Kaimal path: f L_u / U from 1e-5 to 1e5 [1], nodes per decade.
 KAIMAL_FREQUENCY_DECADES = (-5.0, 5.0)
 KAIMAL_FREQUENCY_PER_DECADE = 40
+
+#: Most (y, z) points of a Kaimal box [1] (turbulencebox.kaimal_box): Veers' method
+#: factors a points x points coherence matrix per wavenumber (~P^3 / 3 flops each), so
+#: 1024 points and the ~750 wavenumbers of a ten-minute record cost ~3e11 flops, about a
+#: minute on two cores; a 5-beam DBS at 100 m at the default spacing needs ~720.
+MAX_KAIMAL_POINTS = 1024

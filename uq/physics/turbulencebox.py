@@ -166,6 +166,14 @@ def check_cells(shape, max_cells=constants.MAX_BOX_CELLS):
             f"record.duration, coarsen the spacing or lower the length scale's margin")
 
 
+def check_kaimal_points(points, max_points=constants.MAX_KAIMAL_POINTS):
+    """Raise ValueError (one line) if a Kaimal box's (y, z) grid has too many points."""
+    if points > max_points:
+        raise ValueError(
+            f"a Kaimal box of {points} (y, z) points is above the limit of {max_points} "
+            f"(one Cholesky factor of points x points per wavenumber): coarsen the spacing")
+
+
 @dataclass(frozen=True)
 class TurbulenceBox:
     """A generated field: ``velocity`` (3, nx, ny, nz) [m s-1] on ``grid``."""
@@ -552,24 +560,26 @@ def kaimal_box(grid, sigma_u, speed, scale_parameter, rng, xp=np,
     lengths = np.multiply(constants.KAIMAL_LENGTH_RATIOS_IEC, scale_parameter)
     sigmas = np.multiply(constants.KAIMAL_SIGMA_RATIOS_IEC, sigma_u)
     coherence_length = constants.IEC_COHERENCE_LENGTH_RATIO * scale_parameter
+    check_kaimal_points(ny * nz)
     fft = _fft(xp)
     noise = white_noise(rng, (3, nx, ny, nz), xp)
-    velocity = []
-    for c in range(3):
-        half = fft.rfft(noise[c].reshape(nx, ny * nz), axis=0)
-        # two-sided density in k1 [m3 s-2]: S(f) df / dk1 / 2, Table B.1 [3] via Taylor
-        density = kaimal_spectrum(frequency, sigmas[c], lengths[c], speed) * speed / (4 * np.pi)
-        density[0] = 0.0                                    # the box's mean is zero
-        per_slab = max(1, slab_cells // (ny * nz) ** 2)
-        for a in range(0, k1.size, per_slab):
-            part = slice(a, min(a + per_slab, k1.size))
-            coherence = iec_coherence(separation, frequency[part, None, None], speed,
-                                      coherence_length)
-            factor = xp.asarray(np.linalg.cholesky(coherence) * np.sqrt(density[part])[:, None, None])
-            half[part] = xp.einsum("fpq,fq->fp", factor, half[part])
-        scale = np.sqrt(2.0 * np.pi / dx)                         # sqrt(nx dk1)
-        velocity.append(fft.irfft(half * scale, n=nx, axis=0).reshape(nx, ny, nz))
-    return TurbulenceBox(grid=grid, velocity=xp.stack(velocity))
+    half = fft.rfft(noise.reshape(3, nx, ny * nz), axis=1)            # (3, k1, points)
+    del noise
+    # two-sided densities in k1 [m3 s-2]: S(f) df / dk1 / 2, Table B.1 [3] via Taylor
+    density = np.stack([kaimal_spectrum(frequency, sigmas[c], lengths[c], speed)
+                        for c in range(3)]) * speed / (4 * np.pi)
+    density[:, 0] = 0.0                                                # the box's mean is zero
+    amplitude = xp.asarray(np.sqrt(density * 2.0 * np.pi / dx))        # sqrt(nx dk1 F)
+    per_slab = max(1, slab_cells // (ny * nz) ** 2)
+    for a in range(0, k1.size, per_slab):
+        part = slice(a, min(a + per_slab, k1.size))
+        # one coherence, so one Cholesky factor, for the three components
+        coherence = iec_coherence(separation, frequency[part, None, None], speed,
+                                  coherence_length)
+        factor = xp.asarray(np.linalg.cholesky(coherence))
+        half[:, part] = xp.einsum("fpq,cfq->cfp", factor, half[:, part]) * amplitude[:, part, None]
+    velocity = fft.irfft(half, n=nx, axis=1).reshape(3, nx, ny, nz)
+    return TurbulenceBox(grid=grid, velocity=velocity)
 
 
 def box_for(geometry, length_scale, model="mann", spacing=None, record_duration=None,
@@ -626,6 +636,8 @@ def box_for(geometry, length_scale, model="mann", spacing=None, record_duration=
     shape = tuple(int(scipy.fft.next_fast_len(int(np.ceil(e / step)) + 1, real=True))
                   for e in extent)
     check_cells(shape, max_cells)
+    if model == "kaimal":
+        check_kaimal_points(shape[1] * shape[2])
     centre = (low + high) / 2.0
     origin = (float(low[0] - geometry.speed * (duration + geometry.dwell) - step),
               float(centre[1] - (shape[1] - 1) * step / 2.0),
