@@ -330,6 +330,10 @@ def test_a_real_field():
 def test_memory_bound_is_refused_with_a_clear_message():
     with pytest.raises(ValueError, match=r"8192 x 1024 x 1024 = 8589934592 cells is above the limit"):
         tb.BoxGrid((8192, 1024, 1024), (1.0, 1.0, 1.0))
+    # a Kaimal box's cost is its Cholesky factors: refused by its (y, z) points
+    grid = tb.BoxGrid((16, 64, 32), (5.0, 5.0, 5.0), periodic_yz=False)
+    with pytest.raises(ValueError, match="2048 .y, z. points is above the limit of 1024"):
+        tb.kaimal_box(grid, 1.0, 10.0, 42.0, np.random.default_rng(0))
 
 
 def _dbs(height=100.0, half_cone=30.0, speed=10.0, duration=600.0, dwell=1.0):
