@@ -489,3 +489,8 @@ KAIMAL_FREQUENCY_PER_DECADE = 40
 #: 6.3.1: the 90 % quantile of a normal distribution of the 10-min TI).
 GOLDEN_RECORD_SECONDS = 600.0
 REPRESENTATIVE_TI_QUANTILE = 1.28
+#: Most (y, z) points of a Kaimal box [1] (turbulencebox.kaimal_box): Veers' method
+#: factors a points x points coherence matrix per wavenumber (~P^3 / 3 flops each), so
+#: 1024 points and the ~750 wavenumbers of a ten-minute record cost ~3e11 flops, about a
+#: minute on two cores; a 5-beam DBS at 100 m at the default spacing needs ~720.
+MAX_KAIMAL_POINTS = 1024
