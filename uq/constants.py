@@ -478,6 +478,22 @@ SPECTRAL_K1_PER_DECADE = 12
 SPECTRAL_RADIUS_DECADES = (-5.0, 4.0)
 SPECTRAL_RADIUS_PER_DECADE = 8
 SPECTRAL_ANGLE_NODES = 48
+#: Points of the wavenumber grid whose weighted trace of Phi is below this fraction of the
+#: field's total trace are left out of the lidar's sum [1]: they hold 3e-6 of the trace
+#: of the IEC Mann field, so a component's variance moves by < (sum_b |R_b|)^2 3e-6 (2e-5
+#: of sigma_u^2 for a DBS u), and 40 % of the points go (measured).
+SPECTRAL_PRUNE = 1e-10
 #: Frequencies of the Kaimal path: f L_u / U from 1e-5 to 1e5 [1], nodes per decade.
 KAIMAL_FREQUENCY_DECADES = (-5.0, 5.0)
 KAIMAL_FREQUENCY_PER_DECADE = 40
+
+#: Golden TI (issue 24, item 5): a record is 10 min [s] (IEC 61400-12-1); the
+#: representative TI is the mean plus 1.28 standard deviations (IEC 61400-1:2005 Sec.
+#: 6.3.1: the 90 % quantile of a normal distribution of the 10-min TI).
+GOLDEN_RECORD_SECONDS = 600.0
+REPRESENTATIVE_TI_QUANTILE = 1.28
+#: Most (y, z) points of a Kaimal box [1] (turbulencebox.kaimal_box): Veers' method
+#: factors a points x points coherence matrix per wavenumber (~P^3 / 3 flops each), so
+#: 1024 points and the ~750 wavenumbers of a ten-minute record cost ~3e11 flops, about a
+#: minute on two cores; a 5-beam DBS at 100 m at the default spacing needs ~720.
+MAX_KAIMAL_POINTS = 1024

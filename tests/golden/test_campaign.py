@@ -150,3 +150,23 @@ def test_golden_figures_label_in_words_and_stack_variances(campaign):
     np.testing.assert_allclose(tops, shown["calibration"].values ** 2, rtol=1e-12)
     plt.close(figure)
     assert plots.p_value_text(3e-17) == "p < 0.001" and plots.p_value_text(0.1432) == "p = 0.14"
+
+
+def test_turbulence_kpis_and_prediction(campaign):
+    """Item 5 of issue 24: TI KPIs per bin and the TI uq predicts. The synthetic lidars
+    report the mast's TI (campaign docstring), so the measured errors are 0; FLSa and FLSb
+    share a geometry, so the predicted ratio of one against the other is 1."""
+    from uq.golden.turbulence import predicted_variance_ratio
+    from uq.pipeline.scenario import load_scenario
+    folder, ds = campaign
+    assert (folder / "tables" / "turbulence.csv").exists()
+    assert (folder / "figures" / "turbulence.png").exists()
+    used = ds["ti_n_records"] > 0
+    assert float(np.abs(ds["ti_mean_bias"].where(used)).max()) == 0.0
+    assert set(np.unique(ds["ti_rmse_verdict"].values)) <= {"informational", "no data"}
+    np.testing.assert_allclose(ds["ti_predicted_ratio"].sel(comparison="flsa-flsb"), 1.0)
+    settings = load_scenario(ROOT / "scenarios" / "golden_flsb.yaml").settings
+    assert float(ds["ti_predicted_ratio"].sel(comparison="flsb-mast", height=80.0)) == \
+        pytest.approx(predicted_variance_ratio(settings, 80.0, 10.0), rel=1e-12)
+    report = (folder / "report.md").read_text()
+    assert "Turbulence intensity per bin" in report and "TI predicted [%]" in report

@@ -10,12 +10,14 @@ Dimensions: ``comparison`` (``unit-reference``), ``height`` [m], ``bin`` (centre
 [m s-1]), ``framework`` (``iec``, ``lusr``), ``variable`` (environmental), ``time``
 (the paired records, for the figures).
 """
+import functools
+
 import numpy as np
 import xarray as xr
 
 from uq.errors import ScenarioError
 from uq.pipeline.metadata import cf_encode, history
-from . import binning, calibration, classification, kpi
+from . import binning, calibration, classification, kpi, turbulence
 from .records import align, load_records
 
 FRAMEWORKS = calibration.FRAMEWORKS
@@ -83,16 +85,19 @@ def _env(ds):
 def _comparison(config, key, unit, reference, counts, centres, smc):
     """Tables of one comparison, dimensions (height, bin, framework, variable, time)."""
     heights = unit["height"].values
+    scenario = tuple(config.instruments[ds.attrs["instrument"]].scenario
+                     if ds.attrs.get("instrument") in config.instruments else None
+                     for ds in (unit, reference))
     per_height = [_height_tables(config, unit.sel(height=h), reference.sel(height=h),
                                  centres, smc.sel(height=h) if smc is not None and h in
-                                 smc["height"].values else None) for h in heights]
+                                 smc["height"].values else None, scenario) for h in heights]
     ds = xr.concat(per_height, dim="height").assign_coords(height=heights)
     ds["records_only_unit"] = counts["only_unit"]
     ds["records_only_reference"] = counts["only_reference"]
     return ds.expand_dims(comparison=[key])
 
 
-def _height_tables(config, unit, reference, centres, smc):
+def _height_tables(config, unit, reference, centres, smc, scenario=None):
     ref_speed, unit_speed = reference["speed"].values, unit["speed"].values
     stats = binning.bin_statistics(ref_speed, unit_speed, centres, config.bin_width)
     sufficient, required = binning.sufficient_bins(stats["n_records"], centres,
@@ -111,8 +116,48 @@ def _height_tables(config, unit, reference, centres, smc):
     data.update(_classification(config, centres, reference, smc, slopes))
     data.update(_kpis(config, unit, reference, sufficient, required))
     data.update(_paired(config, unit, reference))
+    data.update(_turbulence(config, unit, reference, centres, scenario))
     return xr.Dataset(data, coords={"framework": list(FRAMEWORKS),
                                     "variable": list(config.variables)})
+
+
+def _turbulence(config, unit, reference, centres, scenario):
+    """TI statistics, KPIs and verdicts per bin (:mod:`uq.golden.turbulence`) when both
+    instruments carry the TI variable; the predicted apparent TI when the unit names its
+    scenario (NaN otherwise)."""
+    name = config.ti_variable
+    if name not in unit or name not in reference:
+        return {}
+    stats = turbulence.ti_bin_kpis(reference[name].values, unit[name].values,
+                                   reference["speed"].values, centres, config.bin_width)
+    data = {f"ti_{k}": ("bin", v) for k, v in stats.items()}
+    for kpi_name in turbulence.TI_KPIS:
+        data[f"ti_{kpi_name}_verdict"] = ("bin", turbulence.band_verdicts(
+            stats[kpi_name], config.ti_bands.get(kpi_name)))
+    unit_scenario, reference_scenario = scenario or (None, None)
+    ratio = np.nan
+    if unit_scenario is not None:    # a lidar reference filters too: the ratio of the two
+        speed, height = float(np.mean(config.required)), float(unit["height"])
+        ratio = _predicted_ratio(unit_scenario, height, speed) / (
+            1.0 if reference_scenario is None else
+            _predicted_ratio(reference_scenario, height, speed))
+    data["ti_predicted_ratio"] = ((), ratio)
+    data["ti_predicted_mean"] = ("bin", stats["reference_mean"] * np.sqrt(ratio))
+    return data
+
+
+@functools.lru_cache(maxsize=256)
+def _cached_ratio(source, text, height, speed):
+    from uq.pipeline.scenario import load_scenario
+    return turbulence.predicted_variance_ratio(load_scenario(source).settings, height, speed)
+
+
+def _predicted_ratio(scenario, height, speed):
+    """The unit's u-variance ratio (:func:`uq.golden.turbulence.predicted_variance_ratio`),
+    once per scenario file, height and speed."""
+    return turbulence.predicted_variance_ratio(scenario.settings, height, speed) \
+        if scenario.source is None else _cached_ratio(str(scenario.source), scenario.text,
+                                                      height, speed)
 
 
 def _in_required_range(config, speed):
@@ -294,6 +339,24 @@ METADATA = {
     "paired_unit_direction": ("degree", "unit wind direction (from, clockwise from north)"),
     "paired_environment": (PER_VARIABLE, "environmental variables of the reference, each "
                            "in its own units (those of its column)"),
+    "ti_n_records": ("1", "records in the bin with a TI from both instruments"),
+    "ti_reference_mean": ("percent", "mean TI of the reference in the bin"),
+    "ti_unit_mean": ("percent", "mean TI of the unit in the bin"),
+    "ti_mean_bias": ("percent", "TI mean bias error, unit minus reference (percentage "
+                     "points)"),
+    "ti_relative_error": ("1", "TI mean bias error over the reference's mean TI"),
+    "ti_rmse": ("percent", "root-mean-square TI error (percentage points)"),
+    "ti_reference_representative": ("percent", "representative TI of the reference, mean "
+                                    "+ 1.28 sd"),
+    "ti_unit_representative": ("percent", "representative TI of the unit, mean + 1.28 sd"),
+    "ti_representative_error": ("percent", "representative TI of the unit minus the "
+                                "reference's (percentage points)"),
+    "ti_predicted_ratio": ("1", "u-variance ratio lidar / point predicted by the spectral "
+                           "path for the unit's lidar (IEC Mann field, fixed and level), "
+                           "over the reference's own ratio where the reference is a lidar "
+                           "with a scenario"),
+    "ti_predicted_mean": ("percent", "apparent TI the unit is predicted to read: reference "
+                          "mean TI times sqrt(ti_predicted_ratio)"),
     "time": ("", "start of the paired 10-min record"),
     "comparison": ("", "comparison: unit-reference"),
     "framework": ("", "framework of the deviation term: iec (IEC 61400-12-1) or lusr"),

@@ -180,6 +180,12 @@ def generate_campaign(config, directory):
     return path
 
 
+def _scenario_path(settings, role):
+    """The absolute path of a synthetic lidar's scenario (its geometry predicts the TI the
+    lidar reads, :mod:`uq.golden.turbulence`)."""
+    return str(Path(settings["lidars"][role].source).resolve())
+
+
 def _data_config(config):
     settings = config.synthetic
     heights = {float(h): {"speed": f"speed_{h:g}", "direction": f"direction_{h:g}",
@@ -190,8 +196,11 @@ def _data_config(config):
     mast = {"file": "mast.csv", **common, "calibration": settings["mast"]["calibration"],
             "class_number": 0.0}
     return {"name": config.name, "description": config.description,
-            "instruments": {"mast": mast, "flsb": {"file": "flsb.csv", **common},
-                            "flsa": {"file": "flsa.csv", **common}},
+            "instruments": {"mast": mast,
+                            "flsb": {"file": "flsb.csv", **common,
+                                     "scenario": _scenario_path(settings, "golden")},
+                            "flsa": {"file": "flsa.csv", **common,
+                                     "scenario": _scenario_path(settings, "unit")}},
             "comparisons": [{"unit": "flsb", "reference": "mast"},
                             {"unit": "flsa", "reference": "mast"},
                             {"unit": "flsa", "reference": "flsb"}],

@@ -84,6 +84,9 @@ def _write(ds, folder, name):
                                       "uncertainty terms per bin (seed Fig. 3)")}
     if not ds.sizes.get("variable"):            # no environmental variable to plot against
         del drawings["deviation"]
+    if "ti_mean_bias" in ds:
+        drawings["turbulence"] = (plots.plot_turbulence, "Mean turbulence intensity per bin: "
+                                  "measured and predicted by uq's spectral path")
     for stem, (draw, caption) in drawings.items():
         fig = draw(ds, height)
         path = folder / "figures" / f"{stem}.png"
@@ -97,9 +100,13 @@ def _write(ds, folder, name):
 
 def golden_tables(ds):
     """The Dataset's tables as pandas DataFrames (long format, one row per index)."""
-    return {"per_bin": ds[list(PER_BIN)].to_dataframe(),
+    tables = {"per_bin": ds[list(PER_BIN)].to_dataframe(),
             "sensitivity": ds[list(SENSITIVITY)].to_dataframe(),
             "kpi": ds[list(KPI)].to_dataframe()}
+    if "ti_mean_bias" in ds:
+        tables["turbulence"] = ds[[v for v in ds.data_vars if v.startswith("ti_")
+                                   and "bin" in ds[v].dims]].to_dataframe()
+    return tables
 
 
 def _summary(ds):

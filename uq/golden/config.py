@@ -20,7 +20,9 @@ from uq.pipeline.yamlfile import read_yaml
 
 TOP_KEYS = ("name", "description", "instruments", "comparisons", "smc", "classification",
             "bins", "kpi", "synthetic")
-INSTRUMENT_KEYS = ("file", "time", "heights", "environment", "calibration", "class_number")
+INSTRUMENT_KEYS = ("file", "time", "heights", "environment", "calibration", "class_number",
+                   "scenario")
+TURBULENCE_KEYS = ("variable", "bands")
 HEIGHT_KEYS = ("speed", "direction", "environment")
 CLASSIFICATION_KEYS = ("variables", "significance", "ranges", "route")
 ROUTES = ("per_variable", "class_number")
@@ -45,6 +47,7 @@ class Instrument:
     environment: dict
     calibration: tuple = None
     class_number: float = None
+    scenario: object = None
 
 
 @dataclass(frozen=True)
@@ -66,6 +69,8 @@ class GoldenConfig:
     minimum_records: int = GOLDEN_MIN_RECORDS
     availability: tuple = KPI_AVAILABILITY
     synthetic: dict = None
+    ti_variable: str = "turbulence_intensity"
+    ti_bands: dict = field(default_factory=dict)
 
 
 def load_golden_config(path):
@@ -90,6 +95,7 @@ def validate_golden(raw, check, base):
     settings.update(_bins(check, raw.get("bins") or {}))
     settings.update(_classification(check, raw.get("classification") or {}))
     settings["availability"] = _availability(check, raw.get("kpi") or {})
+    settings.update(_turbulence(check, (raw.get("kpi") or {}).get("turbulence") or {}))
     if "synthetic" in raw:
         for key in ("instruments", "comparisons", "smc"):
             if key in raw:
@@ -144,7 +150,12 @@ def _instrument(check, spec, key, name, base):
     class_number = spec.get("class_number")
     if class_number is not None:
         class_number = check.number(class_number, f"{key}.class_number", low=0.0)
+    scenario = None
+    if spec.get("scenario") is not None:         # the lidar's uq scenario: predicted TI
+        from uq.pipeline.scenario import load_scenario
+        scenario = load_scenario(base / check.text(spec["scenario"], f"{key}.scenario"))
     return Instrument(name=name, file=base / check.text(spec["file"], f"{key}.file"),
+                      scenario=scenario,
                       time=check.text(spec.get("time", "time"), f"{key}.time"),
                       heights=heights,
                       environment=_columns(check, spec.get("environment") or {},
@@ -244,12 +255,34 @@ def _classification(check, raw):
 
 def _availability(check, raw):
     check.mapping(raw, "golden.kpi")
-    check.keys(raw, "golden.kpi", ("availability",))
+    check.keys(raw, "golden.kpi", ("availability", "turbulence"))
     values = check.number_list(raw.get("availability", list(KPI_AVAILABILITY)),
                                "golden.kpi.availability", low=0.0, high=1.0)
     if len(values) != 2 or values[0] < values[1]:
         check.fail("golden.kpi.availability", "allowed: [best, minimum], best >= minimum")
     return tuple(values)
+
+
+def _turbulence(check, raw):
+    """``golden.kpi.turbulence``: the environmental variable holding each instrument's TI
+    [%] and optional ``[best, minimum]`` bands of the TI KPIs (:mod:`uq.golden.turbulence`;
+    without a band a KPI is informational)."""
+    from .turbulence import TI_KPIS
+    key = "golden.kpi.turbulence"
+    check.mapping(raw, key)
+    check.keys(raw, key, TURBULENCE_KEYS)
+    bands = raw.get("bands") or {}
+    check.mapping(bands, f"{key}.bands")
+    check.keys(bands, f"{key}.bands", tuple(TI_KPIS))
+    out = {}
+    for name, pair in bands.items():
+        values = check.number_list(pair, f"{key}.bands.{name}", low=0.0)
+        if len(values) != 2 or values[0] > values[1]:
+            check.fail(f"{key}.bands.{name}", "allowed: [best, minimum] bounds of the "
+                       "absolute value, 0 <= best <= minimum")
+        out[name] = tuple(values)
+    return {"ti_variable": check.text(raw.get("variable", "turbulence_intensity"),
+                                      f"{key}.variable"), "ti_bands": out}
 
 
 def _synthetic(check, raw):

@@ -133,6 +133,35 @@ def plot_uncertainty_terms(ds, height, unit=None):
     return fig
 
 
+def plot_turbulence(ds, height):
+    """Mean TI per bin, reference and unit as measured and the unit as predicted by the
+    spectral path (dashed), one panel per comparison; below, the mean bias error."""
+    comparisons = ds["comparison"].values
+    fig, axes = plt.subplots(2, len(comparisons), squeeze=False, sharex=True,
+                             figsize=(4.6 * len(comparisons), 5.6), layout="constrained")
+    shown = ds.sel(height=height).isel(bin=np.flatnonzero(ds["required"].values))
+    for column, key in enumerate(comparisons):
+        c = shown.sel(comparison=key)
+        top, bottom = axes[0][column], axes[1][column]
+        top.plot(c["bin"], c["ti_reference_mean"], "o-", ms=3,
+                 label=f"{_name(c, 'reference')} (reference)")
+        top.plot(c["bin"], c["ti_unit_mean"], "s-", ms=3, label=f"{_name(c, 'unit')} measured")
+        if np.isfinite(float(c["ti_predicted_ratio"])):
+            top.plot(c["bin"], c["ti_predicted_mean"], "--", color="k",
+                     label=f"{_name(c, 'unit')} predicted by uq")
+        top.set(ylabel="mean turbulence intensity [%]")
+        top.set_title(f"{_pair(c)}, {height:g} m", fontsize=10)
+        top.legend(fontsize=7)
+        bottom.axhline(0.0, color="0.6", lw=0.8)
+        bottom.plot(c["bin"], c["ti_mean_bias"], "o-", ms=3, label="measured")
+        bottom.plot(c["bin"], c["ti_predicted_mean"] - c["ti_reference_mean"], "--",
+                    color="k", label="predicted")
+        bottom.set(xlabel="reference wind speed bin [m/s]",
+                   ylabel="TI mean bias error\nunit - reference [percentage points]")
+        bottom.legend(fontsize=7)
+    return fig
+
+
 def _stacked_terms(ax, c):
     """The terms' variances stacked (they add); the stack's top is u_cal^2."""
     bottom = np.zeros(c["bin"].size)

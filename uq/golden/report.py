@@ -52,6 +52,7 @@ def report_blocks(ds, figures, height):
                 _sensitivity_rows(ds)),
                ("h2", f"Calibration uncertainty per bin at {height:g} m (Eqs. 2-3)")]
     blocks += _calibration_tables(ds, height)
+    blocks += _turbulence_blocks(ds, height)
     blocks += [("h2", "Figures")] + [("figure", path, caption)
                                      for caption, path in figures.items()]
     return blocks
@@ -147,6 +148,43 @@ def _calibration_tables(ds, height):
             blocks += [("h3", f"{k}, {fw.upper()} [m/s]"),
                        ("table", ["bin [m/s]"] + [h for _, h in CALIBRATION_COLUMNS] + ["flag"],
                         rows)]
+    return blocks
+
+
+TI_COLUMNS = (("ti_n_records", "N"), ("ti_reference_mean", "TI ref [%]"),
+              ("ti_unit_mean", "TI unit [%]"), ("ti_predicted_mean", "TI predicted [%]"),
+              ("ti_mean_bias", "MBE [pp]"), ("ti_relative_error", "rel. error"),
+              ("ti_rmse", "RMSE [pp]"), ("ti_representative_error", "rep. TI error [pp]"))
+TI_VERDICTS = ("ti_mean_bias_verdict", "ti_relative_error_verdict", "ti_rmse_verdict",
+               "ti_representative_error_verdict")
+
+
+def _turbulence_blocks(ds, height):
+    """Per-bin TI KPIs at `height` (:mod:`uq.golden.turbulence`), when the files hold a TI."""
+    if "ti_mean_bias" not in ds:
+        return [("h2", "Turbulence intensity"),
+                ("p", "No TI: the instruments carry no TI variable (golden.kpi.turbulence."
+                 "variable), so no TI KPI is computed.")]
+    bins = np.flatnonzero(ds["required"].values)
+    blocks = [("h2", f"Turbulence intensity per bin at {height:g} m"),
+              ("p", "TI in percent; MBE = mean(unit - reference), relative error = MBE / "
+               "mean reference TI, RMSE, and the representative TI (mean + 1.28 sd) of the "
+               "unit minus the reference's (Carbon Trust OWA roadmap v3.0 metrics). "
+               "Verdicts against golden.kpi.turbulence.bands; without a band a KPI is "
+               "informational (no published numeric band). 'TI predicted' is the apparent "
+               "TI the unit's lidar reads of the reference's TI by uq's spectral path (probe "
+               "volume, beam separation, scan timing; fixed lidar, IEC Mann field), blank "
+               "when the unit names no scenario.")]
+    for k in ds["comparison"].values:
+        c = ds.sel(comparison=k, height=height).isel(bin=bins)
+        ratio = float(c["ti_predicted_ratio"])
+        rows = [[f"{b:g}"] + [_cell(c[name].values[i]) for name, _ in TI_COLUMNS]
+                + [", ".join(sorted({str(c[v].values[i]) for v in TI_VERDICTS}))]
+                for i, b in enumerate(c["bin"].values) if c["ti_n_records"].values[i] > 0]
+        note = (f"predicted u-variance ratio {ratio:.3f} (TI x {np.sqrt(ratio):.3f})"
+                if np.isfinite(ratio) else "no scenario: no prediction")
+        blocks += [("h3", f"{k}: {note}"),
+                   ("table", ["bin [m/s]"] + [h for _, h in TI_COLUMNS] + ["verdicts"], rows)]
     return blocks
 
 

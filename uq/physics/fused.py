@@ -81,6 +81,8 @@ def declined(scene, outputs, errors, scene_draws=False):
     step, which the numpy model differentiates)."""
     if scene.time_resolved is not None:
         return "a time-resolved scene"
+    if scene.tilt != 0:
+        return "a tilted mount (lidar.mount.tilt): the numpy model's clock-position beams"
     if not set(outputs) <= _OUTPUT_SET:
         return f"output(s) {', '.join(sorted(set(outputs) - _OUTPUT_SET))}"
     if scene.probe is not None and any(np.iscomplexobj(v) for v in errors.values()):
@@ -107,6 +109,8 @@ def measurement_model(scene, outputs, scene_draws=False, **errors):
 def evaluate(scene, outputs, scene_draws, errors):
     """:func:`measurement_model` where :func:`applicable`, else None (one pass over the
     arguments for both: the model is called once per slice of ~2^13 trials)."""
+    if scene.tilt != 0:             # a tilted mount: the numpy model (declined)
+        return None
     if scene.probe is not None:             # its node count (the scene itself if chosen)
         from uq.physics import probe as probe_volume
         scene = probe_volume.resolve(scene)

@@ -73,6 +73,8 @@ def declined(scene, outputs, errors, scene_draws=False):
     """Why the compiled model does not take this call, in words ('' where it does)."""
     if scene.time_resolved is None:
         return "a static scene"
+    if scene.tilt != 0:
+        return "a tilted mount (lidar.mount.tilt): the numpy model's clock-position beams"
     if not set(outputs) <= set(FUSED_OUTPUTS):
         return f"output(s) {', '.join(sorted(set(outputs) - set(FUSED_OUTPUTS)))}"
     lacked = modelinputs.lacks(MOTION_COMPILED, errors)

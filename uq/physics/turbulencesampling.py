@@ -149,8 +149,9 @@ def record_radial_velocities(box, geometry, n_scans, displacements=None, directi
 
     Returns
     -------
-    array, shape (n_scans, n_beams, n_gates)
-        Radial velocity [m s-1], positive away from the lidar, of the turbulence alone.
+    array of ``xp``, shape (n_scans, n_beams, n_gates)
+        Radial velocity [m s-1], positive away from the lidar, of the turbulence alone
+        (on the box's device: ``.get()`` a CuPy array for numpy).
     """
     nominal = np.asarray(geometry.directions)
     true_dirs = np.broadcast_to(nominal if directions is None else directions,
