@@ -372,3 +372,54 @@ MOTION_BLOCK_VALUES = 2**15
 #: ~20 us) stays below ~1 % of a block's time for any scan; at most 2^11, beyond which a
 #: larger block gains nothing (measured on a 5-beam DBS scan, scripts/bench_motion.py).
 MOTION_BLOCK_TRIALS = (64, 2**11)
+
+# --- Turbulence defaults (issue 24) ------------------------------------------------------
+# IEC 61400-1 Ed. 3 (2005), Sec. 6.3 and Annex B: the turbulence scale parameter
+# Lambda_1 = 0.7 z below 60 m above ground and 42 m above; the Mann (1994) uniform-shear
+# model with L = 0.8 Lambda_1 and Gamma = 3.9 (Annex B.2); the Kaimal spectra with the
+# longitudinal integral length L_u = 8.1 Lambda_1 (Table B.1).
+
+#: Height above which the IEC turbulence scale parameter is constant [m]. IEC 61400-1
+#: Ed. 3 (2005), Eq. 5.
+IEC_SCALE_HEIGHT = 60.0
+#: Turbulence scale parameter Lambda_1 above :data:`IEC_SCALE_HEIGHT` [m]. IEC 61400-1
+#: Ed. 3 (2005), Eq. 5.
+IEC_SCALE_PARAMETER = 42.0
+#: Lambda_1 / z below :data:`IEC_SCALE_HEIGHT` [1]. IEC 61400-1 Ed. 3 (2005), Eq. 5.
+IEC_SCALE_SLOPE = 0.7
+#: Mann's length scale over Lambda_1 [1]: L = 0.8 Lambda_1 = 33.6 m above 60 m.
+#: IEC 61400-1 Ed. 3 (2005), Annex B.2.
+MANN_LENGTH_FACTOR = 0.8
+#: Mann's shear anisotropy Gamma [1]. IEC 61400-1 Ed. 3 (2005), Annex B.2.
+MANN_ANISOTROPY = 3.9
+#: Kaimal's longitudinal integral length L_u over Lambda_1 [1]: L_u = 8.1 Lambda_1 =
+#: 340.2 m above 60 m. IEC 61400-1 Ed. 3 (2005), Annex B, Table B.1.
+KAIMAL_LENGTH_FACTOR = 8.1
+#: Largest turbulence intensity a scenario accepts [1]: sigma_u / U beyond 0.5 breaks
+#: Taylor's frozen-turbulence hypothesis (it needs sigma_u << U; Willis and Deardorff
+#: 1976, J. Atmos. Sci. 33, 1530, find it holds to sigma_u / U ~ 0.5) that both paths use.
+MAX_TURBULENCE_INTENSITY = 0.5
+#: Longest length scale a scenario accepts [m]: 10 km, beyond any atmospheric surface
+#: layer's integral length (the Kaimal L_u of IEC 61400-1 is 340 m).
+MAX_LENGTH_SCALE = 10_000.0
+#: Largest Mann anisotropy accepted [1]: fits to atmospheric data give 0-5 (Mann 1994,
+#: J. Fluid Mech. 273, 141; Peña et al. 2010, BLM 137, 173); 10 leaves a margin.
+MAX_ANISOTROPY = 10.0
+#: Longest record [s]: one hour (IEC 61400-12-1 uses 10-min records; longer ones are
+#: non-stationary and outside the frozen, homogeneous field of the model).
+MAX_RECORD_DURATION = 3600.0
+#: Most scans in one record [1]: a bound on the cost of a record before anything is
+#: allocated (2^20 scans of a 5-beam DBS is 5 x 2^20 lines of sight: 40 MB per gate and
+#: probe node in float64); a 600-s record of 1-ms beams of a 5-beam DBS has 120 000.
+MAX_RECORD_SCANS = 2**20
+#: Default number of records of a record-mode Monte Carlo run [1] (``sampling.n``
+#: counts records there): 100 records estimate the mean of the apparent TI to
+#: sigma/10 and its standard deviation to ~7 % (1 / sqrt(2 (n - 1))).
+DEFAULT_RECORDS = 100
+#: Gauss-Legendre nodes along the beam with which a probe's weighting samples the
+#: turbulent field [1]: the quadrature of the weighting's transfer function
+#: integral W(s) exp(i k s) ds with 16 nodes is within 1e-3 of the exact one for
+#: k up to 8 / (the rule's half length), where the pulsed and CW transfer functions
+#: have fallen below 5 % (tested against the closed forms in
+#: tests/pipeline/test_turbulencesection.py).
+TURBULENCE_PROBE_NODES = 16
