@@ -412,10 +412,6 @@ MAX_RECORD_DURATION = 3600.0
 #: allocated (2^20 scans of a 5-beam DBS is 5 x 2^20 lines of sight: 40 MB per gate and
 #: probe node in float64); a 600-s record of 1-ms beams of a 5-beam DBS has 120 000.
 MAX_RECORD_SCANS = 2**20
-#: Default number of records of a record-mode Monte Carlo run [1] (``sampling.n``
-#: counts records there): 100 records estimate the mean of the apparent TI to
-#: sigma/10 and its standard deviation to ~7 % (1 / sqrt(2 (n - 1))).
-DEFAULT_RECORDS = 100
 #: Gauss-Legendre nodes along the beam with which a probe's weighting samples the
 #: turbulent field [1]: the quadrature of the weighting's transfer function
 #: integral W(s) exp(i k s) ds with 32 nodes is within 1e-3 of the exact one for

@@ -25,13 +25,11 @@ def test_iec_defaults():
     assert settings["turbulence"] == {"model": "mann", "intensity": 0.1, "length_scale":
                                       pytest.approx(33.6), "anisotropy": 3.9}
     assert settings["record"] == {"duration": 600.0}
-    assert settings["sampling"]["n"] == 100            # records, DEFAULT_RECORDS
 
 
 def test_absent_sections_leave_the_settings_as_they_were():
     settings = load_scenario({}).settings
     assert "turbulence" not in settings and "record" not in settings
-    assert settings["sampling"]["n"] == 100_000
 
 
 @pytest.mark.parametrize("raw, key, allowed", [
@@ -43,7 +41,6 @@ def test_absent_sections_leave_the_settings_as_they_were():
     ({**TURBULENT, "record": {"duration": 1.0}}, "record.duration", "at least 4 s"),
     ({**TURBULENT, "record": {"duration": 3600}, "lidar": {"scan": {"beam_duration": 1e-6}}},
      "record.duration", f"at most {MAX_RECORD_SCANS} scans"),
-    ({**TURBULENT, "sampling": {"digits": 2}}, "sampling.digits", "sampling.n (records)"),
     ({"outputs": ["turbulence_intensity"]}, "outputs", "needs a turbulence section"),
 ])
 def test_bad_input_names_the_key_and_what_is_allowed(raw, key, allowed):

@@ -139,4 +139,8 @@ def skipped_work(settings, outputs, probe_kinds=()):
                       for key in probesection.unused_errors(settings, kind)]
         lines.append("probe volume: evaluated by the numpy model (the compiled model is "
                      "point-wise)")
+    if "turbulence" in settings:
+        lines.append("record mode: Monte Carlo records not computed "
+                     "(turbulence_intensity_mc_*, wind_speed_record_*): the spectral path "
+                     "only (turbulence_intensity_spectral)")
     return "; ".join(lines) or "nothing"

@@ -158,7 +158,7 @@ MEANINGS = {
     "turbulence.anisotropy": ("1", "Mann's Gamma (IEC 61400-1 Ed. 3, Annex B: 3.9)"),
     "record.duration": ("s", "length of a record, the scans that lidar.scan times in it, "
                         "reduced to a mean and standard deviation (needs turbulence; "
-                        "sampling.n then counts records, default 100)"),
+                        "default 600 with turbulence)"),
     "lidar.lever_arm": ("m", "(bow, starboard, up) from the INS to the lidar"),
     "lidar.scan.beam_duration": ("s", "dwell per line of sight; beams in the order of "
                                  "azimuths, then the vertical beam"),

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from uq.constants import (COVERAGE_PROBABILITY, DEFAULT_RECORDS, FULL_CIRCLE_DEG, MAX_BEAMS, MAX_CHUNK_SIZE,
+from uq.constants import (COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, MANN_ANISOTROPY, MAX_BEAMS, MAX_CHUNK_SIZE,
                           MAX_GATES, MAX_GROUPS, MAX_MAGNITUDE, MAX_SCENES, MAX_SEED)
 from uq.physics.correction import CORRECTION_MODELS
 from uq.physics.beams import beam_unit_vectors
@@ -230,7 +230,11 @@ def keys_without_effect(settings, sweep=None):
         found.append(("ins.rate", "has no effect without a motion section (an INS on a "
                       "platform at rest reads the same at every sample: the same model, "
                       "other random draws); allowed: add motion, or leave ins.rate out"))
-    if "scan" in lidar and not moving and not timed:
+    if "turbulence" in settings and settings["turbulence"]["model"] == "kaimal" and \
+            settings["turbulence"]["anisotropy"] != MANN_ANISOTROPY:
+        found.append(("turbulence.anisotropy", "has no effect with model kaimal (Mann's "
+                      "Gamma); allowed: model mann, or leave anisotropy out"))
+    if "scan" in lidar and not moving and not timed and "turbulence" not in settings:
         found.append(("lidar.scan", "has no effect without a motion section or an INS "
                       "error's correlation_time (the beams' times matter only where "
                       "something changes between them)"))
@@ -318,8 +322,7 @@ def _validate(raw, source, check=None):
 
 def _records(check, raw, settings):
     """``turbulence`` and ``record`` (record mode: one goes with the other; a record
-    lasts 600 s unless given); ``sampling.n`` counts records there (default
-    :data:`~uq.constants.DEFAULT_RECORDS`)."""
+    lasts 600 s unless given)."""
     if raw.get("turbulence") is None:
         check.fail("record", "a record needs a turbulent wind; allowed: add a turbulence "
                    "section (model, intensity), or leave record out")
@@ -328,12 +331,6 @@ def _records(check, raw, settings):
                                                  settings["wind"]["reference_height"])
     settings["record"] = validate_record(check, raw.get("record") or {}, len(lidar["azimuths"])
                                          + int(lidar["vertical_beam"]), lidar)
-    sampling = raw.get("sampling") or {}
-    if "digits" in sampling:
-        check.fail("sampling.digits", "record mode samples a number of records; allowed: "
-                   "sampling.n (records)")
-    if "n" not in sampling:
-        settings["sampling"]["n"] = DEFAULT_RECORDS
 
 
 def _section(check, value, key, optional=()):
