@@ -24,8 +24,9 @@ reference point over the record (the same high-pass and scan sampling), so that
 u-variance ratio (Sathe et al. 2011) where motion and errors are absent and there is no
 shear. ``turbulence_intensity_point`` is the scenario's intensity (no high-pass).
 
-Not computed here: the Monte Carlo records (``turbulence_intensity_mc_*``,
-``wind_speed_record_*``); the ``skipped`` attribute says so.
+Unless ``sampling.method`` is ``none``, ``record.count`` Monte Carlo records per scene
+give the distribution of the apparent TI and of the record mean
+(:func:`monte_carlo_variables`).
 """
 import copy
 import math
@@ -35,10 +36,41 @@ import numpy as np
 from uq.physics.lidarspectral import lidar_variances, probe_transfer_for
 from uq.physics.spectraltensor import KaimalSpectra, mann_tensor_for_intensity
 from uq.pipeline import probesection
-from uq.pipeline.turbulencesection import scan_geometry
+from uq.constants import KAIMAL_LENGTH_FACTOR as LENGTH_FACTORS_KAIMAL
+from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
 
 #: Attributes of the record-mode variables.
 RECORD_ATTRIBUTES = {
+    "turbulence_intensity_mc_mean": {
+        "units": "1", "long_name": "Monte Carlo mean over records of the apparent "
+        "turbulence intensity std(Vh) / mean(Vh) of a record"},
+    "turbulence_intensity_mc_u": {
+        "units": "1", "long_name": "Monte Carlo standard deviation over records of the "
+        "apparent turbulence intensity"},
+    "turbulence_intensity_mc_low": {
+        "units": "1", "long_name": "lower end of the 95 % interval over records of the "
+        "apparent turbulence intensity (2.5 % quantile)"},
+    "turbulence_intensity_mc_high": {
+        "units": "1", "long_name": "upper end of the 95 % interval over records of the "
+        "apparent turbulence intensity (97.5 % quantile)"},
+    "turbulence_intensity_true_mc_mean": {
+        "units": "1", "long_name": "Monte Carlo mean over records of the field's std(u) / "
+        "mean(u) at the reference point, sampled once a scan"},
+    "turbulence_intensity_spectral_z": {
+        "units": "1", "long_name": "spectral expected TI^2 minus the records' mean TI^2, "
+        "in standard errors of that mean"},
+    "turbulence_intensity_spectral_valid": {
+        "units": "1", "long_name": "spectral path validated by the Monte Carlo records "
+        "(|turbulence_intensity_spectral_z| <= 2)"},
+    "turbulence_intensity_box_kept": {
+        "units": "1", "long_name": "variance of u the turbulence box keeps of the model's "
+        "point variance"},
+    "wind_speed_record_bias": {
+        "units": "m s-1", "long_name": "Monte Carlo mean over records of the record's mean "
+        "horizontal wind speed minus the field's true mean"},
+    "wind_speed_record_u": {
+        "units": "m s-1", "long_name": "Monte Carlo standard deviation over records of the "
+        "record's mean horizontal wind speed minus the field's true mean"},
     "turbulence_intensity_true": {
         "units": "1", "long_name": "turbulence intensity sigma_u / U of the field at the "
         "reference point over a record (expected, spectral; the record's high-pass)"},
@@ -103,9 +135,10 @@ def scene_settings(scenario, fields):
     return out
 
 
-def record_variables(scenario, fields, dataset):
+def record_variables(scenario, fields, dataset, seed=0, compiled=True):
     """The record-mode variables of a chunk's scenes (dimension ``scene``, and ``range``):
-    `fields` as :func:`scene_settings`; `dataset` the chunk's per-scan results."""
+    `fields` as :func:`scene_settings`; `dataset` the chunk's per-scan results; the
+    Monte Carlo records (unless ``sampling.method`` is ``none``) from `seed`."""
     scenes = scene_settings(scenario, fields)
     n_gates = len(scenario.settings["lidar"]["ranges"])
     lidar, true = np.full((len(scenes), n_gates), np.nan), np.full(len(scenes), np.nan)
@@ -116,7 +149,7 @@ def record_variables(scenario, fields, dataset):
     speeds = np.array([s["wind"]["speed"] for s in scenes])
     truth = dataset["wind_speed_true"].values.reshape(len(scenes), n_gates)
     u_scan = _scan_uncertainty(dataset).reshape(len(scenes), n_gates)
-    return {
+    out = {
         "turbulence_intensity_true": (("scene",), np.sqrt(true) / speeds),
         "turbulence_intensity_spectral": (("scene", "range"),
                                           np.sqrt(lidar + u_scan ** 2) / truth),
@@ -124,6 +157,10 @@ def record_variables(scenario, fields, dataset):
                                                      np.sqrt(lidar) / truth),
         "turbulence_intensity_u_ratio": (("scene", "range"), lidar / true[:, None]),
     }
+    if scenario.sampling["method"] != "none":
+        out.update(monte_carlo_variables(scenes, truth, seed, compiled,
+                                         out["turbulence_intensity_spectral"][1]))
+    return out
 
 
 def _scan_uncertainty(dataset):
@@ -131,3 +168,166 @@ def _scan_uncertainty(dataset):
     where it ran, else the GUM's (``sampling.method: none``)."""
     name = "wind_speed_mc_u" if "wind_speed_mc_u" in dataset else "wind_speed_gum_u"
     return dataset[name].values
+
+
+# --- Monte Carlo records --------------------------------------------------------------------
+
+#: Largest |z| of the spectral variance against the records' mean variance for which the
+#: spectral path is taken as validated [1]: the two-sided 95 % normal quantile, 1.96 ~ 2
+#: (the records' mean variance is near normal by the central limit theorem).
+VALID_Z = 2.0
+#: Spawn key of the records' random streams (apart from the per-scan engine's blocks).
+RECORD_STREAM = 24
+#: Inputs of a time-resolved scan that record mode sets itself: the motion's phases
+#: advance coherently from scan to scan within a record.
+PHASE_INPUTS = ("motion_phases",)
+
+
+def record_generator(seed, record):
+    """The independent generator of record `record` of a run seeded with `seed`: the same
+    records for every scene (common random numbers) and whatever the chunking."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(RECORD_STREAM,
+                                                                         record)))
+
+
+def turbulence_box(settings, geometry, rng):
+    """A box of the scenario's turbulence holding every probe point of a record
+    (:func:`uq.physics.turbulencebox.box_for`), and the variance of u it keeps of the
+    model's point variance [1] (Mann: its discrete wavenumbers, ``box_variance``;
+    Kaimal: 1, its spectra are sampled, not integrated)."""
+    from uq.physics import turbulencebox
+    turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
+    model = turbulence_model(turbulence, speed)
+    if turbulence["model"] == "mann":
+        grid = turbulencebox.box_for(geometry, turbulence["length_scale"], "mann")
+        box = turbulencebox.mann_box(grid, model.alpha_epsilon, model.length_scale,
+                                     model.anisotropy, rng)
+        kept = turbulencebox.box_variance(grid, model.alpha_epsilon, model.length_scale,
+                                          model.anisotropy)[0] / (turbulence["intensity"]
+                                                                  * speed) ** 2
+        return box, float(kept)
+    scale = turbulence["length_scale"] / LENGTH_FACTORS_KAIMAL
+    grid = turbulencebox.box_for(geometry, scale, "kaimal")
+    return turbulencebox.kaimal_box(grid, turbulence["intensity"] * speed, speed, scale,
+                                    rng), 1.0
+
+
+def coherent_phases(scene, n_scans, scan_period, rng):
+    """The scene with every motion component's phase an input, and the unit phases
+    (n_scans, K, 2) that advance each component by ``w T_s`` from scan to scan: a
+    record's scans are consecutive in time. Random phases are drawn once per record
+    (uniform), fixed ones start at their value; None where the scan has no motion."""
+    import dataclasses
+    resolved = scene.time_resolved
+    if resolved is None or not resolved.motion.components:
+        return scene, None
+    components = resolved.motion.components
+    start = np.array([rng.uniform(0, 2 * np.pi) if c.phase is None else c.phase
+                      for c in components])
+    omega = np.array([c.angular_frequency for c in components])
+    phase = start + omega * scan_period * np.arange(n_scans)[:, None]     # (S, K)
+    free = tuple(dataclasses.replace(c, phase=None) for c in components)
+    motion = dataclasses.replace(resolved.motion, components=free)
+    scene = dataclasses.replace(scene, time_resolved=dataclasses.replace(resolved,
+                                                                         motion=motion))
+    return scene, np.stack([np.cos(phase), np.sin(phase)], axis=-1)
+
+
+def scan_errors(settings, scene, n_scans, rng):
+    """The declared errors of each scan of a record (n_scans trials, drawn independently
+    scan by scan from ``rng``), the motion's phases apart."""
+    from uq.engine.inputs import input_set
+    from uq.pipeline.modelsetup import error_inputs
+    inputs = {name: spec for name, spec in error_inputs(
+        settings, scene.n_beams, len(scene.ranges)).items() if name not in PHASE_INPUTS}
+    layout = input_set(inputs)
+    values = layout.values(rng.standard_normal((n_scans, layout.dimension)))
+    values.update(layout.constants)
+    return values
+
+
+def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True):
+    """One record: the per-scan horizontal speed [m s-1] at each gate (n_scans, n_gates),
+    the field's u at the reference point once a scan (n_scans,) [m s-1] (mean speed
+    included) and the u-variance fraction the box keeps [1].
+
+    The turbulence's radial velocity at the nominal probe points and beam times
+    (:func:`uq.physics.turbulencesampling.record_radial_velocities`) enters the
+    measurement model as an additive radial velocity per beam and gate, as the radial
+    noise does; the scenario's motion, INS errors and correction act as in a single
+    scan. The probe points are not moved by the platform's motion (its displacement,
+    ~1 m, is small against the eddies that carry the variance, L ~ 30 m).
+    """
+    from uq.physics import turbulencesampling
+    from uq.physics.measurement import measurement_model
+    from uq.pipeline.modelsetup import scene_from_settings
+    box, kept = turbulence_box(settings, geometry, rng)
+    radial = np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans))
+    times = turbulencesampling.scan_times(geometry, n_scans)
+    reference = np.asarray(turbulencesampling.reference_series(box, geometry.speed, times))
+    scene = probe_volume_resolved(scene_from_settings(settings))
+    scene, phases = coherent_phases(scene, n_scans, geometry.scan_period, rng)
+    errors = scan_errors(settings, scene, n_scans, rng)
+    errors["lidar_radial_velocity"] = errors.get("lidar_radial_velocity", 0.0) + radial
+    if phases is not None:
+        errors["motion_phases"] = phases
+    speed = measurement_model(scene, ("wind_speed",), compiled=compiled, **errors)["wind_speed"]
+    return np.real(speed).reshape(n_scans, -1), geometry.speed + reference[:, 0], kept
+
+
+def probe_volume_resolved(scene):
+    """The scene with its probe's node count chosen (:func:`uq.physics.probe.resolve`)."""
+    from uq.physics import probe
+    return probe.resolve(scene)
+
+
+def monte_carlo_variables(scenes, truth, seed, compiled, spectral):
+    """The Monte Carlo records of each scene (``record.count`` records, the same random
+    streams for every scene), reduced per record as a lidar's software reduces it (the
+    record's mean and sample standard deviation of Vh), then over the records.
+
+    ``turbulence_intensity_mc_*``: mean, standard deviation and 95 % interval (the 2.5 %
+    and 97.5 % quantiles, probabilistically symmetric, JCGM 101 7.7) over the records of
+    ``std(Vh) / mean(Vh)``. ``turbulence_intensity_true_mc_mean``: the mean over the records
+    of the field's ``std(u) / mean(u)`` at the reference point, sampled once a scan.
+    ``wind_speed_record_bias`` and ``_u``: mean and standard deviation over the records of
+    the record's mean Vh minus the true mean (``wind_speed_true`` at the gate plus the
+    record's mean u' at the reference point). ``turbulence_intensity_spectral_z``: the
+    spectral expected variance against the records' mean variance, in standard errors
+    of that mean (clause 8 in spirit: the spectral path is validated where |z| <= 2,
+    ``turbulence_intensity_spectral_valid``); ``turbulence_intensity_box_kept``: the
+    u-variance the box keeps of the model's (where the two paths part by design).
+    """
+    records = [scene["record"] for scene in scenes]
+    count = records[0]["count"]
+    n_gates = truth.shape[1]
+    apparent = np.full((len(scenes), count, n_gates), np.nan)
+    true_ti = np.full((len(scenes), count), np.nan)
+    error = np.full((len(scenes), count, n_gates), np.nan)
+    kept = np.full(len(scenes), np.nan)
+    for i, settings in enumerate(scenes):
+        if not settings["wind"]["speed"] > 0:
+            continue
+        geometry = scan_geometry(settings)
+        n_scans = scans_per_record(settings)
+        for r in range(count):
+            vh, reference, kept[i] = monte_carlo_record(settings, geometry, n_scans,
+                                                        record_generator(seed, r), compiled)
+            apparent[i, r] = vh.std(axis=0, ddof=1) / vh.mean(axis=0)
+            true_ti[i, r] = reference.std(ddof=1) / reference.mean()
+            error[i, r] = vh.mean(axis=0) - truth[i] - (reference.mean() - settings["wind"]["speed"])
+    squares = apparent ** 2
+    z = (spectral ** 2 - squares.mean(axis=1)) / (squares.std(axis=1, ddof=1) / np.sqrt(count))
+    low, high = np.quantile(apparent, [0.025, 0.975], axis=1)
+    return {
+        "turbulence_intensity_mc_mean": (("scene", "range"), apparent.mean(axis=1)),
+        "turbulence_intensity_mc_u": (("scene", "range"), apparent.std(axis=1, ddof=1)),
+        "turbulence_intensity_mc_low": (("scene", "range"), low),
+        "turbulence_intensity_mc_high": (("scene", "range"), high),
+        "turbulence_intensity_true_mc_mean": (("scene",), true_ti.mean(axis=1)),
+        "turbulence_intensity_spectral_z": (("scene", "range"), z),
+        "turbulence_intensity_spectral_valid": (("scene", "range"), np.abs(z) <= VALID_Z),
+        "turbulence_intensity_box_kept": (("scene",), kept),
+        "wind_speed_record_bias": (("scene", "range"), error.mean(axis=1)),
+        "wind_speed_record_u": (("scene", "range"), error.std(axis=1, ddof=1)),
+    }

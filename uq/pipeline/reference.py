@@ -49,7 +49,7 @@ EXEMPLAR_OPTIONAL = {
     "sampling": {"chunk_size": 65536, "seed": 1},
     "turbulence": {"model": "mann", "intensity": 0.1, "length_scale": 33.6,
                    "anisotropy": 3.9},
-    "record": {"duration": 600.0},
+    "record": {"duration": 600.0, "count": 20},
     "fit": {"priors": {"shear": {"dist": "uniform", "low": -0.5, "high": 1.0},
                        "reference_speed": {"dist": "normal", "mean": 9.0, "u": 2.0}},
             "columns": {"height": "height", "speed": "speed", "speed_u": "speed_u",
@@ -156,6 +156,8 @@ MEANINGS = {
                                 "(default 8.1 Lambda_1); Lambda_1 = 0.7 z below 60 m, 42 m "
                                 "above (IEC 61400-1 Ed. 3, Annex B)"),
     "turbulence.anisotropy": ("1", "Mann's Gamma (IEC 61400-1 Ed. 3, Annex B: 3.9)"),
+    "record.count": ("1", "Monte Carlo records per scene (each a turbulence box; not with "
+                     "sampling.method none, the spectral path alone)"),
     "record.duration": ("s", "length of a record, the scans that lidar.scan times in it, "
                         "reduced to a mean and standard deviation (needs turbulence; "
                         "default 600 with turbulence)"),

@@ -119,7 +119,7 @@ def run_chunk(scenario, plan, chunk, seed, compiled=True):
     if "turbulence" in scenario.settings and "wind_speed_true" in dataset:
         # record mode: the spectral path per scene
         dataset = dataset.assign(records.record_variables(
-            scenario, records.chunk_fields(scenario, plan, chunk), dataset))
+            scenario, records.chunk_fields(scenario, plan, chunk), dataset, seed, compiled))
     return dataset
 
 

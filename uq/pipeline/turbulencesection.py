@@ -13,7 +13,8 @@ settings unless given).
       length_scale: 33.6         # m: Mann's L (default 0.8 Lambda_1), Kaimal's L_u
                                  # (default 8.1 Lambda_1); IEC 61400-1 Ed. 3, Annex B
       anisotropy: 3.9            # Mann's Gamma (default 3.9, IEC 61400-1 Ed. 3, Annex B)
-    record: {duration: 600}      # s: a record is the scans lidar.scan times in that long
+    record: {duration: 600, count: 20}   # s: a record is the scans lidar.scan times in
+                                 # that long; count: Monte Carlo records per scene
 
 Defaults (:mod:`uq.constants`, block "Turbulence defaults (issue 24)"): the length scale
 follows IEC 61400-1 Ed. 3 from the reference height z through the turbulence scale
@@ -34,7 +35,8 @@ import numpy as np
 from uq.constants import (IEC_SCALE_HEIGHT, IEC_SCALE_PARAMETER, IEC_SCALE_SLOPE,
                           KAIMAL_LENGTH_FACTOR, MANN_ANISOTROPY, MANN_LENGTH_FACTOR,
                           MAX_ANISOTROPY, MAX_LENGTH_SCALE, MAX_RECORD_DURATION,
-                          MAX_RECORD_SCANS, MAX_TURBULENCE_INTENSITY, TURBULENCE_PROBE_NODES)
+                          MAX_RECORD_SCANS, MAX_RECORDS, MAX_TURBULENCE_INTENSITY,
+                          DEFAULT_RECORDS, TURBULENCE_PROBE_NODES)
 from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
 from uq.physics.probe import legendre
 from uq.physics.rotation import attitude_matrix, rotate_vectors
@@ -45,7 +47,7 @@ from uq.pipeline.motionsection import SCAN_DEFAULTS
 #: Turbulence models (``turbulence.model``).
 TURBULENCE_MODELS = ("mann", "kaimal")
 TURBULENCE_KEYS = ("model", "intensity", "length_scale", "anisotropy")
-RECORD_KEYS = ("duration",)
+RECORD_KEYS = ("duration", "count")
 #: IEC 61400-1's length scale of each model per Lambda_1 [1] (:mod:`uq.constants`).
 LENGTH_FACTORS = {"mann": MANN_LENGTH_FACTOR, "kaimal": KAIMAL_LENGTH_FACTOR}
 
@@ -103,7 +105,9 @@ def validate_record(check, value, n_beams, lidar):
         check.fail("record.duration", f"{duration:g} s holds {scans} scans of {period:g} s; "
                    f"allowed: at most {MAX_RECORD_SCANS} scans (a shorter record or longer "
                    "lidar.scan.beam_duration)")
-    return {"duration": duration}
+    count = check.integer(value.get("count", DEFAULT_RECORDS), "record.count", low=2,
+                          high=MAX_RECORDS)
+    return {"duration": duration, "count": count}
 
 
 def beam_duration(lidar):
