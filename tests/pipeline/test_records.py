@@ -60,3 +60,63 @@ def test_scan_errors_add_in_quadrature():
     noise = sigma_r ** 2 / (2 * math.sin(math.radians(cone)) ** 2) / WIND["speed"] ** 2
     expected = np.sqrt(ds["turbulence_intensity_spectral_turbulence"] ** 2 + noise)
     np.testing.assert_allclose(ds["turbulence_intensity_spectral"], expected, rtol=1e-12)
+
+
+def surge_scenario(correction, phase):
+    # a nearly still atmosphere (I = 1e-4: u-variance 1e-6 m2 s-2 against the surge's
+    # 0.1) with a long length scale (a coarse, cheap box); a level 4-beam DBS, the wind
+    # from the south along the beams at azimuths 0 and 180 (the bow, heading 0)
+    return {"wind": {"speed": 10.0, "direction": 180.0, "reference_height": 100.0},
+            "lidar": {"height": 0.0, "ranges": [100.0], "half_cone": 30.0,
+                      "scan": {"beam_duration": 1.0}},
+            "motion": {"surge": {"amplitude": 0.5, "period": 7.0, "phase": phase}},
+            "correction": correction,
+            "turbulence": {"intensity": 1e-4, "length_scale": 400.0},
+            "record": {"duration": 600, "count": 2},
+            "sampling": {"n": 64, "seed": 5}, "outputs": ["wind_speed", "turbulence_intensity"]}
+
+
+def test_harmonic_surge_advances_coherently_from_scan_to_scan():
+    # The DBS u = (v_1 - v_3) / (2 sin theta) of a surge a sin(w t + phi) uncorrected
+    # errs by the platform velocity seen by beams 1 and 3, 2 s apart: record variance
+    # (a w cos(w dt / 2))^2 / 2 (lidarspectral Eq. 7, derived there) for a long record.
+    # A fixed phase gives it only if the phase advances by w T_s from scan to scan (the
+    # same phase in every scan would give 0). 150 scans: the record's own mean removes
+    # |D_N|^2 < 1e-3 of it; s^2 with ddof 1 is N / (N - 1) = 1.0067 times the 1/N one;
+    # 2 % covers both and the turbulence's 1e-5.
+    from uq.physics.lidarspectral import dbs_surge_variance
+    ds = run(surge_scenario("none", 0.0))
+    variance = float(ds["turbulence_intensity_mc_mean"]) ** 2 * 10.0 ** 2
+    assert variance == pytest.approx(dbs_surge_variance(0.5, 7.0, 2.0), rel=0.02)
+    # the same at a random phase per record; the correction removes the surge
+    random = run(surge_scenario("none", "random"))
+    assert float(random["turbulence_intensity_mc_mean"]) == pytest.approx(
+        float(ds["turbulence_intensity_mc_mean"]), rel=0.02)
+    corrected = run(surge_scenario("pointwise", 0.0))
+    assert float(corrected["turbulence_intensity_mc_mean"]) < 0.01 * float(
+        ds["turbulence_intensity_mc_mean"])
+
+
+def test_spectral_and_monte_carlo_agree_on_a_fixed_dbs():
+    # a fixed 5-beam DBS with a pulsed probe, Mann field; 12 records of 60 s. The
+    # spectral TI^2 against the records' mean TI^2: within 3 standard errors of that
+    # mean plus what the box leaves out of the variance (1 - box_kept, a bound on the
+    # box's deficit: it removes that share of the point variance, less of the lidar's,
+    # which filters the small scales the box also misses)
+    ds = run({"wind": {"speed": 10.0, "direction": 180.0, "reference_height": 100.0},
+              "lidar": {"height": 0.0, "ranges": [100.0], "half_cone": 30.0,
+                        "vertical_beam": True, "scan": {"beam_duration": 0.5},
+                        "probe": {"kind": "pulsed", "gate_length": 18.75,
+                                  "pulse_fwhm": 24.75}},
+              "turbulence": {"intensity": 0.1}, "record": {"duration": 60, "count": 12},
+              "sampling": {"n": 64, "seed": 11}, "outputs": ["turbulence_intensity"]})
+    spectral = float(ds["turbulence_intensity_spectral"]) ** 2
+    z = float(ds["turbulence_intensity_spectral_z"])
+    deficit = (1 - float(ds["turbulence_intensity_box_kept"])) * spectral
+    # the standard error of the records' mean TI^2 by the delta method, 2 TI u(TI) / sqrt(n)
+    standard_error = 2 * float(ds["turbulence_intensity_mc_mean"] * ds[
+        "turbulence_intensity_mc_u"]) / np.sqrt(12)
+    assert abs(z) <= 3 + deficit / standard_error
+    assert float(ds["turbulence_intensity_mc_low"]) < float(ds["turbulence_intensity_mc_mean"]) \
+        < float(ds["turbulence_intensity_mc_high"])
+    assert ds["wind_speed_record_u"].attrs["units"] == "m s-1"
