@@ -246,10 +246,11 @@ def scan_errors(settings, scene, n_scans, rng):
     return values
 
 
-def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True):
+def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True, radial=False):
     """One record: the per-scan horizontal speed [m s-1] at each gate (n_scans, n_gates),
     the field's u at the reference point once a scan (n_scans,) [m s-1] (mean speed
-    included) and the u-variance fraction the box keeps [1].
+    included) and the u-variance fraction the box keeps [1]; with `radial` also the
+    corrected radial velocities (n_scans, n_beams, n_gates) [m s-1] (a fourth item).
 
     The turbulence's radial velocity at the nominal probe points and beam times
     (:func:`uq.physics.turbulencesampling.record_radial_velocities`) enters the
@@ -262,17 +263,23 @@ def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True):
     from uq.physics.measurement import measurement_model
     from uq.pipeline.modelsetup import scene_from_settings
     box, kept = turbulence_box(settings, geometry, rng)
-    radial = np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans))
+    seen = np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans))
     times = turbulencesampling.scan_times(geometry, n_scans)
     reference = np.asarray(turbulencesampling.reference_series(box, geometry.speed, times))
+    del box
     scene = probe_volume_resolved(scene_from_settings(settings))
     scene, phases = coherent_phases(scene, n_scans, geometry.scan_period, rng)
     errors = scan_errors(settings, scene, n_scans, rng)
-    errors["lidar_radial_velocity"] = errors.get("lidar_radial_velocity", 0.0) + radial
+    errors["lidar_radial_velocity"] = errors.get("lidar_radial_velocity", 0.0) + seen
     if phases is not None:
         errors["motion_phases"] = phases
-    speed = measurement_model(scene, ("wind_speed",), compiled=compiled, **errors)["wind_speed"]
-    return np.real(speed).reshape(n_scans, -1), geometry.speed + reference[:, 0], kept
+    outputs = ("wind_speed", "radial_velocity") if radial else ("wind_speed",)
+    result = measurement_model(scene, outputs, compiled=compiled, **errors)
+    speed = np.real(result["wind_speed"]).reshape(n_scans, -1)
+    found = (speed, geometry.speed + reference[:, 0], kept)
+    if radial:
+        found += (np.real(result["radial_velocity"]).reshape(n_scans, scene.n_beams, -1),)
+    return found
 
 
 def probe_volume_resolved(scene):
