@@ -71,7 +71,10 @@ def record_series(settings, seed=0, records=SPECTRUM_RECORDS):
     [s], {name: (records, n_scans) Vh or u}, {name: (records, n_scans) radial})."""
     geometry = scan_geometry(settings)
     n_scans = scans_per_record(settings)
-    variants = {"lidar, fixed": _variant(settings, motion=None, correction="full")}
+    still = copy.deepcopy(settings["ins"])
+    for key in ("rate", "interpolation", "clock_offset"):      # (nothing to sample at rest)
+        still.pop(key, None)
+    variants = {"lidar, fixed": _variant(settings, motion=None, correction="full", ins=still)}
     if settings.get("motion"):
         for correction in dict.fromkeys(("none", settings["correction"])):
             variants[f"lidar, moving, correction {correction}"] = _variant(
@@ -192,9 +195,7 @@ def error_contributions(dataset, settings):
     docstring), from the result's GUM budget of the file's scene."""
     if "wind_speed_budget" not in dataset:
         return [], []
-    budget = dataset["wind_speed_budget"]
-    for dim in [d for d in budget.dims if d not in ("input", "range")]:
-        budget = budget.isel({dim: 0})
+    budget = file_scene(dataset["wind_speed_budget"], settings)
     groups = {}
     for name in budget["input"].values:
         label = next((bar for prefix, bar in ERROR_GROUPS if str(name).startswith(prefix)),
@@ -204,6 +205,24 @@ def error_contributions(dataset, settings):
     names = [bar for _, bar in ERROR_GROUPS if bar in groups] + \
         (["other"] if "other" in groups else [])
     return names, [groups[n] for n in names]
+
+
+def file_scene(variable, settings):
+    """`variable` at the scene of the file's values of the swept keys (the nearest swept
+    value; the first where the key is not a number)."""
+    for dim in [d for d in variable.dims if d not in ("input", "range", "beam")]:
+        node = settings
+        for part in dim.split("_", 1):
+            node = node.get(part, {}) if isinstance(node, dict) else {}
+        value = node if not isinstance(node, dict) else settings.get(dim)
+        coordinate = variable[dim].values
+        if isinstance(value, (int, float)) and coordinate.dtype.kind in "iuf":
+            variable = variable.isel({dim: int(np.argmin(np.abs(coordinate - value)))})
+        elif value in list(coordinate):
+            variable = variable.isel({dim: list(coordinate).index(value)})
+        else:
+            variable = variable.isel({dim: 0})
+    return variable
 
 
 def ti_budget(dataset):
@@ -224,8 +243,8 @@ def ti_budget(dataset):
     ax.set_yticks(np.arange(len(names)), names, fontsize=8)
     ax.invert_yaxis()
     ax.set_xlabel("contribution to the record variance of Vh [m$^2$ s$^{-2}$]")
-    ax.set_title("variance budget of the apparent TI (spectral path; bars add up to the "
-                 "total)", fontsize=9)
+    ax.set_title(f"variance budget of the apparent TI, correction {settings['correction']} "
+                 "(spectral path and the GUM of a scan; bars add up to the total)", fontsize=9)
     ax.grid(alpha=0.3, axis="x")
     ax.legend(fontsize=7, loc="lower right")
     return figure
