@@ -200,7 +200,7 @@ def cut_lorentzian_transfer(kappa, rayleigh, half_length, nodes=1024):
     :mod:`uq.physics.probe`): with ``s = z_R tan(theta)``, ``What = (1 / 2a) int_{-a}^{a}
     cos(kappa z_R tan theta) d theta``, ``a = atan(L / z_R)`` (Gauss-Legendre in theta;
     tested against :func:`lorentzian_transfer` as the cut goes to infinity)."""
-    x, w = np.polynomial.legendre.leggauss(nodes)
+    x, w = special.roots_legendre(nodes)       # Newton iteration: O(n), unlike leggauss
     a = np.arctan(half_length / rayleigh)
     s = rayleigh * np.tan(a * x)
     return np.cos(np.multiply.outer(np.asarray(kappa, dtype=float), s)) @ (w / 2.0)
@@ -266,45 +266,61 @@ def mann_lidar_variances(geometry, tensor, probe_transfer=None, grid=None):
     directions = np.asarray(geometry.directions, dtype=float)               # (B, 3)
     centres = np.asarray(geometry.gate_centres, dtype=float)                # (B, G, 3)
     times = np.asarray(geometry.times, dtype=float)
-    # M[g, c, b, j] = R_gcb n_bj: the reconstruction of each component from the beams
-    weights = np.einsum("gcb,bj->gcbj", np.asarray(geometry.reconstruction, float), directions)
+    reconstruction = np.asarray(geometry.reconstruction, dtype=float)       # (G, 3, B)
     k1_all, w1_all = grid.k1()
     speed = geometry.speed
     highpass = record_filter(k1_all * speed / (2 * np.pi), geometry.scan_period,
                              geometry.record_duration)
-    lidar = np.zeros((geometry.n_gates, 3))
+    pairs = np.zeros((geometry.n_gates, geometry.n_beams, geometry.n_beams))
     true = np.zeros(3)
     for start in range(0, len(k1_all), _K1_CHUNK):
         k1 = k1_all[start:start + _K1_CHUNK]
         k2, k3, w23 = grid.cross_section(k1)
         k1b = np.broadcast_to(k1[:, None], k2.shape)
-        weight = w23 * (w1_all[start:start + _K1_CHUNK] * highpass[start:start + _K1_CHUNK])[:, None]
-        factor, k0, zetas = tensor.distortion(k1b, k2, k3)
-        true += [np.sum(weight * _form(np.eye(3)[c], factor, k0, zetas)) for c in range(3)]
-        kvec = np.stack([k1b, k2, k3], axis=-1)                              # (n, q, 3)
-        kappa = kvec @ directions.T                                          # (n, q, B)
-        dwell = np.sinc(k1b * speed * geometry.dwell / (2 * np.pi))          # (n, q)
-        probe = transfer(kappa)                                              # (G, n, q, B)
+        weight = (w23 * (w1_all * highpass)[start:start + _K1_CHUNK, None]).ravel()
+        distortion = [np.ravel(v) for v in _flatten(tensor.distortion(k1b, k2, k3))]
+        true += weight @ _projected(np.eye(3), np.eye(3), distortion)
+        beam_pairs = weight[:, None, None] * _projected(directions, directions, distortion,
+                                                        pairs=True)          # (P, B, B)
+        kvec = np.stack([k1b.ravel(), k2.ravel(), k3.ravel()], axis=-1)  # (P, 3)
+        dwell = np.sinc(kvec[:, 0] * speed * geometry.dwell / (2 * np.pi))
+        probe = transfer(kvec @ directions.T) * dwell[:, None]            # (G, P, B)
+        delay = np.outer(kvec[:, 0] * speed, times)                      # (P, B)
         for g in range(geometry.n_gates):
-            phase = np.exp(1j * (np.einsum("nqj,bj->nqb", kvec, centres[:, g])
-                                 - k1b[..., None] * speed * times))
-            beams = probe[g] * phase * dwell[..., None]                      # (n, q, B)
-            vectors = np.einsum("nqb,cbj->nqcj", beams, weights[g])
-            for c in range(3):
-                lidar[g, c] += np.sum(weight * _form(vectors[..., c, :], factor, k0, zetas))
+            angle = kvec @ centres[:, g].T - delay
+            real, imaginary = probe[g] * np.cos(angle), probe[g] * np.sin(angle)
+            # Re(T_b T_d*) = X_b X_d + Y_b Y_d, Eq. (1)
+            pairs[g] += (np.einsum("pbd,pb,pd->bd", beam_pairs, real, real)
+                         + np.einsum("pbd,pb,pd->bd", beam_pairs, imaginary, imaginary))
+    # Eq. (2)-(3): var_c = sum_bd R_gcb R_gcd <(n_b . dZ T_b)(n_d . dZ T_d)*>
+    lidar = np.einsum("gcb,gbd,gcd->gc", reconstruction, pairs, reconstruction)
     return SpectralVariances(lidar, true)
 
 
-def _form(vectors, factor, k0, zetas):
-    """``g Phi g^H`` from the tensor's distortion (MannTensor.quadratic_form, unpacked)."""
-    zeta1, zeta2, ratio = zetas
-    g = np.asarray(vectors)
-    g0, g1, g2 = (np.broadcast_to(g[..., j], factor.shape) for j in range(3))
-    q2 = zeta1 * g0 + zeta2 * g1 + ratio * g2
-    k0sq = k0[0] ** 2 + k0[1] ** 2 + k0[2] ** 2
-    norm = np.abs(g0) ** 2 + np.abs(g1) ** 2 + np.abs(q2) ** 2
-    along = np.abs(g0 * k0[0] + g1 * k0[1] + q2 * k0[2]) ** 2
-    return factor * (k0sq * norm - along)
+def _flatten(distortion):
+    """(factor, k0 components, zetas) of MannTensor.distortion as a flat list of arrays."""
+    factor, k0, zetas = distortion
+    return [factor, *k0, *zetas]
+
+
+def _projected(left, right, distortion, pairs=False):
+    """``l Phi(k) r^T`` for rows of `left` and `right` (each (B, 3)) at every point: the
+    diagonal (P, B) or, with `pairs`, every pair (P, B, B) [m5 s-2]. With ``m = n A``,
+    ``n Phi n'^T = E(k0)/(4 pi k0^4) (k0^2 m . m' - (m . k0)(m' . k0))`` (Eq. 2 of
+    :mod:`uq.physics.spectraltensor`)."""
+    factor, k01, k02, k03, zeta1, zeta2, ratio = distortion
+
+    def rows(n):
+        third = zeta1[:, None] * n[:, 0] + zeta2[:, None] * n[:, 1] + ratio[:, None] * n[:, 2]
+        m = np.stack([np.broadcast_to(n[:, 0], third.shape),
+                      np.broadcast_to(n[:, 1], third.shape), third], axis=-1)  # (P, B, 3)
+        return m, m[..., 0] * k01[:, None] + m[..., 1] * k02[:, None] + m[..., 2] * k03[:, None]
+    (ml, al), (mr, ar) = rows(np.asarray(left, float)), rows(np.asarray(right, float))
+    k0sq = (k01 ** 2 + k02 ** 2 + k03 ** 2)
+    if pairs:
+        dot = np.einsum("pbj,pdj->pbd", ml, mr)
+        return factor[:, None, None] * (k0sq[:, None, None] * dot - al[:, :, None] * ar[:, None, :])
+    return factor[:, None] * (k0sq[:, None] * np.sum(ml * mr, axis=-1) - al * ar)
 
 
 # --- the Kaimal path -------------------------------------------------------------------------
