@@ -24,7 +24,7 @@ def test_iec_defaults():
     settings = load_scenario(TURBULENT).settings
     assert settings["turbulence"] == {"model": "mann", "intensity": 0.1, "length_scale":
                                       pytest.approx(33.6), "anisotropy": 3.9}
-    assert settings["record"] == {"duration": 600.0}
+    assert settings["record"] == {"duration": 600.0, "count": 20}
 
 
 def test_absent_sections_leave_the_settings_as_they_were():
@@ -42,6 +42,7 @@ def test_absent_sections_leave_the_settings_as_they_were():
     ({**TURBULENT, "record": {"duration": 3600}, "lidar": {"scan": {"beam_duration": 1e-6}}},
      "record.duration", f"at most {MAX_RECORD_SCANS} scans"),
     ({"outputs": ["turbulence_intensity"]}, "outputs", "needs a turbulence section"),
+    ({**TURBULENT, "record": {"count": 1}}, "record.count", "[2, 10000]"),
 ])
 def test_bad_input_names_the_key_and_what_is_allowed(raw, key, allowed):
     with pytest.raises(ScenarioError) as error:
