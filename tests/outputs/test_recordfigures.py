@@ -53,3 +53,19 @@ def test_record_plan_only_in_record_mode():
     assert [name for name, _ in recordfigures.record_plan(record)] == [
         "record_spectra", "ti_budget", "apparent_against_true_ti"]
     assert "record_plan" in dir(figures.recordfigures)
+
+
+def test_summary_reports_record_mode():
+    from uq.outputs.summary import summary_table
+    ds = xr.Dataset({
+        "turbulence_intensity_true": ((), 0.095),
+        "turbulence_intensity_spectral": (("range",), [0.0886, 0.0857]),
+        "turbulence_intensity_mc_mean": (("range",), [0.0873, 0.0835]),
+        "turbulence_intensity_mc_low": (("range",), [0.0807, 0.0754]),
+        "turbulence_intensity_mc_high": (("range",), [0.1, 0.0944]),
+        "turbulence_intensity_spectral_valid": (("range",), [True, False])},
+        coords={"range": [40.0, 100.0]})
+    lines = summary_table(ds).splitlines()
+    assert "turbulence intensity over a record [%]: true 9.5" in lines
+    assert "  apparent @100 m: spectral 8.57, Monte Carlo 8.35 (95 % of records 7.54 to " \
+           "9.44); spectral validated 0/1" in lines
