@@ -421,17 +421,18 @@ DEFAULT_RECORDS = 20
 MAX_RECORDS = 10_000
 #: Gauss-Legendre nodes along the beam with which a probe's weighting samples the
 #: turbulent field [1]: the quadrature of the weighting's transfer function
-#: integral W(s) exp(i k s) ds with 32 nodes is within 1e-3 of the exact one for
-#: k h <= 39 (h the rule's half length; k <= 0.5 rad m-1, wavelengths >= 12 m, for a
-#: pulsed gate of 18.75 m and pulse of 24.75 m, where the transfer function has fallen
-#: to 2e-7; 16 nodes reach only k h = 8.7); for a CW Lorentzian cut at 2 % (h = 7 z_R)
-#: the "tan" rule holds for k h <= 20 (k z_R <= 2.9, transfer function 0.07). Beyond it the rule aliases: a field sampled
-#: with it must carry no wavenumbers above that (a box's grid spacing >= pi h / 39).
-#: Measured against the closed forms in tests/pipeline/test_turbulencesection.py.
-TURBULENCE_PROBE_NODES = 32
+#: integral W(s) exp(i k s) ds with 48 nodes is within 1e-3 of the exact one for
+#: k h <= 70 (h the rule's half length: k <= 0.9 rad m-1 for a pulsed gate of 18.75 m and
+#: pulse of 24.75 m, h = 77 m, beyond the Nyquist wavenumber pi / (L / 8) = 0.75 rad m-1
+#: of a box of the IEC L = 33.6 m; 32 nodes reach only k h = 39, 0.5 rad m-1, and their
+#: response between 0.5 and 0.75 rad m-1 aliases up to 0.5); for a CW Lorentzian cut at
+#: 2 % (h = 7 z_R) the "tan" rule holds for k h <= 50. Beyond its reach a rule aliases:
+#: a field sampled with it must carry no wavenumbers above that. Measured against the
+#: closed forms in tests/pipeline/test_turbulencesection.py.
+TURBULENCE_PROBE_NODES = 48
 #: k h up to which the :data:`TURBULENCE_PROBE_NODES`-node rule holds to 1e-3 [1],
 #: per probe kind (measured, see above).
-TURBULENCE_PROBE_REACH = {"pulsed": 39.0, "cw": 20.0}
+TURBULENCE_PROBE_REACH = {"pulsed": 70.0, "cw": 50.0}
 # --- Turbulence (issue 24) ------------------------------------------------------------
 
 #: Mann (1994) uniform-shear spectral tensor, the IEC 61400-1:2005 Annex B (B.2)

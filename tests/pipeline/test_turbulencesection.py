@@ -125,12 +125,13 @@ def test_pulsed_quadrature_transfer_function():
     # 1e-3: the claim of TURBULENCE_PROBE_NODES, plus the tail mass the cut removes
     assert np.max(np.abs(quadrature - pulsed_transfer(k, 18.75, 24.75))) < 1e-3 + PULSE_TAIL_MASS
     assert abs(pulsed_transfer(TURBULENCE_PROBE_REACH['pulsed'] / half, 18.75, 24.75)) < 1e-6
+    assert TURBULENCE_PROBE_REACH['pulsed'] / half > math.pi / (33.6 / 8)   # a box's Nyquist
 
 
 def test_cw_quadrature_per_gate():
     # a CW focus at 50 and 150 m: the Rayleigh lengths (~ F^2) differ, so the gates get
-    # their own nodes side by side; each against a 4001-point rule of the truncated
-    # Lorentzian (an independent quadrature: trapezoid in s)
+    # their own nodes side by side; each against a 40001-point rule of the truncated
+    # Lorentzian (an independent quadrature: trapezoid in s, 40001 points)
     probe = {"kind": "cw", "wavelength": 1.565, "beam_radius": 28.0, "truncation": 0.02}
     focus = np.array([50.0, 150.0])
     offsets, weights = probe_quadrature(probe, focus)
@@ -140,10 +141,10 @@ def test_cw_quadrature_per_gate():
     for gate, f in enumerate(focus):
         z_r = 1.565e-6 * f**2 / (math.pi * 0.028**2)
         half = min(z_r * math.sqrt(1 / 0.02 - 1), f)
-        s = np.linspace(-half, half, 4001)
+        s = np.linspace(-half, half, 40001)
         density = 1 / (1 + (s / z_r) ** 2)
         for k in np.linspace(0, TURBULENCE_PROBE_REACH['cw'] / half, 9):
             exact = np.trapezoid(density * np.cos(k * s), s) / np.trapezoid(density, s)
             # 1e-3: the claim of TURBULENCE_PROBE_NODES (the trapezoid's own error
-            # at 4001 points is ~1e-7 here)
+            # at 40001 points is below 1e-6 here)
             assert weights[gate] @ np.cos(k * offsets) == pytest.approx(exact, abs=1e-3)
