@@ -120,3 +120,21 @@ def test_spectral_and_monte_carlo_agree_on_a_fixed_dbs():
     assert float(ds["turbulence_intensity_mc_low"]) < float(ds["turbulence_intensity_mc_mean"]) \
         < float(ds["turbulence_intensity_mc_high"])
     assert ds["wind_speed_record_u"].attrs["units"] == "m s-1"
+
+
+def test_sweeps_of_scene_values_and_of_the_intensity():
+    # the spectral variance is alpha eps^(2/3) times the filter's integral, and alpha
+    # eps^(2/3) goes as the intensity squared: the TIs scale with the intensity exactly;
+    # a swept direction (a scene value: the scenes of one chunk) gives each scene its
+    # own geometry: the wind along a beam pair (0) and between the pairs (45) differ
+    ds = run(scenario({"height": 0.0, "ranges": [100.0], "half_cone": 30.0},
+                      sweep={"turbulence.intensity": [0.05, 0.1],
+                             "wind.direction": [0.0, 45.0, 90.0]}))
+    ti = ds["turbulence_intensity_spectral"]
+    assert ti.dims == ("turbulence_intensity", "wind_direction")
+    np.testing.assert_allclose(ti.isel(turbulence_intensity=0), ti.isel(
+        turbulence_intensity=1) / 2, rtol=1e-12)
+    np.testing.assert_allclose(ti.sel(wind_direction=0.0), ti.sel(wind_direction=90.0),
+                               rtol=1e-6)          # the 4-beam DBS's symmetry
+    assert abs(float(ti.isel(turbulence_intensity=1).sel(wind_direction=45.0)
+                     / ti.isel(turbulence_intensity=1).sel(wind_direction=0.0)) - 1) > 1e-3
