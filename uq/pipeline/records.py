@@ -64,7 +64,7 @@ RECORD_ATTRIBUTES = {
         "(|turbulence_intensity_spectral_z| <= 2)"},
     "turbulence_intensity_box_kept": {
         "units": "1", "long_name": "variance of u the turbulence box keeps of the model's "
-        "point variance"},
+        "point variance (Mann; NaN for Kaimal: not computed)"},
     "wind_speed_record_bias": {
         "units": "m s-1", "long_name": "Monte Carlo mean over records of the record's mean "
         "horizontal wind speed minus the field's true mean"},
@@ -194,7 +194,8 @@ def turbulence_box(settings, geometry, rng):
     """A box of the scenario's turbulence holding every probe point of a record
     (:func:`uq.physics.turbulencebox.box_for`), and the variance of u it keeps of the
     model's point variance [1] (Mann: its discrete wavenumbers, ``box_variance``;
-    Kaimal: 1, its spectra are sampled, not integrated)."""
+    Kaimal: NaN, not computed: its box misses the frequencies below 1 / (its length /
+    U), which a record's high-pass partly keeps)."""
     from uq.physics import turbulencebox
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
     model = turbulence_model(turbulence, speed)
@@ -209,7 +210,7 @@ def turbulence_box(settings, geometry, rng):
     scale = turbulence["length_scale"] / LENGTH_FACTORS_KAIMAL
     grid = turbulencebox.box_for(geometry, scale, "kaimal")
     return turbulencebox.kaimal_box(grid, turbulence["intensity"] * speed, speed, scale,
-                                    rng), 1.0
+                                    rng), np.nan
 
 
 def coherent_phases(scene, n_scans, scan_period, rng):
