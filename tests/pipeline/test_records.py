@@ -36,7 +36,7 @@ def test_a_lidar_shrunk_to_a_point_sees_the_true_variance():
 
 
 def test_probe_volume_lowers_the_apparent_variance():
-    # Sathe et al. (2011), Fig. 6: a pulsed DBS at 100 m sees 5-45 % less u-variance
+    # Sathe et al. (2011), as issue 24 cites them: a lidar sees 5-45 % less u-variance
     # than a point; the point-probe DBS is above 1 (w leaks into u through cot(theta))
     point = run(scenario({"height": 0.0, "ranges": [100.0], "half_cone": 30.0,
                           "vertical_beam": True}))
