@@ -376,6 +376,66 @@ MOTION_BLOCK_VALUES = 2**16
 #: larger block gains nothing (measured on a 5-beam DBS scan, scripts/bench_motion.py).
 MOTION_BLOCK_TRIALS = (64, 2**11)
 
+# --- Turbulence defaults (issue 24) ------------------------------------------------------
+# IEC 61400-1 Ed. 3 (2005), Sec. 6.3 and Annex B: the turbulence scale parameter
+# Lambda_1 = 0.7 z below 60 m above ground and 42 m above; the Mann (1994) uniform-shear
+# model with L = 0.8 Lambda_1 and Gamma = 3.9 (Annex B.2); the Kaimal spectra with the
+# longitudinal integral length L_u = 8.1 Lambda_1 (Table B.1).
+
+#: Height above which the IEC turbulence scale parameter is constant [m]. IEC 61400-1
+#: Ed. 3 (2005), Eq. 5.
+IEC_SCALE_HEIGHT = 60.0
+#: Turbulence scale parameter Lambda_1 above :data:`IEC_SCALE_HEIGHT` [m]. IEC 61400-1
+#: Ed. 3 (2005), Eq. 5.
+IEC_SCALE_PARAMETER = 42.0
+#: Lambda_1 / z below :data:`IEC_SCALE_HEIGHT` [1]. IEC 61400-1 Ed. 3 (2005), Eq. 5.
+IEC_SCALE_SLOPE = 0.7
+#: Mann's length scale over Lambda_1 [1]: L = 0.8 Lambda_1 = 33.6 m above 60 m.
+#: IEC 61400-1 Ed. 3 (2005), Annex B.2.
+MANN_LENGTH_FACTOR = 0.8
+#: Mann's shear anisotropy Gamma [1]. IEC 61400-1 Ed. 3 (2005), Annex B.2.
+MANN_ANISOTROPY = 3.9
+#: Kaimal's longitudinal integral length L_u over Lambda_1 [1]: L_u = 8.1 Lambda_1 =
+#: 340.2 m above 60 m. IEC 61400-1 Ed. 3 (2005), Annex B, Table B.1.
+KAIMAL_LENGTH_FACTOR = 8.1
+#: Largest turbulence intensity a scenario accepts [1]: sigma_u / U beyond 0.5 breaks
+#: Taylor's frozen-turbulence hypothesis (it needs sigma_u << U; Willis and Deardorff
+#: 1976, J. Atmos. Sci. 33, 1530, find it holds to sigma_u / U ~ 0.5) that both paths use.
+MAX_TURBULENCE_INTENSITY = 0.5
+#: Longest length scale a scenario accepts [m]: 10 km, beyond any atmospheric surface
+#: layer's integral length (the Kaimal L_u of IEC 61400-1 is 340 m).
+MAX_LENGTH_SCALE = 10_000.0
+#: Largest Mann anisotropy accepted [1]: fits to atmospheric data give 0-5 (Mann 1994,
+#: J. Fluid Mech. 273, 141; Peña et al. 2010, BLM 137, 173); 10 leaves a margin.
+MAX_ANISOTROPY = 10.0
+#: Longest record [s]: one hour (IEC 61400-12-1 uses 10-min records; longer ones are
+#: non-stationary and outside the frozen, homogeneous field of the model).
+MAX_RECORD_DURATION = 3600.0
+#: Most scans in one record [1]: a bound on the cost of a record before anything is
+#: allocated (2^20 scans of a 5-beam DBS is 5 x 2^20 lines of sight: 40 MB per gate and
+#: probe node in float64); a 600-s record of 1-ms beams of a 5-beam DBS has 120 000.
+MAX_RECORD_SCANS = 2**20
+#: Default Monte Carlo records per scene (``record.count``) [1]: each record costs a
+#: turbulence box (~7 s CPU for a 600-s record of a 5-beam DBS at 10 m s-1, L = 33.6 m, on
+#: one core here); with 20 records the standard error of the mean apparent TI is its
+#: spread over the records / sqrt(20) = 0.22 of that spread.
+DEFAULT_RECORDS = 20
+#: Most records per scene (``record.count``) [1]: a bound on the run's cost (boxes).
+MAX_RECORDS = 10_000
+#: Gauss-Legendre nodes along the beam with which a probe's weighting samples the
+#: turbulent field [1]: the quadrature of the weighting's transfer function
+#: integral W(s) exp(i k s) ds with 48 nodes is within 1e-3 of the exact one for
+#: k h <= 70 (h the rule's half length: k <= 0.9 rad m-1 for a pulsed gate of 18.75 m and
+#: pulse of 24.75 m, h = 77 m, beyond the Nyquist wavenumber pi / (L / 8) = 0.75 rad m-1
+#: of a box of the IEC L = 33.6 m; 32 nodes reach only k h = 39, 0.5 rad m-1, and their
+#: response between 0.5 and 0.75 rad m-1 aliases up to 0.5); for a CW Lorentzian cut at
+#: 2 % (h = 7 z_R) the "tan" rule holds for k h <= 50. Beyond its reach a rule aliases:
+#: a field sampled with it must carry no wavenumbers above that. Measured against the
+#: closed forms in tests/pipeline/test_turbulencesection.py.
+TURBULENCE_PROBE_NODES = 48
+#: k h up to which the :data:`TURBULENCE_PROBE_NODES`-node rule holds to 1e-3 [1],
+#: per probe kind (measured, see above).
+TURBULENCE_PROBE_REACH = {"pulsed": 70.0, "cw": 50.0}
 # --- Turbulence (issue 24) ------------------------------------------------------------
 
 #: Mann (1994) uniform-shear spectral tensor, the IEC 61400-1:2005 Annex B (B.2)

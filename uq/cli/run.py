@@ -25,6 +25,9 @@ def add_parser(commands):
                      help="the measurement model: 'compiled' (default; numba, wherever it "
                      "applies, else numpy, said at -v) or 'numpy' (the reference model "
                      "throughout; the same numbers to 1e-12 m/s, slower)")
+    run.add_argument("--device", choices=("cpu", "gpu"), default="cpu",
+                     help="where the turbulence boxes of record mode are made: 'cpu' "
+                     "(numpy, default) or 'gpu' (CuPy on a CUDA GPU; exits 2 without one)")
     scale = run.add_mutually_exclusive_group()
     scale.add_argument("--workers", type=int, metavar="N",
                        help="run the sweep on a local dask cluster of N processes "
@@ -34,6 +37,22 @@ def add_parser(commands):
                        "(e.g. tcp://host:8786)")
     run.set_defaults(handler=command)
     return run
+
+
+def check_device(args, scenario):
+    """``--device gpu``: CuPy and a CUDA GPU must be there (else exit 2, one line, before
+    any work); this version's runs make no box (the Monte Carlo records are not wired
+    yet), which it says at once."""
+    if getattr(args, "device", "cpu") != "gpu":
+        return
+    from uq.physics.turbulencebox import array_namespace
+    try:
+        array_namespace("gpu")
+    except ValueError as error:
+        raise ScenarioError("--device", "gpu", f"{error}; allowed: --device cpu") from None
+    logging.getLogger(__name__).warning(
+        "--device gpu: this run makes no turbulence box (the Monte Carlo records are not "
+        "wired yet); it runs on the CPU as with --device cpu")
 
 
 def command(args):
@@ -50,6 +69,7 @@ def command(args):
         raise ScenarioError("-o", str(output), "the output file must end in .nc")
     check_target(output)                     # before any work: refused targets cost nothing
     check_scale_out(args)
+    check_device(args, scenario)
     load_kernels(args, scenario)
     progress = None if args.quiet else ProgressBar()
     new_folders = missing_folders(output.parent)

@@ -35,7 +35,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 
 from uq.errors import ScenarioError  # noqa: E402
 from uq.files import check_target, output_folder, save_figure  # noqa: E402
-from uq.outputs import motionfigures, plots  # noqa: E402
+from uq.outputs import motionfigures, plots, recordfigures  # noqa: E402
 from uq.outputs.labels import MODELS as LABEL_MODELS  # noqa: E402
 from uq.outputs.labels import coordinate_label, model_style  # noqa: E402
 from uq.outputs.planning import VELOCITY_RATIOS, velocity_ratio_line  # noqa: E402
@@ -453,7 +453,8 @@ def figure_plan(dataset, select=None):
     does). Empty only for a sweep of more dimensions than a figure shows, or a run
     without any uncertainty (:func:`no_figure_reason`)."""
     dataset = select_scenes(dataset, select)
-    return uncertainty_plan(dataset) + probe_plan(dataset)
+    return uncertainty_plan(dataset) + probe_plan(dataset) + \
+        recordfigures.record_plan(dataset)
 
 
 def uncertainty_plan(dataset):

@@ -43,6 +43,7 @@ def summary_table(dataset):
     columns.append("GUM valid")
     lines = [title] + _table(rows, columns)
     lines += _motion_line(dataset)
+    lines += _record_lines(dataset)
     units = ", ".join(f"{q} [{QUANTITIES[q]['units']}]" for q in shown)
     lines.append(f"units: {units}")
     lines.append("GUM valid: scenes whose GUM interval Monte Carlo validates (JCGM 101 "
@@ -78,6 +79,29 @@ def _motion_line(dataset):
     note = fixed_phase_note(dataset)
     return [f"motion-induced turbulence-intensity increment [%]: {ti}"
             + (f" ({note})" if note else "")]
+
+
+def _record_lines(dataset):
+    """Record mode: per gate the true, spectral and Monte Carlo TI [%] (min..max over a
+    sweep), and the scenes where the records validate the spectral path."""
+    if "turbulence_intensity_spectral" not in dataset:
+        return []
+    true = _cell(100 * dataset["turbulence_intensity_true"].values, "mc_u")
+    lines = [f"turbulence intensity over a record [%]: true {true}"]
+    spectral = dataset["turbulence_intensity_spectral"]
+    gates = dataset["range"].values.reshape(-1) if "range" in spectral.dims else [None]
+    for gate in gates:
+        select = {} if gate is None else {"range": gate}
+        text = f"  apparent{'' if gate is None else f' @{gate:g} m'}: spectral " + \
+            _cell(100 * spectral.sel(select).values, "mc_u")
+        if "turbulence_intensity_mc_mean" in dataset:
+            valid = dataset["turbulence_intensity_spectral_valid"].sel(select).values
+            text += (f", Monte Carlo {_cell(100 * dataset['turbulence_intensity_mc_mean'].sel(select).values, 'mc_u')}"
+                     f" (95 % of records {_cell(100 * dataset['turbulence_intensity_mc_low'].sel(select).values, 'mc_u')}"
+                     f" to {_cell(100 * dataset['turbulence_intensity_mc_high'].sel(select).values, 'mc_u')});"
+                     f" spectral validated {int(np.sum(valid))}/{np.size(valid)}")
+        lines.append(text)
+    return lines
 
 
 def _shown(values, quantity, column):

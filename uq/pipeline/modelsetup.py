@@ -140,4 +140,11 @@ def skipped_work(settings, outputs, probe_kinds=()):
                       for key in probesection.unused_errors(settings, kind)]
         lines.append("probe volume: evaluated by the numpy model (the compiled model is "
                      "point-wise)")
+    if "turbulence" in settings and settings["sampling"]["method"] == "none":
+        lines.append("record mode with sampling.method none: no Monte Carlo records "
+                     "(turbulence_intensity_mc_*, wind_speed_record_*), the spectral path "
+                     "only (turbulence_intensity_spectral)")
+    if "turbulence" in settings:
+        lines.append("record mode: the turbulence is sampled at the nominal probe points "
+                     "(the platform's displacement does not move them)")
     return "; ".join(lines) or "nothing"

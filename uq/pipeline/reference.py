@@ -48,6 +48,9 @@ EXEMPLAR_OPTIONAL = {
                "spectrum": {"hs": 2.0, "tp": 7.0},
                "response": {"roll": {"factor": 2.0, "lag": 90.0}}},
     "sampling": {"chunk_size": 65536, "seed": 1},
+    "turbulence": {"model": "mann", "intensity": 0.1, "length_scale": 33.6,
+                   "anisotropy": 3.9},
+    "record": {"duration": 600.0, "count": 20},
     "fit": {"priors": {"shear": {"dist": "uniform", "low": -0.5, "high": 1.0},
                        "reference_speed": {"dist": "normal", "mean": 9.0, "u": 2.0}},
             "columns": {"height": "height", "speed": "speed", "speed_u": "speed_u",
@@ -120,7 +123,9 @@ MEANINGS = {
                 "turbulence-intensity increment, u of Vh from motion over Vh; needs motion; "
                 "yaw_misalignment: wind_direction minus ship.heading, the rotor axis, in "
                 "[-180, 180) deg; shear_exponent: the power-law exponent from the upper and "
-                "lower beams of a tilted mount, w = 0 assumed)"),
+                "lower beams of a tilted mount, w = 0 assumed; "
+                "turbulence_intensity: the records' apparent TI against the true one, "
+                "needs turbulence)"),
     "motion.<dof>.amplitude": ("deg or m", "amplitude of a harmonic motion of a degree of "
                                "freedom, added to the static attitude: roll, pitch, yaw in "
                                "deg (at most 45); surge, sway, heave in m"),
@@ -148,6 +153,20 @@ MEANINGS = {
                                 "yaw in deg; surge, sway, heave in m"),
     "motion.series.components": ("1", "Fourier harmonics of the record kept (those with "
                                  "the most motion)"),
+    "turbulence.model": ("", "spectral model of the frozen turbulent field (Taylor): mann "
+                         "(Mann 1994 uniform-shear tensor) or kaimal (IEC 61400-1 Kaimal "
+                         "spectra with its exponential coherence); gives record mode"),
+    "turbulence.intensity": ("1", "sigma_u / U of the point field at wind.reference_height "
+                             "(required: the site's)"),
+    "turbulence.length_scale": ("m", "Mann's L (default 0.8 Lambda_1) or Kaimal's L_u "
+                                "(default 8.1 Lambda_1); Lambda_1 = 0.7 z below 60 m, 42 m "
+                                "above (IEC 61400-1 Ed. 3, Annex B)"),
+    "turbulence.anisotropy": ("1", "Mann's Gamma (IEC 61400-1 Ed. 3, Annex B: 3.9)"),
+    "record.count": ("1", "Monte Carlo records per scene (each a turbulence box; not with "
+                     "sampling.method none, the spectral path alone)"),
+    "record.duration": ("s", "length of a record, the scans that lidar.scan times in it, "
+                        "reduced to a mean and standard deviation (needs turbulence; "
+                        "default 600 with turbulence)"),
     "lidar.lever_arm": ("m", "(bow, starboard, up) from the INS to the lidar"),
     "lidar.mount.tilt": ("deg", "boresight tilted from vertical towards the bow (0: the "
                          "upward lidar, as without mount; 90: a nacelle lidar looking "
@@ -484,7 +503,7 @@ def render():
 
 
 def _order(key):
-    sections = list(DEFAULTS)
+    sections = list(DEFAULTS) + list(scenario_module.OPTIONAL_SECTIONS)
     return (sections.index(key.split(".")[0]) if key.split(".")[0] in sections else 99, key)
 
 

@@ -18,7 +18,7 @@ import xarray as xr
 from uq._version import __version__
 from uq.pipeline.distributions import error_distribution
 from uq.engine.inputs import Input
-from uq.pipeline import probesection
+from uq.pipeline import probesection, records
 from uq.pipeline.modelsetup import (MOTION_INPUTS, error_inputs, input_label, scene_from_settings,
                                     skipped_work)
 from uq.physics.correction import describe_corrections
@@ -115,7 +115,12 @@ def run_chunk(scenario, plan, chunk, seed, compiled=True):
         scenario = scenario.with_values(group_assignments(scenario, plan, chunk.group))
     base = scene_from_settings(scenario.settings)
     fields = vector_fields(scenario, plan, chunk) or {"wind_speed": np.array([base.wind_speed])}
-    return run_scene(scenario, batch_scene(base, fields), seed, compiled)
+    dataset = run_scene(scenario, batch_scene(base, fields), seed, compiled)
+    if "turbulence" in scenario.settings and "wind_speed_true" in dataset:
+        # record mode: the spectral path per scene
+        dataset = dataset.assign(records.record_variables(
+            scenario, records.chunk_fields(scenario, plan, chunk), dataset, seed, compiled))
+    return dataset
 
 
 def run_scene(scenario, scene, seed, compiled=True):
@@ -143,7 +148,8 @@ def wants_motion_ti(settings):
 def model_outputs(outputs):
     """The per-trial outputs the model evaluates (derived ones need wind_speed)."""
     model = [q for q in outputs if q in ALL_OUTPUTS]
-    if "wind_speed_motion_ti" in outputs and "wind_speed" not in model:
+    derived = ("wind_speed_motion_ti", "turbulence_intensity")
+    if any(q in outputs for q in derived) and "wind_speed" not in model:
         model.insert(0, "wind_speed")
     return tuple(model)
 
@@ -344,6 +350,8 @@ def _annotate(ds, scenario):
         quantity = next((q for q in QUANTITIES if name.startswith(q + "_")), None)
         if name in DERIVED_ATTRIBUTES:
             ds.variables[name].attrs.update(DERIVED_ATTRIBUTES[name])
+        elif name in records.RECORD_ATTRIBUTES:
+            ds.variables[name].attrs.update(records.RECORD_ATTRIBUTES[name])
         elif quantity:
             ds.variables[name].attrs.update(
                 variable_attributes(quantity, name[len(quantity) + 1:]))

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from uq.constants import (COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, MAX_BEAMS, MAX_CHUNK_SIZE,
+from uq.constants import (COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, MANN_ANISOTROPY, MAX_BEAMS, MAX_CHUNK_SIZE,
                           MAX_GATES, MAX_GROUPS, MAX_MAGNITUDE, MAX_SCENES, MAX_SEED)
 from uq.physics.correction import CORRECTION_MODELS
 from uq.physics.beams import beam_unit_vectors
@@ -32,6 +32,7 @@ from uq.pipeline.motionsection import (check_dwell, check_record, random_phase_c
                                        validate_ins_timing, validate_lever_arm, validate_motion,
                                        validate_scan)
 from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
+from uq.pipeline.turbulencesection import validate_record, validate_turbulence
 from uq.physics.modelinputs import error_keys
 from uq.physics.scene import ALL_OUTPUTS
 from uq.pipeline.mountsection import (check_mount_settings, check_mounted_beams, tilt_of,
@@ -82,12 +83,17 @@ DEFAULTS = {
     "fit": {},
     "motion": {},
 }
+#: Optional top-level sections without defaults: given, they switch record mode on
+#: (:mod:`uq.pipeline.turbulencesection`); absent, nothing of them enters the settings.
+OPTIONAL_SECTIONS = ("turbulence", "record")
 #: Optional keys of a section that enter the settings only when given (so a scenario
 #: without them is today's, to the text of its ``scenario`` attribute).
 OPTIONAL_LIDAR_KEYS = ("lever_arm", "scan", "probe", "mount")
 OPTIONAL_INS_KEYS = ("rate", "interpolation", "clock_offset")
 #: Outputs derived from the results rather than evaluated per trial.
 DERIVED_OUTPUTS = ("wind_speed_motion_ti",)
+#: Outputs of record mode (a ``turbulence`` section, :mod:`uq.pipeline.records`).
+RECORD_OUTPUTS = ("turbulence_intensity",)
 DEFAULT_SAMPLES = 100_000
 
 
@@ -226,7 +232,11 @@ def keys_without_effect(settings, sweep=None):
         found.append(("ins.rate", "has no effect without a motion section (an INS on a "
                       "platform at rest reads the same at every sample: the same model, "
                       "other random draws); allowed: add motion, or leave ins.rate out"))
-    if "scan" in lidar and not moving and not timed:
+    if "turbulence" in settings and settings["turbulence"]["model"] == "kaimal" and \
+            settings["turbulence"]["anisotropy"] != MANN_ANISOTROPY:
+        found.append(("turbulence.anisotropy", "has no effect with model kaimal (Mann's "
+                      "Gamma); allowed: model mann, or leave anisotropy out"))
+    if "scan" in lidar and not moving and not timed and "turbulence" not in settings:
         found.append(("lidar.scan", "has no effect without a motion section or an INS "
                       "error's correlation_time (the beams' times matter only where "
                       "something changes between them)"))
@@ -289,7 +299,7 @@ def _validate(raw, source, check=None):
     if "golden" in raw:
         check.fail("golden", "this is a golden-lidar configuration, not a scenario; "
                    "allowed: uq golden FILE")
-    check.keys(raw, "", DEFAULTS)
+    check.keys(raw, "", tuple(DEFAULTS) + OPTIONAL_SECTIONS)
     settings = {
         "name": check.name(raw.get("name", DEFAULTS["name"])),
         "description": check.text(raw.get("description", ""), "description"),
@@ -306,9 +316,24 @@ def _validate(raw, source, check=None):
         settings["fit"] = validate_fit(check, raw["fit"]).to_dict()
     if raw.get("motion") is not None:                # optional: motion within the scan
         settings["motion"] = validate_motion(check, raw["motion"])
+    if raw.get("turbulence") is not None or raw.get("record") is not None:
+        _records(check, raw, settings)               # optional: records in turbulence
     _check_time_resolved(check, settings)
     check_mount_settings(check, settings)
     return settings
+
+
+def _records(check, raw, settings):
+    """``turbulence`` and ``record`` (record mode: one goes with the other; a record
+    lasts 600 s unless given)."""
+    if raw.get("turbulence") is None:
+        check.fail("record", "a record needs a turbulent wind; allowed: add a turbulence "
+                   "section (model, intensity), or leave record out")
+    lidar = settings["lidar"]
+    settings["turbulence"] = validate_turbulence(check, raw["turbulence"],
+                                                 settings["wind"]["reference_height"])
+    settings["record"] = validate_record(check, raw.get("record") or {}, len(lidar["azimuths"])
+                                         + int(lidar["vertical_beam"]), lidar)
 
 
 def _section(check, value, key, optional=()):
@@ -414,6 +439,9 @@ def _check_time_resolved(check, settings):
     if DERIVED_OUTPUTS[0] in settings["outputs"] and not settings.get("motion"):
         check.fail("outputs", f"{DERIVED_OUTPUTS[0]} needs a motion section; allowed: the "
                    "other outputs")
+    if RECORD_OUTPUTS[0] in settings["outputs"] and "turbulence" not in settings:
+        check.fail("outputs", f"{RECORD_OUTPUTS[0]} needs a turbulence section; allowed: "
+                   "the other outputs, or add turbulence: {model, intensity}")
     check_dwell(check, settings)
     lidar = settings["lidar"]
     check_record(settings, len(lidar["azimuths"]) + int(lidar["vertical_beam"]))
@@ -493,7 +521,7 @@ def _sampling(check, value):
 def _outputs(check, value):
     items = check.list(value, "outputs")
     for item in items:
-        check.choice(item, "outputs", ALL_OUTPUTS + DERIVED_OUTPUTS)
+        check.choice(item, "outputs", ALL_OUTPUTS + DERIVED_OUTPUTS + RECORD_OUTPUTS)
     check.unique(items, "outputs")
     if not items:
         raise ScenarioError(check.source, "outputs", f"empty; allowed: any of {', '.join(ALL_OUTPUTS)}")

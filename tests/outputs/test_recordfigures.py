@@ -1,0 +1,71 @@
+"""Record-mode figures: the budget's arithmetic, the aliasing of the motion's peak, the plan."""
+import matplotlib
+import numpy as np
+import pytest
+import xarray as xr
+
+matplotlib.use("Agg")
+
+from uq.outputs import figures, recordfigures  # noqa: E402
+from uq.pipeline.records import spectral_variances  # noqa: E402
+from uq.pipeline.scenario import load_scenario  # noqa: E402
+
+DBS = {"wind": {"speed": 10.0, "direction": 180.0, "reference_height": 100.0},
+       "lidar": {"height": 0.0, "ranges": [60.0, 100.0], "half_cone": 30.0,
+                 "vertical_beam": True, "scan": {"beam_duration": 1.0},
+                 "probe": {"kind": "pulsed", "gate_length": 18.75, "pulse_fwhm": 24.75}},
+       "turbulence": {"intensity": 0.1}, "sampling": {"method": "none"}}
+
+
+def test_budget_steps_add_up_to_the_spectral_variance():
+    settings = load_scenario(DBS).settings
+    names, values = recordfigures.geometry_contributions(settings)
+    assert names[0].startswith("true")
+    total = values[0] + values[1] + values[2] + values[3]
+    # the steps telescope: true + (each step minus the one before) = the last step,
+    # the spectral path of the scan as it is (same quadrature: to rounding)
+    np.testing.assert_allclose(total, spectral_variances(settings)[0].lidar[:, 0],
+                               rtol=1e-10)
+    assert np.all(values[3] < 0)               # the probe volume removes variance
+
+
+@pytest.mark.parametrize("frequency, sampling, seen", [
+    (1 / 7, 1 / 5, 1 / 5 - 1 / 7),            # a 7-s wave in 5-s scans: 0.0571 Hz
+    (0.05, 0.2, 0.05),                         # below Nyquist: where it is
+    (0.4, 0.2, 0.0),                           # twice the sampling rate: at 0
+])
+def test_aliased_motion_peak(frequency, sampling, seen):
+    assert recordfigures.aliased(frequency, sampling) == pytest.approx(seen, abs=1e-12)
+
+
+def test_motion_peak():
+    assert recordfigures.motion_peak({"motion": {"spectrum": {"tp": 7.0}}}) == 1 / 7
+    assert recordfigures.motion_peak({"motion": {
+        "surge": {"amplitude": 0.5, "period": 7.0}, "heave": {"amplitude": 1.0,
+                                                               "period": 9.0}}}) == 1 / 9
+    assert recordfigures.motion_peak({}) is None
+
+
+def test_record_plan_only_in_record_mode():
+    assert recordfigures.record_plan(xr.Dataset()) == []
+    record = xr.Dataset({"turbulence_intensity_spectral": ("turbulence_intensity", [0.1, 0.2])},
+                        coords={"turbulence_intensity": [0.1, 0.2]})
+    assert [name for name, _ in recordfigures.record_plan(record)] == [
+        "record_spectra", "ti_budget", "apparent_against_true_ti"]
+    assert "record_plan" in dir(figures.recordfigures)
+
+
+def test_summary_reports_record_mode():
+    from uq.outputs.summary import summary_table
+    ds = xr.Dataset({
+        "turbulence_intensity_true": ((), 0.095),
+        "turbulence_intensity_spectral": (("range",), [0.0886, 0.0857]),
+        "turbulence_intensity_mc_mean": (("range",), [0.0873, 0.0835]),
+        "turbulence_intensity_mc_low": (("range",), [0.0807, 0.0754]),
+        "turbulence_intensity_mc_high": (("range",), [0.1, 0.0944]),
+        "turbulence_intensity_spectral_valid": (("range",), [True, False])},
+        coords={"range": [40.0, 100.0]})
+    lines = summary_table(ds).splitlines()
+    assert "turbulence intensity over a record [%]: true 9.5" in lines
+    assert "  apparent @100 m: spectral 8.57, Monte Carlo 8.35 (95 % of records 7.54 to " \
+           "9.44); spectral validated 0/1" in lines

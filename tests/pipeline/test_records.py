@@ -1,0 +1,140 @@
+"""Record mode through uq.run: the spectral path's turbulence intensities."""
+import math
+
+import numpy as np
+import pytest
+
+from uq.pipeline.runner import run
+
+WIND = {"speed": 10.0, "direction": 180.0, "reference_height": 100.0}
+
+
+def scenario(lidar, **extra):
+    return {"wind": WIND, "lidar": {"scan": {"beam_duration": 1e-3}, **lidar},
+            "turbulence": {"intensity": 0.1}, "sampling": {"method": "none"},
+            "outputs": ["turbulence_intensity"], **extra}
+
+
+def test_absent_turbulence_adds_nothing():
+    ds = run({"sampling": {"method": "none"}, "outputs": ["wind_speed"]})
+    assert not [name for name in ds.data_vars if name.startswith("turbulence_")]
+
+
+def test_a_lidar_shrunk_to_a_point_sees_the_true_variance():
+    # gates 0.1 m from the lidar at the reference height, point probe, beams 1 ms apart:
+    # the beams sample the reference point. The difference from 1 is the structure
+    # function of w across the opposite beams' separation r = 0.115 m, amplified by the
+    # DBS's cot(theta)^2 / 4 = 0.75: about 0.75 (r / L)^(2/3) = 0.017 of the variance (L =
+    # 33.6 m); 0.03 bounds it.
+    ds = run(scenario({"height": 99.9, "ranges": [0.1], "half_cone": 30.0,
+                       "vertical_beam": True}))
+    assert float(ds["turbulence_intensity_u_ratio"]) == pytest.approx(1.0, abs=0.03)
+    ratio = (ds["turbulence_intensity_spectral"] / ds["turbulence_intensity_true"]) ** 2
+    assert float(ratio) == pytest.approx(float(ds["turbulence_intensity_u_ratio"]), rel=1e-12)
+    for name in ("turbulence_intensity_true", "turbulence_intensity_spectral"):
+        assert ds[name].attrs["units"] == "1" and ds[name].attrs["long_name"]
+
+
+def test_probe_volume_lowers_the_apparent_variance():
+    # Sathe et al. (2011), as issue 24 cites them: a lidar sees 5-45 % less u-variance
+    # than a point; the point-probe DBS is above 1 (w leaks into u through cot(theta))
+    point = run(scenario({"height": 0.0, "ranges": [100.0], "half_cone": 30.0,
+                          "vertical_beam": True}))
+    pulsed = run(scenario({"height": 0.0, "ranges": [100.0], "half_cone": 30.0,
+                           "vertical_beam": True, "probe": {
+                               "kind": "pulsed", "gate_length": 18.75, "pulse_fwhm": 24.75}}))
+    assert 0.55 < float(pulsed["turbulence_intensity_u_ratio"]) < 0.95
+    assert float(pulsed["turbulence_intensity_u_ratio"]) < \
+        float(point["turbulence_intensity_u_ratio"])
+
+
+def test_scan_errors_add_in_quadrature():
+    # radial noise sigma_r on a 4-beam DBS with the wind along a beam pair: u_x =
+    # (v_1 - v_3) / (2 sin theta) has variance sigma_r^2 / (2 sin^2 theta), which is the
+    # variance of Vh (linear: the GUM of method none is exact here); it adds to the
+    # filtered turbulence's variance, independent scan by scan
+    sigma_r, cone = 0.2, 30.0
+    ds = run(scenario({"height": 0.0, "ranges": [100.0], "half_cone": cone, "errors": {
+        "radial_velocity": {"dist": "normal", "u": sigma_r}}},
+        outputs=["wind_speed", "turbulence_intensity"]))
+    noise = sigma_r ** 2 / (2 * math.sin(math.radians(cone)) ** 2) / WIND["speed"] ** 2
+    expected = np.sqrt(ds["turbulence_intensity_spectral_turbulence"] ** 2 + noise)
+    np.testing.assert_allclose(ds["turbulence_intensity_spectral"], expected, rtol=1e-12)
+
+
+def surge_scenario(correction, phase):
+    # a nearly still atmosphere (I = 1e-4: u-variance 1e-6 m2 s-2 against the surge's
+    # 0.1) with a long length scale (a coarse, cheap box); a level 4-beam DBS, the wind
+    # from the south along the beams at azimuths 0 and 180 (the bow, heading 0)
+    return {"wind": {"speed": 10.0, "direction": 180.0, "reference_height": 100.0},
+            "lidar": {"height": 0.0, "ranges": [100.0], "half_cone": 30.0,
+                      "scan": {"beam_duration": 1.0}},
+            "motion": {"surge": {"amplitude": 0.5, "period": 7.0, "phase": phase}},
+            "correction": correction,
+            "turbulence": {"intensity": 1e-4, "length_scale": 400.0},
+            "record": {"duration": 600, "count": 2},
+            "sampling": {"n": 64, "seed": 5}, "outputs": ["wind_speed", "turbulence_intensity"]}
+
+
+def test_harmonic_surge_advances_coherently_from_scan_to_scan():
+    # The DBS u = (v_1 - v_3) / (2 sin theta) of a surge a sin(w t + phi) uncorrected
+    # errs by the platform velocity seen by beams 1 and 3, 2 s apart: record variance
+    # (a w cos(w dt / 2))^2 / 2 (lidarspectral Eq. 7, derived there) for a long record.
+    # A fixed phase gives it only if the phase advances by w T_s from scan to scan (the
+    # same phase in every scan would give 0). 150 scans: the record's own mean removes
+    # |D_N|^2 < 1e-3 of it; s^2 with ddof 1 is N / (N - 1) = 1.0067 times the 1/N one;
+    # 2 % covers both and the turbulence's 1e-5.
+    from uq.physics.lidarspectral import dbs_surge_variance
+    ds = run(surge_scenario("none", 0.0))
+    variance = float(ds["turbulence_intensity_mc_mean"]) ** 2 * 10.0 ** 2
+    assert variance == pytest.approx(dbs_surge_variance(0.5, 7.0, 2.0), rel=0.02)
+    # the same at a random phase per record; the correction removes the surge
+    random = run(surge_scenario("none", "random"))
+    assert float(random["turbulence_intensity_mc_mean"]) == pytest.approx(
+        float(ds["turbulence_intensity_mc_mean"]), rel=0.02)
+    corrected = run(surge_scenario("pointwise", 0.0))
+    assert float(corrected["turbulence_intensity_mc_mean"]) < 0.01 * float(
+        ds["turbulence_intensity_mc_mean"])
+
+
+def test_spectral_and_monte_carlo_agree_on_a_fixed_dbs():
+    # a fixed 5-beam DBS with a pulsed probe, Mann field; 12 records of 60 s. The
+    # spectral TI^2 against the records' mean TI^2: within 3 standard errors of that
+    # mean plus what the box leaves out of the variance (1 - box_kept, a bound on the
+    # box's deficit: it removes that share of the point variance, less of the lidar's,
+    # which filters the small scales the box also misses)
+    ds = run({"wind": {"speed": 10.0, "direction": 180.0, "reference_height": 100.0},
+              "lidar": {"height": 0.0, "ranges": [100.0], "half_cone": 30.0,
+                        "vertical_beam": True, "scan": {"beam_duration": 0.5},
+                        "probe": {"kind": "pulsed", "gate_length": 18.75,
+                                  "pulse_fwhm": 24.75}},
+              "turbulence": {"intensity": 0.1}, "record": {"duration": 60, "count": 12},
+              "sampling": {"n": 64, "seed": 11}, "outputs": ["turbulence_intensity"]})
+    spectral = float(ds["turbulence_intensity_spectral"]) ** 2
+    z = float(ds["turbulence_intensity_spectral_z"])
+    deficit = (1 - float(ds["turbulence_intensity_box_kept"])) * spectral
+    # the standard error of the records' mean TI^2 by the delta method, 2 TI u(TI) / sqrt(n)
+    standard_error = 2 * float(ds["turbulence_intensity_mc_mean"] * ds[
+        "turbulence_intensity_mc_u"]) / np.sqrt(12)
+    assert abs(z) <= 3 + deficit / standard_error
+    assert float(ds["turbulence_intensity_mc_low"]) < float(ds["turbulence_intensity_mc_mean"]) \
+        < float(ds["turbulence_intensity_mc_high"])
+    assert ds["wind_speed_record_u"].attrs["units"] == "m s-1"
+
+
+def test_sweeps_of_scene_values_and_of_the_intensity():
+    # the spectral variance is alpha eps^(2/3) times the filter's integral, and alpha
+    # eps^(2/3) goes as the intensity squared: the TIs scale with the intensity exactly;
+    # a swept direction (a scene value: the scenes of one chunk) gives each scene its
+    # own geometry: the wind along a beam pair (0) and between the pairs (45) differ
+    ds = run(scenario({"height": 0.0, "ranges": [100.0], "half_cone": 30.0},
+                      sweep={"turbulence.intensity": [0.05, 0.1],
+                             "wind.direction": [0.0, 45.0, 90.0]}))
+    ti = ds["turbulence_intensity_spectral"]
+    assert ti.dims == ("turbulence_intensity", "wind_direction")
+    np.testing.assert_allclose(ti.isel(turbulence_intensity=0), ti.isel(
+        turbulence_intensity=1) / 2, rtol=1e-12)
+    np.testing.assert_allclose(ti.sel(wind_direction=0.0), ti.sel(wind_direction=90.0),
+                               rtol=1e-6)          # the 4-beam DBS's symmetry
+    assert abs(float(ti.isel(turbulence_intensity=1).sel(wind_direction=45.0)
+                     / ti.isel(turbulence_intensity=1).sel(wind_direction=0.0)) - 1) > 1e-3

@@ -1,0 +1,341 @@
+"""Record mode: the turbulence intensity a lidar reports over a record, by the spectral
+path (:mod:`uq.physics.lidarspectral`), beside the per-scan results.
+
+For each scene, ``turbulence_intensity_spectral`` at each gate is::
+
+    TI_lidar = sqrt(var_turbulence + u_scan^2) / Vh_true
+
+* ``var_turbulence`` [m2 s-2]: the expected record variance of the reconstructed
+  along-wind component u_x from the turbulence alone, the spectral tensor filtered by the
+  scan's transfer function (probe weighting, beam positions, beam times through Taylor's
+  hypothesis, reconstruction, the record's high-pass; :func:`uq.physics.lidarspectral.
+  lidar_variances` of :func:`uq.pipeline.turbulencesection.scan_geometry`). For the wind
+  along x, ``var(Vh) = var(u_x)`` to O(sigma^4 / U^2).
+* ``u_scan`` [m s-1]: the standard uncertainty of one scan's Vh from everything else
+  (motion with its random phases, INS errors, noise; ``wind_speed_mc_u``, or
+  ``wind_speed_gum_u`` where ``sampling.method`` is ``none``): these errors are drawn
+  independently scan by scan and uncorrelated with the turbulence, so their variance
+  adds (the record's high-pass takes 1/N of it, N the scans of a record, negligible).
+* ``Vh_true``: the true horizontal speed at the gate (``wind_speed_true``).
+
+``turbulence_intensity_true`` is the expected ``sigma_u / U`` of the field at the
+reference point over the record (the same high-pass and scan sampling), so that
+(``turbulence_intensity_spectral`` / ``turbulence_intensity_true``)^2 is the lidar's
+u-variance ratio (Sathe et al. 2011) where motion and errors are absent and there is no
+shear. ``turbulence_intensity_point`` is the scenario's intensity (no high-pass).
+
+Unless ``sampling.method`` is ``none``, ``record.count`` Monte Carlo records per scene
+give the distribution of the apparent TI and of the record mean
+(:func:`monte_carlo_variables`).
+"""
+import copy
+import math
+
+import numpy as np
+
+from uq.physics.lidarspectral import lidar_variances, probe_transfer_for
+from uq.physics.spectraltensor import KaimalSpectra, mann_tensor_for_intensity
+from uq.pipeline import probesection
+from uq.constants import KAIMAL_LENGTH_FACTOR as LENGTH_FACTORS_KAIMAL
+from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
+
+#: Attributes of the record-mode variables.
+RECORD_ATTRIBUTES = {
+    "turbulence_intensity_mc_mean": {
+        "units": "1", "long_name": "Monte Carlo mean over records of the apparent "
+        "turbulence intensity std(Vh) / mean(Vh) of a record"},
+    "turbulence_intensity_mc_u": {
+        "units": "1", "long_name": "Monte Carlo standard deviation over records of the "
+        "apparent turbulence intensity"},
+    "turbulence_intensity_mc_low": {
+        "units": "1", "long_name": "lower end of the 95 % interval over records of the "
+        "apparent turbulence intensity (2.5 % quantile)"},
+    "turbulence_intensity_mc_high": {
+        "units": "1", "long_name": "upper end of the 95 % interval over records of the "
+        "apparent turbulence intensity (97.5 % quantile)"},
+    "turbulence_intensity_true_mc_mean": {
+        "units": "1", "long_name": "Monte Carlo mean over records of the field's std(u) / "
+        "mean(u) at the reference point, sampled once a scan"},
+    "turbulence_intensity_spectral_z": {
+        "units": "1", "long_name": "spectral expected TI^2 minus the records' mean TI^2, "
+        "in standard errors of that mean"},
+    "turbulence_intensity_spectral_valid": {
+        "units": "1", "long_name": "spectral path validated by the Monte Carlo records "
+        "(|turbulence_intensity_spectral_z| <= 2)"},
+    "turbulence_intensity_box_kept": {
+        "units": "1", "long_name": "variance of u the turbulence box keeps of the model's "
+        "point variance (Mann; NaN for Kaimal: not computed)"},
+    "wind_speed_record_bias": {
+        "units": "m s-1", "long_name": "Monte Carlo mean over records of the record's mean "
+        "horizontal wind speed minus the field's true mean"},
+    "wind_speed_record_u": {
+        "units": "m s-1", "long_name": "Monte Carlo standard deviation over records of the "
+        "record's mean horizontal wind speed minus the field's true mean"},
+    "turbulence_intensity_true": {
+        "units": "1", "long_name": "turbulence intensity sigma_u / U of the field at the "
+        "reference point over a record (expected, spectral; the record's high-pass)"},
+    "turbulence_intensity_spectral": {
+        "units": "1", "long_name": "apparent turbulence intensity the lidar reports over a "
+        "record: the spectral path's filtered turbulence variance plus the per-scan "
+        "error variance, over the true horizontal speed"},
+    "turbulence_intensity_spectral_turbulence": {
+        "units": "1", "long_name": "apparent turbulence intensity from the filtered "
+        "turbulence alone (spectral path), over the true horizontal speed"},
+    "turbulence_intensity_u_ratio": {
+        "units": "1", "long_name": "u-variance ratio of the lidar's filtered turbulence to "
+        "the field's at the reference point over the record (spectral path)"},
+}
+
+
+def turbulence_model(turbulence, speed):
+    """The spectral model of a validated ``turbulence`` section at `speed` [m s-1]: a
+    :class:`~uq.physics.spectraltensor.MannTensor` whose point sigma_u / U is the
+    intensity, or the IEC :class:`~uq.physics.spectraltensor.KaimalSpectra`."""
+    if turbulence["model"] == "mann":
+        return mann_tensor_for_intensity(turbulence["intensity"], speed,
+                                         turbulence["length_scale"], turbulence["anisotropy"])
+    return KaimalSpectra.iec(turbulence["intensity"], speed, turbulence["length_scale"])
+
+
+def spectral_variances(settings):
+    """The :class:`~uq.physics.lidarspectral.SpectralVariances` of validated `settings`:
+    the probe's own transfer function (:func:`~uq.physics.lidarspectral.
+    probe_transfer_for`) at the slanted beams' focus of each gate."""
+    geometry = scan_geometry(settings)
+    lidar = settings["lidar"]
+    focus = np.asarray(lidar["ranges"], float) / math.cos(math.radians(lidar["half_cone"]))
+    transfer = probe_transfer_for(probesection.make_probe(lidar.get("probe")), focus)
+    model = turbulence_model(settings["turbulence"], settings["wind"]["speed"])
+    return lidar_variances(geometry, model, transfer), geometry
+
+
+def chunk_fields(scenario, plan, chunk):
+    """The swept scene values (:data:`~uq.pipeline.sweep.VECTOR_KEYS`) of a chunk's
+    scenes in scenario units (degrees): dotted key -> array (n_chunk,), links included."""
+    if not plan.vector_keys:
+        return {}
+    index = np.unravel_index(np.arange(chunk.start, chunk.stop), plan.vector_shape)
+    fields = {key: np.asarray(values, dtype=float)[position] for key, values, position
+              in zip(plan.vector_keys, plan.vector_values, index)}
+    fields.update({f: fields[lead] for f, lead in scenario.links if lead in fields})
+    return fields
+
+
+def scene_settings(scenario, fields):
+    """Settings of each scene of a chunk: `fields` maps a swept dotted key to the values
+    of the chunk's scenes (scenario units)."""
+    count = len(next(iter(fields.values()))) if fields else 1
+    out = []
+    for i in range(count):
+        settings = copy.deepcopy(scenario.settings)
+        for dotted, values in fields.items():
+            section, key = dotted.split(".")
+            settings[section][key] = float(values[i])
+        out.append(settings)
+    return out
+
+
+def record_variables(scenario, fields, dataset, seed=0, compiled=True):
+    """The record-mode variables of a chunk's scenes (dimension ``scene``, and ``range``):
+    `fields` as :func:`scene_settings`; `dataset` the chunk's per-scan results; the
+    Monte Carlo records (unless ``sampling.method`` is ``none``) from `seed`."""
+    scenes = scene_settings(scenario, fields)
+    n_gates = len(scenario.settings["lidar"]["ranges"])
+    lidar, true = np.full((len(scenes), n_gates), np.nan), np.full(len(scenes), np.nan)
+    for i, settings in enumerate(scenes):
+        if settings["wind"]["speed"] > 0:        # no frozen field without a mean wind: NaN
+            variances = spectral_variances(settings)[0]
+            lidar[i], true[i] = variances.lidar[:, 0], variances.true[0]
+    speeds = np.array([s["wind"]["speed"] for s in scenes])
+    truth = dataset["wind_speed_true"].values.reshape(len(scenes), n_gates)
+    u_scan = _scan_uncertainty(dataset).reshape(len(scenes), n_gates)
+    out = {
+        "turbulence_intensity_true": (("scene",), np.sqrt(true) / speeds),
+        "turbulence_intensity_spectral": (("scene", "range"),
+                                          np.sqrt(lidar + u_scan ** 2) / truth),
+        "turbulence_intensity_spectral_turbulence": (("scene", "range"),
+                                                     np.sqrt(lidar) / truth),
+        "turbulence_intensity_u_ratio": (("scene", "range"), lidar / true[:, None]),
+    }
+    if scenario.sampling["method"] != "none":
+        out.update(monte_carlo_variables(scenes, truth, seed, compiled,
+                                         out["turbulence_intensity_spectral"][1]))
+    return out
+
+
+def _scan_uncertainty(dataset):
+    """u of one scan's Vh from the declared errors and the motion [m s-1]: Monte Carlo
+    where it ran, else the GUM's (``sampling.method: none``)."""
+    name = "wind_speed_mc_u" if "wind_speed_mc_u" in dataset else "wind_speed_gum_u"
+    return dataset[name].values
+
+
+# --- Monte Carlo records --------------------------------------------------------------------
+
+#: Largest |z| of the spectral variance against the records' mean variance for which the
+#: spectral path is taken as validated [1]: the two-sided 95 % normal quantile, 1.96 ~ 2
+#: (the records' mean variance is near normal by the central limit theorem).
+VALID_Z = 2.0
+#: Spawn key of the records' random streams (apart from the per-scan engine's blocks).
+RECORD_STREAM = 24
+#: Inputs of a time-resolved scan that record mode sets itself: the motion's phases
+#: advance coherently from scan to scan within a record.
+PHASE_INPUTS = ("motion_phases",)
+
+
+def record_generator(seed, record):
+    """The independent generator of record `record` of a run seeded with `seed`: the same
+    records for every scene (common random numbers) and whatever the chunking."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(RECORD_STREAM,
+                                                                         record)))
+
+
+def turbulence_box(settings, geometry, rng):
+    """A box of the scenario's turbulence holding every probe point of a record
+    (:func:`uq.physics.turbulencebox.box_for`), and the variance of u it keeps of the
+    model's point variance [1] (Mann: its discrete wavenumbers, ``box_variance``;
+    Kaimal: NaN, not computed: its box misses the frequencies below 1 / (its length /
+    U), which a record's high-pass partly keeps)."""
+    from uq.physics import turbulencebox
+    turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
+    model = turbulence_model(turbulence, speed)
+    if turbulence["model"] == "mann":
+        grid = turbulencebox.box_for(geometry, turbulence["length_scale"], "mann")
+        box = turbulencebox.mann_box(grid, model.alpha_epsilon, model.length_scale,
+                                     model.anisotropy, rng)
+        kept = turbulencebox.box_variance(grid, model.alpha_epsilon, model.length_scale,
+                                          model.anisotropy)[0] / (turbulence["intensity"]
+                                                                  * speed) ** 2
+        return box, float(kept)
+    scale = turbulence["length_scale"] / LENGTH_FACTORS_KAIMAL
+    grid = turbulencebox.box_for(geometry, scale, "kaimal")
+    return turbulencebox.kaimal_box(grid, turbulence["intensity"] * speed, speed, scale,
+                                    rng), np.nan
+
+
+def coherent_phases(scene, n_scans, scan_period, rng):
+    """The scene with every motion component's phase an input, and the unit phases
+    (n_scans, K, 2) that advance each component by ``w T_s`` from scan to scan: a
+    record's scans are consecutive in time. Random phases are drawn once per record
+    (uniform), fixed ones start at their value; None where the scan has no motion."""
+    import dataclasses
+    resolved = scene.time_resolved
+    if resolved is None or not resolved.motion.components:
+        return scene, None
+    components = resolved.motion.components
+    start = np.array([rng.uniform(0, 2 * np.pi) if c.phase is None else c.phase
+                      for c in components])
+    omega = np.array([c.angular_frequency for c in components])
+    phase = start + omega * scan_period * np.arange(n_scans)[:, None]     # (S, K)
+    free = tuple(dataclasses.replace(c, phase=None) for c in components)
+    motion = dataclasses.replace(resolved.motion, components=free)
+    scene = dataclasses.replace(scene, time_resolved=dataclasses.replace(resolved,
+                                                                         motion=motion))
+    return scene, np.stack([np.cos(phase), np.sin(phase)], axis=-1)
+
+
+def scan_errors(settings, scene, n_scans, rng):
+    """The declared errors of each scan of a record (n_scans trials, drawn independently
+    scan by scan from ``rng``), the motion's phases apart."""
+    from uq.engine.inputs import input_set
+    from uq.pipeline.modelsetup import error_inputs
+    inputs = {name: spec for name, spec in error_inputs(
+        settings, scene.n_beams, len(scene.ranges)).items() if name not in PHASE_INPUTS}
+    layout = input_set(inputs)
+    values = layout.values(rng.standard_normal((n_scans, layout.dimension)))
+    values.update(layout.constants)
+    return values
+
+
+def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True, radial=False):
+    """One record: the per-scan horizontal speed [m s-1] at each gate (n_scans, n_gates),
+    the field's u at the reference point once a scan (n_scans,) [m s-1] (mean speed
+    included) and the u-variance fraction the box keeps [1]; with `radial` also the
+    corrected radial velocities (n_scans, n_beams, n_gates) [m s-1] (a fourth item).
+
+    The turbulence's radial velocity at the nominal probe points and beam times
+    (:func:`uq.physics.turbulencesampling.record_radial_velocities`) enters the
+    measurement model as an additive radial velocity per beam and gate, as the radial
+    noise does; the scenario's motion, INS errors and correction act as in a single
+    scan. The probe points are not moved by the platform's motion (its displacement,
+    ~1 m, is small against the eddies that carry the variance, L ~ 30 m).
+    """
+    from uq.physics import turbulencesampling
+    from uq.physics.measurement import measurement_model
+    from uq.pipeline.modelsetup import scene_from_settings
+    box, kept = turbulence_box(settings, geometry, rng)
+    seen = np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans))
+    times = turbulencesampling.scan_times(geometry, n_scans)
+    reference = np.asarray(turbulencesampling.reference_series(box, geometry.speed, times))
+    del box
+    scene = probe_volume_resolved(scene_from_settings(settings))
+    scene, phases = coherent_phases(scene, n_scans, geometry.scan_period, rng)
+    errors = scan_errors(settings, scene, n_scans, rng)
+    errors["lidar_radial_velocity"] = errors.get("lidar_radial_velocity", 0.0) + seen
+    if phases is not None:
+        errors["motion_phases"] = phases
+    outputs = ("wind_speed", "radial_velocity") if radial else ("wind_speed",)
+    result = measurement_model(scene, outputs, compiled=compiled, **errors)
+    speed = np.real(result["wind_speed"]).reshape(n_scans, -1)
+    found = (speed, geometry.speed + reference[:, 0], kept)
+    if radial:
+        found += (np.real(result["radial_velocity"]).reshape(n_scans, scene.n_beams, -1),)
+    return found
+
+
+def probe_volume_resolved(scene):
+    """The scene with its probe's node count chosen (:func:`uq.physics.probe.resolve`)."""
+    from uq.physics import probe
+    return probe.resolve(scene)
+
+
+def monte_carlo_variables(scenes, truth, seed, compiled, spectral):
+    """The Monte Carlo records of each scene (``record.count`` records, the same random
+    streams for every scene), reduced per record as a lidar's software reduces it (the
+    record's mean and sample standard deviation of Vh), then over the records.
+
+    ``turbulence_intensity_mc_*``: mean, standard deviation and 95 % interval (the 2.5 %
+    and 97.5 % quantiles, probabilistically symmetric, JCGM 101 7.7) over the records of
+    ``std(Vh) / mean(Vh)``. ``turbulence_intensity_true_mc_mean``: the mean over the records
+    of the field's ``std(u) / mean(u)`` at the reference point, sampled once a scan.
+    ``wind_speed_record_bias`` and ``_u``: mean and standard deviation over the records of
+    the record's mean Vh minus the true mean (``wind_speed_true`` at the gate plus the
+    record's mean u' at the reference point). ``turbulence_intensity_spectral_z``: the
+    spectral expected variance against the records' mean variance, in standard errors
+    of that mean (clause 8 in spirit: the spectral path is validated where |z| <= 2,
+    ``turbulence_intensity_spectral_valid``); ``turbulence_intensity_box_kept``: the
+    u-variance the box keeps of the model's (where the two paths part by design).
+    """
+    records = [scene["record"] for scene in scenes]
+    count = records[0]["count"]
+    n_gates = truth.shape[1]
+    apparent = np.full((len(scenes), count, n_gates), np.nan)
+    true_ti = np.full((len(scenes), count), np.nan)
+    error = np.full((len(scenes), count, n_gates), np.nan)
+    kept = np.full(len(scenes), np.nan)
+    for i, settings in enumerate(scenes):
+        if not settings["wind"]["speed"] > 0:
+            continue
+        geometry = scan_geometry(settings)
+        n_scans = scans_per_record(settings)
+        for r in range(count):
+            vh, reference, kept[i] = monte_carlo_record(settings, geometry, n_scans,
+                                                        record_generator(seed, r), compiled)
+            apparent[i, r] = vh.std(axis=0, ddof=1) / vh.mean(axis=0)
+            true_ti[i, r] = reference.std(ddof=1) / reference.mean()
+            error[i, r] = vh.mean(axis=0) - truth[i] - (reference.mean() - settings["wind"]["speed"])
+    squares = apparent ** 2
+    z = (spectral ** 2 - squares.mean(axis=1)) / (squares.std(axis=1, ddof=1) / np.sqrt(count))
+    low, high = np.quantile(apparent, [0.025, 0.975], axis=1)
+    return {
+        "turbulence_intensity_mc_mean": (("scene", "range"), apparent.mean(axis=1)),
+        "turbulence_intensity_mc_u": (("scene", "range"), apparent.std(axis=1, ddof=1)),
+        "turbulence_intensity_mc_low": (("scene", "range"), low),
+        "turbulence_intensity_mc_high": (("scene", "range"), high),
+        "turbulence_intensity_true_mc_mean": (("scene",), true_ti.mean(axis=1)),
+        "turbulence_intensity_spectral_z": (("scene", "range"), z),
+        "turbulence_intensity_spectral_valid": (("scene", "range"), np.abs(z) <= VALID_Z),
+        "turbulence_intensity_box_kept": (("scene",), kept),
+        "wind_speed_record_bias": (("scene", "range"), error.mean(axis=1)),
+        "wind_speed_record_u": (("scene", "range"), error.std(axis=1, ddof=1)),
+    }
