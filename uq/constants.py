@@ -398,6 +398,18 @@ MANN_ANISOTROPY = 3.9
 #: Kaimal's longitudinal integral length L_u over Lambda_1 [1]: L_u = 8.1 Lambda_1 =
 #: 340.2 m above 60 m. IEC 61400-1 Ed. 3 (2005), Annex B, Table B.1.
 KAIMAL_LENGTH_FACTOR = 8.1
+#: Kaimal integral scales L_k of (u, v, w) over Lambda_1 [1] and standard deviations of
+#: (u, v, w) over sigma_u [1]. IEC 61400-1 Ed. 3 (2005), Annex B, Table B.1.
+IEC_KAIMAL_LENGTH_FACTORS = (KAIMAL_LENGTH_FACTOR, 2.7, 0.66)
+IEC_KAIMAL_SIGMA_RATIOS = (1.0, 0.8, 0.5)
+#: The exponential coherence exp(-a sqrt((f r / V)^2 + (b r / L_c)^2)): decrement a = 12
+#: [1], b = 0.12 [1], L_c = 8.1 Lambda_1 (ratio [1]). IEC 61400-1 Ed. 3 (2005), Annex B,
+#: Eq. B.13.
+IEC_COHERENCE_DECREMENT = 12.0
+IEC_COHERENCE_SCALE_RATIO = 0.12
+IEC_COHERENCE_LENGTH_FACTOR = 8.1
+#: Mann's length scale above 60 m [m]: 0.8 x 42 m = 33.6 m (IEC 61400-1 Ed. 3, Annex B).
+MANN_LENGTH_SCALE_IEC = MANN_LENGTH_FACTOR * IEC_SCALE_PARAMETER
 #: Largest turbulence intensity a scenario accepts [1]: sigma_u / U beyond 0.5 breaks
 #: Taylor's frozen-turbulence hypothesis (it needs sigma_u << U; Willis and Deardorff
 #: 1976, J. Atmos. Sci. 33, 1530, find it holds to sigma_u / U ~ 0.5) that both paths use.
@@ -437,25 +449,6 @@ TURBULENCE_PROBE_NODES = 48
 #: per probe kind (measured, see above).
 TURBULENCE_PROBE_REACH = {"pulsed": 70.0, "cw": 50.0}
 # --- Turbulence (issue 24) ------------------------------------------------------------
-
-#: Mann (1994) uniform-shear spectral tensor, the IEC 61400-1:2005 Annex B (B.2)
-#: parameters: length scale L = 0.8 Lambda_1 [m] and anisotropy Gamma [1], with the
-#: turbulence scale parameter Lambda_1 = 0.7 z below 60 m, 42 m above (IEC 61400-1:2005,
-#: 6.3.1, Eq. 5). Mann, J. (1994). J. Fluid Mech. 273:141-168.
-IEC_TURBULENCE_SCALE_PARAMETER = 42.0
-MANN_LENGTH_SCALE_IEC = 0.8 * IEC_TURBULENCE_SCALE_PARAMETER
-MANN_ANISOTROPY_IEC = 3.9
-
-#: Kaimal spectra of IEC 61400-1:2005 Annex B, Table B.1: integral scales L_k of u, v, w
-#: in units of Lambda_1 [1] and standard deviations sigma_v / sigma_u, sigma_w / sigma_u [1].
-KAIMAL_LENGTH_RATIOS_IEC = (8.1, 2.7, 0.66)
-KAIMAL_SIGMA_RATIOS_IEC = (1.0, 0.8, 0.5)
-
-#: IEC 61400-1:2005 Annex B, exponential coherence model: exp(-a sqrt((f r / V)^2 +
-#: (b r / L_c)^2)) with a = 12 [1], b = 0.12 [1] and L_c = 8.1 Lambda_1 (ratio [1]).
-IEC_COHERENCE_DECREMENT = 12.0
-IEC_COHERENCE_OFFSET = 0.12
-IEC_COHERENCE_LENGTH_RATIO = 8.1
 
 #: Von Karman energy spectrum's exponent 17/6 [1], also the second parameter of Mann's
 #: eddy lifetime 2F1(1/3, 17/6; 4/3; -(kL)^-2): Mann (1994), Sec. 3 (a property of the
@@ -505,27 +498,6 @@ CELL_AVERAGE_K1_NODES = 3
 CELL_AVERAGE_GRADING = (0.25, 6)
 
 # --- Turbulence spectra (issue 24) ----------------------------------------------------------
-
-#: IEC 61400-1:2005 (Ed. 3) Annex B, Eq. B.1 (Ed. 4, 2019: Annex C): the turbulence scale
-#: parameter Lambda_1 [m] is 0.7 z below 60 m and 42 m above (hub height z).
-IEC_SCALE_SLOPE = 0.7
-IEC_SCALE_HEIGHT = 60.0
-IEC_SCALE_MAX = 42.0
-
-#: IEC 61400-1:2005 Annex B.1 (Mann uniform-shear model): Gamma = 3.9 [1] and the length
-#: scale L = 0.8 Lambda_1 [m] (33.6 m above 60 m).
-IEC_MANN_ANISOTROPY = 3.9
-IEC_MANN_LENGTH_FACTOR = 0.8
-
-#: IEC 61400-1:2005 Annex B.2, Table B.1 (Kaimal): integral scale parameters L_k =
-#: (8.1, 2.7, 0.66) Lambda_1 [m] and standard deviations (1, 0.8, 0.5) sigma_1 [1] of
-#: (u, v, w); the exponential coherence's decrement 12 and scale L_c = 8.1 Lambda_1
-#: (Eq. B.13: Coh = exp(-12 sqrt((f r / V)^2 + (0.12 r / L_c)^2))).
-IEC_KAIMAL_LENGTH_FACTORS = (8.1, 2.7, 0.66)
-IEC_KAIMAL_SIGMA_RATIOS = (1.0, 0.8, 0.5)
-IEC_COHERENCE_DECREMENT = 12.0
-IEC_COHERENCE_SCALE_RATIO = 0.12
-IEC_COHERENCE_LENGTH_FACTOR = 8.1
 
 #: Quadrature of the spectral path (:class:`uq.physics.spectraltensor.WavenumberGrid`),
 #: tested for convergence in tests/physics/test_spectraltensor.py: k1 L from 1e-6 to 1e6

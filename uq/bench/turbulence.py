@@ -58,9 +58,9 @@ def _box(model, grid, seed, xp, workers):
     rng = np.random.default_rng(seed)
     if model == "mann":
         return turbulencebox.mann_box(grid, ALPHA_EPSILON, constants.MANN_LENGTH_SCALE_IEC,
-                                      constants.MANN_ANISOTROPY_IEC, rng, xp=xp, workers=workers)
+                                      constants.MANN_ANISOTROPY, rng, xp=xp, workers=workers)
     return turbulencebox.kaimal_box(grid, KAIMAL_SIGMA_U, SPEED,
-                                    constants.IEC_TURBULENCE_SCALE_PARAMETER, rng, xp=xp)
+                                    constants.IEC_SCALE_PARAMETER, rng, xp=xp)
 
 
 def one_record(seed=0, device="cpu", workers=None, model="mann"):
@@ -72,7 +72,7 @@ def one_record(seed=0, device="cpu", workers=None, model="mann"):
     clock = time.process_time if xp is np else time.perf_counter
     geometry = dbs_geometry()
     scale = (constants.MANN_LENGTH_SCALE_IEC if model == "mann"
-             else constants.IEC_TURBULENCE_SCALE_PARAMETER)
+             else constants.IEC_SCALE_PARAMETER)
     grid = turbulencebox.box_for(geometry, scale, model=model)
     n_scans = int(RECORD / geometry.scan_period)
     start = clock()

@@ -59,8 +59,8 @@ from scipy import special
 
 from uq.constants import (IEC_COHERENCE_DECREMENT, IEC_COHERENCE_LENGTH_FACTOR,
                           IEC_COHERENCE_SCALE_RATIO, IEC_KAIMAL_LENGTH_FACTORS,
-                          IEC_KAIMAL_SIGMA_RATIOS, IEC_MANN_ANISOTROPY, IEC_MANN_LENGTH_FACTOR,
-                          IEC_SCALE_HEIGHT, IEC_SCALE_MAX, IEC_SCALE_SLOPE,
+                          IEC_KAIMAL_SIGMA_RATIOS, MANN_ANISOTROPY, MANN_LENGTH_FACTOR,
+                          IEC_SCALE_HEIGHT, IEC_SCALE_PARAMETER, IEC_SCALE_SLOPE,
                           SPECTRAL_ANGLE_NODES, SPECTRAL_K1_PER_DECADE, SPECTRAL_K_DECADES,
                           SPECTRAL_RADIUS_DECADES, SPECTRAL_RADIUS_PER_DECADE)
 
@@ -71,12 +71,12 @@ TURBULENCE_MODELS = ("mann", "kaimal")
 def iec_scale_parameter(height):
     """Turbulence scale parameter Lambda_1 [m] at hub `height` [m], IEC 61400-1 Eq. (B.1) [3]."""
     return np.where(np.asarray(height) <= IEC_SCALE_HEIGHT, IEC_SCALE_SLOPE * height,
-                    IEC_SCALE_MAX)
+                    IEC_SCALE_PARAMETER)
 
 
 def iec_mann_parameters(height):
     """IEC 61400-1 Annex B.1 defaults (L [m], Gamma [1]) of the Mann model at `height` [m]."""
-    return IEC_MANN_LENGTH_FACTOR * float(iec_scale_parameter(height)), IEC_MANN_ANISOTROPY
+    return MANN_LENGTH_FACTOR * float(iec_scale_parameter(height)), MANN_ANISOTROPY
 
 
 def von_karman_energy(k, length_scale, alpha_epsilon=1.0):

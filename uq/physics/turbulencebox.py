@@ -521,7 +521,7 @@ def iec_coherence(separation, frequency, speed, coherence_length):
     ``coherence_length`` L_c [m].
     """
     r, f = np.asarray(separation, dtype=float), np.asarray(frequency, dtype=float)
-    a, b = constants.IEC_COHERENCE_DECREMENT, constants.IEC_COHERENCE_OFFSET
+    a, b = constants.IEC_COHERENCE_DECREMENT, constants.IEC_COHERENCE_SCALE_RATIO
     return np.exp(-a * np.sqrt((f * r / speed) ** 2 + (b * r / coherence_length) ** 2))
 
 
@@ -557,9 +557,9 @@ def kaimal_box(grid, sigma_u, speed, scale_parameter, rng, xp=np,
     separation = np.linalg.norm(points[:, None] - points[None], axis=-1)
     k1 = 2.0 * np.pi * np.fft.rfftfreq(nx, dx)
     frequency = speed * k1 / (2.0 * np.pi)
-    lengths = np.multiply(constants.KAIMAL_LENGTH_RATIOS_IEC, scale_parameter)
-    sigmas = np.multiply(constants.KAIMAL_SIGMA_RATIOS_IEC, sigma_u)
-    coherence_length = constants.IEC_COHERENCE_LENGTH_RATIO * scale_parameter
+    lengths = np.multiply(constants.IEC_KAIMAL_LENGTH_FACTORS, scale_parameter)
+    sigmas = np.multiply(constants.IEC_KAIMAL_SIGMA_RATIOS, sigma_u)
+    coherence_length = constants.IEC_COHERENCE_LENGTH_FACTOR * scale_parameter
     check_kaimal_points(ny * nz)
     fft = _fft(xp)
     noise = white_noise(rng, (3, nx, ny, nz), xp)
