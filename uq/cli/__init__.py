@@ -1,5 +1,5 @@
 """Command line: ``uq run``, ``uq check``, ``uq list``, ``uq plot``, ``uq report``,
-``uq export``, ``uq bench``, ``uq fit``, ``uq golden``, ``uq --version``; one module per
+``uq export``, ``uq bench``, ``uq fit``, ``uq golden``, ``uq warmup``, ``uq --version``; one module per
 subcommand.
 
 The command line dispatches; it computes nothing. Each subcommand module adds its
@@ -13,13 +13,15 @@ allowed; no traceback; no output file); 1 anything else; 130 interrupted (Ctrl-C
 import sys
 
 from uq._version import __version__
-from uq.cli import bench, check, export, fit, golden, listing, plot, report, run
+from uq.cli import bench, check, export, fit, golden, listing, plot, report, run, warmup
 from uq.cli.common import (EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK,  # noqa: F401
                            EXIT_TERMINATED, Parser, add_common_options, configure_logging,
                            interrupted_status, parse_overrides, stop_on_sigterm)
 from uq.errors import InputError
 
-SUBCOMMANDS = (run, check, listing, plot, report, export, bench, fit, golden)
+SUBCOMMANDS = (run, check, listing, plot, report, export, bench, fit, golden, warmup)
+#: Commands that may compile numba kernels: they say so on stderr (uq.cli.compiling).
+COMPILING = ("run", "plot", "report", "bench", "fit", "golden", "warmup")
 
 
 def build_parser():
@@ -44,6 +46,9 @@ def main(argv=None):
             parser.print_help(sys.stderr)
             return EXIT_BAD_INPUT
         configure_logging(args)
+        if args.command in COMPILING:            # say when numba compiles (imports numba)
+            from uq.cli import compiling
+            args.compile_notice = compiling.notice(args)
         with stop_on_sigterm():
             return args.handler(args)
     except InputError as error:
