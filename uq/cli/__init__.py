@@ -10,6 +10,7 @@ Exit status: 0 success; 2 bad input (one line naming the file, the key and what 
 allowed; no traceback; no output file); 1 anything else; 130 interrupted (Ctrl-C);
 143 terminated (SIGTERM: a batch system's time limit), cleaned up as after Ctrl-C.
 """
+import contextlib
 import sys
 
 from uq._version import __version__
@@ -46,10 +47,7 @@ def main(argv=None):
             parser.print_help(sys.stderr)
             return EXIT_BAD_INPUT
         configure_logging(args)
-        if args.command in COMPILING:            # say when numba compiles (imports numba)
-            from uq.cli import compiling
-            args.compile_notice = compiling.notice(args)
-        with stop_on_sigterm():
+        with stop_on_sigterm(), _compile_notice(args):
             return args.handler(args)
     except InputError as error:
         print(f"uq: error: {error}", file=sys.stderr)
@@ -59,6 +57,18 @@ def main(argv=None):
         print(f"\nuq: {'terminated' if status == EXIT_TERMINATED else 'interrupted'}",
               file=sys.stderr)
         return status
+
+
+@contextlib.contextmanager
+def _compile_notice(args):
+    """Say on stderr when the command compiles numba kernels (uq.cli.compiling; imports
+    numba: only for the commands that may compile)."""
+    if args.command not in COMPILING:
+        yield
+        return
+    from uq.cli import compiling
+    with compiling.notice(args) as args.compile_notice:
+        yield
 
 
 if __name__ == "__main__":

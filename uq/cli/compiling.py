@@ -16,6 +16,8 @@ import time
 #: What the first line says, once per process.
 FIRST_LINE = ("uq: compiling kernels into numba's cache (once after an install; "
               "`uq warmup` compiles them all ahead)")
+#: How every line of the notice starts (tests tell it from other output by this).
+PREFIX = "uq: compiling"
 
 
 class CompileNotice:
@@ -23,11 +25,11 @@ class CompileNotice:
 
     Parameters
     ----------
-    stream : file, optional
-        Where the lines go (default stderr); None prints nothing but still counts.
+    stream : file or None
+        Where the lines go; None prints nothing but still counts.
     """
 
-    def __init__(self, stream=sys.stderr):
+    def __init__(self, stream):
         self.stream = stream
         self.seconds = 0.0              # wall time of the top-level compiles [s]
         self.kernels = 0                # top-level compiles
@@ -45,8 +47,20 @@ class CompileNotice:
 
             def on_end(self, item):
                 listener._end(item)
-        event.register("numba:compile", _Listener())
+        self._listener = _Listener()
+        event.register("numba:compile", self._listener)
         return self
+
+    def remove(self):
+        """Unregister from numba (a command's notice ends with the command)."""
+        from numba.core import event
+        event.unregister("numba:compile", self._listener)
+
+    def __enter__(self):
+        return self.install()
+
+    def __exit__(self, *exc):
+        self.remove()
 
     def _start(self, item):
         depth = getattr(self._local, "depth", 0)
@@ -57,7 +71,7 @@ class CompileNotice:
                 if not self._told:
                     print(FIRST_LINE, file=self.stream, flush=True)
                     self._told = True
-                print(f"  {kernel_name(item.data)} ...", end="", file=self.stream,
+                print(f"{PREFIX} {kernel_name(item.data)} ...", end="", file=self.stream,
                       flush=True)
 
     def _end(self, item):
@@ -82,6 +96,6 @@ def kernel_name(data):
 
 
 def notice(args):
-    """A CompileNotice for a command's `args` (silent with --quiet), installed."""
-    quiet = getattr(args, "quiet", False)
-    return CompileNotice(None if quiet else sys.stderr).install()
+    """A CompileNotice for a command's `args` on stderr (silent with --quiet), to be
+    used as a context manager around the command."""
+    return CompileNotice(None if getattr(args, "quiet", False) else sys.stderr)
