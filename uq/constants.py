@@ -372,3 +372,109 @@ MOTION_BLOCK_VALUES = 2**15
 #: ~20 us) stays below ~1 % of a block's time for any scan; at most 2^11, beyond which a
 #: larger block gains nothing (measured on a 5-beam DBS scan, scripts/bench_motion.py).
 MOTION_BLOCK_TRIALS = (64, 2**11)
+
+# --- Turbulence (issue 24) ------------------------------------------------------------
+
+#: Mann (1994) uniform-shear spectral tensor, the IEC 61400-1:2005 Annex B (B.2)
+#: parameters: length scale L = 0.8 Lambda_1 [m] and anisotropy Gamma [1], with the
+#: turbulence scale parameter Lambda_1 = 0.7 z below 60 m, 42 m above (IEC 61400-1:2005,
+#: 6.3.1, Eq. 5). Mann, J. (1994). J. Fluid Mech. 273:141-168.
+IEC_TURBULENCE_SCALE_PARAMETER = 42.0
+MANN_LENGTH_SCALE_IEC = 0.8 * IEC_TURBULENCE_SCALE_PARAMETER
+MANN_ANISOTROPY_IEC = 3.9
+
+#: Kaimal spectra of IEC 61400-1:2005 Annex B, Table B.1: integral scales L_k of u, v, w
+#: in units of Lambda_1 [1] and standard deviations sigma_v / sigma_u, sigma_w / sigma_u [1].
+KAIMAL_LENGTH_RATIOS_IEC = (8.1, 2.7, 0.66)
+KAIMAL_SIGMA_RATIOS_IEC = (1.0, 0.8, 0.5)
+
+#: IEC 61400-1:2005 Annex B, exponential coherence model: exp(-a sqrt((f r / V)^2 +
+#: (b r / L_c)^2)) with a = 12 [1], b = 0.12 [1] and L_c = 8.1 Lambda_1 (ratio [1]).
+IEC_COHERENCE_DECREMENT = 12.0
+IEC_COHERENCE_OFFSET = 0.12
+IEC_COHERENCE_LENGTH_RATIO = 8.1
+
+#: Von Karman energy spectrum's exponent 17/6 [1], also the second parameter of Mann's
+#: eddy lifetime 2F1(1/3, 17/6; 4/3; -(kL)^-2): Mann (1994), Sec. 3 (a property of the
+#: spectrum, E ~ k^4 at small k and k^(-5/3) at large k, not a tunable).
+VON_KARMAN_EXPONENT = 17.0 / 6.0
+
+#: Nodes per decade of the tabulated eddy lifetime (log-linear interpolation of
+#: beta(kL) between nodes; the interpolation's relative error is 3.4e-6 at 200 per
+#: decade, tested below 1e-5) and the kL range of the table [1]; outside it the exact asymptotes
+#: (kL)^-1 and (kL)^-2/3 hold to < 1e-8 (tested).
+EDDY_LIFETIME_TABLE_PER_DECADE = 200
+EDDY_LIFETIME_TABLE_RANGE = (1e-4, 1e4)
+
+#: Most cells of a generated turbulence box [1]: the FFT generator holds the three
+#: components in float64 plus their half spectra (~ 3 x 8 + 3 x 8 + a 9-entry factor of
+#: one slab) bytes per cell, ~1 GB at 2^24 cells, the memory a 2-core machine shared
+#: with others can give one record. Boxes above it are refused (box_for, mann_box).
+MAX_BOX_CELLS = 2**24
+
+#: Cells of one slab of the spectral factor computed at a time [1]: nine float64 arrays
+#: of that size (2^20: 72 MB) bound the factor's memory whatever the box.
+BOX_SLAB_CELLS = 2**20
+
+#: Margin around the probe points of a periodic (Mann) box in each of y and z, in units
+#: of the length scale L on each side [1]: the box is then >= 6 L wide, and the variance
+#: its discrete wavenumbers keep is reported by turbulencebox.box_variance (tested).
+BOX_MARGIN_LENGTH_SCALES = 3.0
+
+#: Default cells per length scale of a box's spacing [1] (box_for: spacing L / 8, 4.2 m
+#: at IEC's L = 33.6 m): a pulsed lidar's probe (~25-30 m) spans 6-7 cells; the variance
+#: the box's resolution keeps is what box_variance reports (tested).
+BOX_DEFAULT_CELLS_PER_LENGTH = 8.0
+
+#: Probe-quadrature points sampled at a time in a record (turbulencesampling) [1]: each
+#: point holds ~ 8 corners x 3 components of float64 temporaries, so 2^18 points keep a
+#: chunk's memory near 50 MB; records do not depend on it.
+SAMPLING_CHUNK_POINTS = 2**18
+
+#: Cell averaging of the Mann tensor near the k1 axis (turbulencebox.cell_averaged_factors)
+#: [1]: cells with |k1| <= CELL_AVERAGE_K1 max(dk2, dk3), beyond which the tensor varies
+#: across a cell on scales >= the cell (point values suffice; the variance's change from
+#: doubling it is tested); Gauss nodes along k1; the graded rule's panel ratio and number
+#: of panels per side (down to 4^-6 = 1/4096 of a half cell, below dk1 / dk2 of any box
+#: within the cell limit's aspect ratios).
+CELL_AVERAGE_K1 = 4.0
+CELL_AVERAGE_K1_NODES = 3
+CELL_AVERAGE_GRADING = (0.25, 6)
+
+# --- Turbulence spectra (issue 24) ----------------------------------------------------------
+
+#: IEC 61400-1:2005 (Ed. 3) Annex B, Eq. B.1 (Ed. 4, 2019: Annex C): the turbulence scale
+#: parameter Lambda_1 [m] is 0.7 z below 60 m and 42 m above (hub height z).
+IEC_SCALE_SLOPE = 0.7
+IEC_SCALE_HEIGHT = 60.0
+IEC_SCALE_MAX = 42.0
+
+#: IEC 61400-1:2005 Annex B.1 (Mann uniform-shear model): Gamma = 3.9 [1] and the length
+#: scale L = 0.8 Lambda_1 [m] (33.6 m above 60 m).
+IEC_MANN_ANISOTROPY = 3.9
+IEC_MANN_LENGTH_FACTOR = 0.8
+
+#: IEC 61400-1:2005 Annex B.2, Table B.1 (Kaimal): integral scale parameters L_k =
+#: (8.1, 2.7, 0.66) Lambda_1 [m] and standard deviations (1, 0.8, 0.5) sigma_1 [1] of
+#: (u, v, w); the exponential coherence's decrement 12 and scale L_c = 8.1 Lambda_1
+#: (Eq. B.13: Coh = exp(-12 sqrt((f r / V)^2 + (0.12 r / L_c)^2))).
+IEC_KAIMAL_LENGTH_FACTORS = (8.1, 2.7, 0.66)
+IEC_KAIMAL_SIGMA_RATIOS = (1.0, 0.8, 0.5)
+IEC_COHERENCE_DECREMENT = 12.0
+IEC_COHERENCE_SCALE_RATIO = 0.12
+IEC_COHERENCE_LENGTH_FACTOR = 8.1
+
+#: Quadrature of the spectral path (:class:`uq.physics.spectraltensor.WavenumberGrid`),
+#: tested for convergence in tests/physics/test_spectraltensor.py: k1 L from 1e-6 to 1e6
+#: and the polar radius rho / sqrt(k1^2 + L^-2) from 1e-5 to 1e4 (the sheared tensor keeps
+#: energy at rho << k1 for small k: 8e-4 of sigma_u^2 lies below 1e-3; the inertial tail
+#: beyond 1e6 holds (1e6)^(-2/3) = 1e-4); Gauss-Legendre nodes per decade of k1 and of
+#: rho; trapezoid nodes in the polar angle (periodic: spectral convergence).
+SPECTRAL_K_DECADES = (-6.0, 6.0)
+SPECTRAL_K1_PER_DECADE = 12
+SPECTRAL_RADIUS_DECADES = (-5.0, 4.0)
+SPECTRAL_RADIUS_PER_DECADE = 8
+SPECTRAL_ANGLE_NODES = 48
+#: Frequencies of the Kaimal path: f L_u / U from 1e-5 to 1e5 [1], nodes per decade.
+KAIMAL_FREQUENCY_DECADES = (-5.0, 5.0)
+KAIMAL_FREQUENCY_PER_DECADE = 40

@@ -17,7 +17,9 @@ QUANTITIES = {"wind_speed": ("wind speed", "$V_h$", "m s$^{-1}$"),
               "wind_direction": ("wind direction", r"$\Theta$", "deg"),
               "vertical_wind": ("vertical wind", "$w$", "m s$^{-1}$"),
               "radial_velocity": ("radial velocity", "$v_r$", "m s$^{-1}$"),
-              "gate_height": ("gate height", "$z$", "m")}
+              "gate_height": ("gate height", "$z$", "m"),
+              "yaw_misalignment": ("yaw misalignment", r"$\gamma$", "deg"),
+              "shear_exponent": ("shear exponent", r"$\alpha$", "1")}
 #: The quantities a figure of a sweep shows, in this order, when the result has them.
 SWEEP_QUANTITIES = ("wind_speed", "wind_direction", "vertical_wind", "gate_height")
 #: Requested outputs with a value per beam: a figure of their own (one panel per beam).
@@ -30,7 +32,8 @@ KEY_WORDS = {"wind_direction": "wind direction", "wind_speed": "wind speed",
              "ship_heading": "ship heading", "ship_pitch": "pitch (bow up +)",
              "ship_roll": "roll (starboard down +)", "ship_heave": "heave velocity",
              "lidar_misalignment": "lidar misalignment", "lidar_half_cone": "half-cone angle",
-             "lidar_height": "lidar height", "range": "range gate (height above a level lidar)"}
+             "lidar_height": "lidar height", "range": "range gate (height above a level lidar)",
+             "preview": "preview distance along the boresight"}
 #: Units as the axes write them.
 UNIT_TEXT = {"degree": "deg", "m s-1": "m s$^{-1}$", "m": "m", "1": "1"}
 

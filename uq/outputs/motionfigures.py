@@ -6,7 +6,10 @@
   a sweep of ``wind.direction`` and ``motion.pitch.amplitude`` (or ``ship.pitch``);
 * :func:`correction_comparison`: scatter and bias of the horizontal wind speed (and the
   vertical wind) under each correction model of a ``correction`` sweep of a moving
-  platform: the Monte Carlo trials as histograms of the error, bias +- u beside them.
+  platform: the Monte Carlo trials as histograms of the error, bias +- u beside them;
+* :func:`uncertainty_against_preview`: with several range gates (a nacelle lidar's
+  preview distances), u of its hub-height wind speed, yaw misalignment and shear
+  exponent against them, per correction model.
 
 References
 ----------
@@ -95,8 +98,48 @@ def comparison_plan(dataset, dims):
     if tuple(dims) == ("correction",) and scenario.get("motion") and \
             dataset.attrs.get("sampling_method") not in (None, "none") and \
             "wind_speed_true" in dataset:
-        return [("motion_correction_comparison", correction_comparison)]
+        plan = [("motion_correction_comparison", correction_comparison)]
+        if dataset.sizes.get("range", 1) > 1 and any(
+                f"{q}_mc_u" in dataset for q in PREVIEW_QUANTITIES):
+            plan.append(("uncertainty_against_preview", uncertainty_against_preview))
+        return plan
     return []
+
+
+#: What a nacelle lidar's figure shows against the preview distance, with its unit.
+PREVIEW_QUANTITIES = {"wind_speed": ("u(hub-height wind speed)", "m s$^{-1}$"),
+                      "yaw_misalignment": ("u(yaw misalignment)", "deg"),
+                      "shear_exponent": ("u(shear exponent)", "1")}
+
+
+def uncertainty_against_preview(dataset):
+    """u of the hub-height wind speed, the yaw misalignment and the shear exponent against
+    the range gate (a nacelle lidar's preview distance), a colour per correction model:
+    Monte Carlo as markers, the GUM as dashed lines (log scale: the models differ by
+    orders of magnitude)."""
+    quantities = [q for q in PREVIEW_QUANTITIES if f"{q}_mc_u" in dataset]
+    figure, axes = plt.subplots(1, len(quantities), figsize=(4.4 * len(quantities), 3.8),
+                                constrained_layout=True, squeeze=False)
+    ranges = dataset["range"].values
+    for ax, q in zip(axes[0], quantities):
+        for c in [str(c) for c in dataset["correction"].values]:
+            colour = CORRECTION_COLOURS.get(c)
+            mc = dataset[f"{q}_mc_u"].sel(correction=c).values
+            ax.plot(ranges, mc, "o", color=colour, label=f"{c}: Monte Carlo")
+            if f"{q}_gum_u" in dataset:
+                ax.plot(ranges, dataset[f"{q}_gum_u"].sel(correction=c).values, "--",
+                        color=colour, lw=1.0, label=f"{c}: GUM")
+        words, unit = PREVIEW_QUANTITIES[q]
+        ax.set_yscale("log")
+        ax.set_xlabel("preview distance [m]")
+        ax.set_ylabel(f"{words} [{unit}]")
+        ax.grid(True, which="both", lw=0.3)
+    axes[0][0].legend(fontsize=8)
+    scenario = yaml.safe_load(dataset.attrs.get("scenario", "")) or {}
+    n = int(np.max(dataset["mc_n_samples"]))
+    figure.suptitle(f"{scenario.get('name', '')}: {_sea(scenario)}; {n} Monte Carlo scans "
+                    "per model", fontsize=9)
+    return figure
 
 
 def correction_comparison(dataset, n_max=HISTOGRAM_TRIALS):
@@ -142,9 +185,10 @@ def _sea(scenario):
         record = motion["series"]
         return (f"measured motion record {Path(str(record.get('file', ''))).name} "
                 f"({record.get('components', '')} harmonics kept, random window per scan)")
-    parts = [f"{dof} {spec['amplitude']:g} {HARMONIC_UNITS.get(dof, '')} at "
-             f"{spec['period']:g} s" for dof, spec in motion.items()
-             if isinstance(spec, dict) and "amplitude" in spec]
+    parts = [f"{dof} {one['amplitude']:g} {HARMONIC_UNITS.get(dof, '')} at "
+             f"{one['period']:g} s" for dof, spec in motion.items()
+             for one in (spec if isinstance(spec, list) else [spec])
+             if isinstance(one, dict) and "amplitude" in one]
     return "harmonic motion: " + ", ".join(parts) if parts else "motion"
 
 

@@ -9,6 +9,27 @@ A slanted beam with half-cone angle theta (from the lidar's vertical) and azimut
 in (bow, starboard, up). An optional vertical beam is (0, 0, 1). Radial velocity is
 positive away from the lidar: ``v_r = n . (u_wind - u_lidar)``.
 
+Tilted mount (``lidar.mount.tilt`` tau > 0, a nacelle lidar at tau = 90 deg)
+---------------------------------------------------------------------------
+The boresight d is tilted from the deck's vertical towards the bow by tau; the beams open
+by the half-cone alpha about d, at *clock positions* phi about it: 0 = up, 90 = starboard
+(to the right looking along the boresight), 180 = down, 270 = port, i.e. clockwise as
+seen looking along the boresight::
+
+    d = (sin tau, 0, cos tau),  e_up = (-cos tau, 0, sin tau),  e_starboard = (0, 1, 0)
+    n = Rz(m) [cos(alpha) d + sin(alpha) (cos(phi) e_up + sin(phi) e_starboard)]
+
+with the misalignment m turning the whole head about the deck's vertical (clockwise seen
+from above; at tau = 90 the boresight's azimuth from the bow). This frame is the upward
+(tau = 0) lidar's frame turned about the starboard axis by tau, with the clock position
+phi = 180 deg - (today's azimuth): today's azimuths run clockwise *seen from above*, i.e.
+counter-clockwise seen along an upward boresight, so the clock convention is their mirror
+image and no family of frames continuous in tau joins the two. ``tilt: 0`` keeps today's
+azimuths exactly (the contract: bit for bit); any tau > 0 reads them as clock positions.
+The range gates of a tilted mount are preview distances along the boresight, so the
+slant distance is ``range / cos(alpha)`` as for the upward lidar's heights
+(:func:`slant_distances`).
+
 References
 ----------
 .. [1] Rubio, H. and Gottschall, J. (2022). J. Phys.: Conf. Ser. 2362 012034.
@@ -16,7 +37,7 @@ References
 import numpy as np
 
 
-def beam_unit_vectors(half_cone, azimuths, misalignment=0.0, vertical_beam=False):
+def beam_unit_vectors(half_cone, azimuths, misalignment=0.0, vertical_beam=False, tilt=0.0):
     """Ship-frame unit vectors of the beams.
 
     Parameters
@@ -29,12 +50,20 @@ def beam_unit_vectors(half_cone, azimuths, misalignment=0.0, vertical_beam=False
         Angle from the bow to the reference beam, clockwise [rad].
     vertical_beam : bool
         Append a vertical beam (unaffected by half-cone and misalignment).
+    tilt : float
+        Mount tilt tau from the deck's vertical towards the bow [rad]; 0: today's upward
+        lidar (this function's first formula, bit for bit); > 0: `azimuths` are clock
+        positions about the tilted boresight (:func:`mounted_unit_vectors`).
 
     Returns
     -------
     ndarray, shape (..., n_beams, 3)
         Slanted beams first, in the order of `azimuths`, then the vertical beam.
     """
+    if tilt != 0:
+        if vertical_beam:
+            raise ValueError("a tilted mount has no vertical beam")
+        return mounted_unit_vectors(half_cone, azimuths, misalignment, tilt)
     half_cone = np.asarray(half_cone)[..., None]
     misalignment = np.asarray(misalignment)[..., None]
     azimuths = np.asarray(azimuths, dtype=float)
@@ -51,6 +80,40 @@ def beam_unit_vectors(half_cone, azimuths, misalignment=0.0, vertical_beam=False
         up[..., 2] = 1.0
         vectors = np.concatenate([vectors, up], axis=-2)
     return vectors
+
+
+def mounted_unit_vectors(half_cone, clock_positions, misalignment, tilt):
+    """Ship-frame unit vectors of a tilted mount's beams (module docstring).
+
+    Parameters
+    ----------
+    half_cone : array_like, shape (...)
+        Opening angle alpha from the boresight [rad].
+    clock_positions : array_like, shape (n_beams,)
+        phi about the boresight, 0 up, pi/2 starboard, pi down [rad].
+    misalignment : array_like, shape (...)
+        Turn of the head about the deck's vertical, clockwise seen from above [rad].
+    tilt : float
+        tau, boresight from the deck's vertical towards the bow [rad].
+
+    Returns
+    -------
+    ndarray, shape (..., n_beams, 3)
+        (bow, starboard, up).
+    """
+    alpha = np.asarray(half_cone)[..., None]
+    m = np.asarray(misalignment)[..., None]
+    phi = np.asarray(clock_positions, dtype=float)
+    cos_a, sin_a = np.cos(alpha), np.sin(alpha)
+    sin_t, cos_t = np.sin(tilt), np.cos(tilt)
+    # n = cos(a) d + sin(a) (cos(phi) e_up + sin(phi) e_starboard) in the unturned head
+    bow = cos_a * sin_t - sin_a * np.cos(phi) * cos_t
+    starboard = sin_a * np.sin(phi)
+    up = cos_a * cos_t + sin_a * np.cos(phi) * sin_t
+    cos_m, sin_m = np.cos(m), np.sin(m)
+    # Rz(m), clockwise seen from above (uq.physics.rotation.rotation_about_vertical)
+    return np.stack(np.broadcast_arrays(cos_m * bow - sin_m * starboard,
+                                        sin_m * bow + cos_m * starboard, up + 0 * m), axis=-1)
 
 
 def least_squares_operator(unit_vectors):

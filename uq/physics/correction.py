@@ -112,7 +112,7 @@ def correction_ship_velocity(model, sog, cog, heave):
 
 
 def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navigation,
-                     nominal_heading=0.0):
+                     nominal_heading=0.0, horizontal_only=False):
     """Earth-frame wind from radial velocities under a correction model.
 
     Parameters
@@ -130,6 +130,10 @@ def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navig
         [rad], ``heave`` [m s-1]; k = 1 (scan) or n_beams (beam, point-wise).
     nominal_heading : float or ndarray
         Heading assumed by ``none`` [rad], broadcastable to the navigation arrays.
+    horizontal_only : bool
+        Two beams of a nacelle lidar: w = 0 assumed, the horizontal wind from the earth-
+        frame beams the model believes (:func:`uq.physics.nacelle.horizontal_least_squares`);
+        `operator` is not used. ``tilt2d`` (Eq. 13 on a 3-D DBS wind) is refused.
 
     Returns
     -------
@@ -156,6 +160,10 @@ def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navig
     rotation = correction_rotation(model, nav["heading"], nav["pitch"], nav["roll"],
                                    nominal_heading)
     ship = correction_ship_velocity(model, nav["sog"], nav["cog"], nav["heave"])
+    if horizontal_only:
+        if model == "tilt2d":
+            raise ValueError("tilt2d needs beams that determine the 3-D wind")
+        return _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship, True)
     if rotation.shape[-3] == 1 and ship.shape[-2] == 1:    # one reading for all beams
         return _scan_correction(radial_velocity, model, operator, rotation[..., 0, :, :],
                                 ship[..., 0, :])
@@ -222,7 +230,8 @@ def removed_velocity(model, velocity):
     return velocity * np.array([1.0, 1.0, 0.0])
 
 
-def pointwise_wind(radial_velocity, lidar_unit_vectors, rotation, ship_velocity):
+def pointwise_wind(radial_velocity, lidar_unit_vectors, rotation, ship_velocity,
+                   horizontal_only=False):
     """Least squares on point-wise corrected beams, each with its own reading (Matavar
     2024, Sec. 3.2 [2]).
 
@@ -235,18 +244,26 @@ def pointwise_wind(radial_velocity, lidar_unit_vectors, rotation, ship_velocity)
         Each beam's lidar-to-earth rotation as read.
     ship_velocity : ndarray, shape (..., b, 3)
         Each beam's lidar velocity as read [m s-1].
+    horizontal_only : bool
+        w = 0 assumed, the horizontal wind alone (a 2-beam nacelle lidar).
 
     Returns
     -------
     ndarray, shape (..., 3, g)
     """
-    return _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship_velocity)
+    return _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship_velocity,
+                                 horizontal_only)
 
 
-def _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship_velocity):
-    """Least squares on point-wise corrected beams, each with its own reading."""
+def _pointwise_correction(radial_velocity, lidar_unit_vectors, rotation, ship_velocity,
+                          horizontal_only=False):
+    """Least squares on point-wise corrected beams, each with its own reading (with
+    `horizontal_only`, w = 0 and the horizontal components alone)."""
     beams = (rotation @ lidar_unit_vectors[..., None])[..., 0]     # (..., b, 3)
     ship_along_beam = np.sum(beams * ship_velocity, axis=-1)       # (..., b)
     corrected = radial_velocity + ship_along_beam[..., None]       # (..., b, g)
+    if horizontal_only:
+        from uq.physics.nacelle import horizontal_least_squares
+        return horizontal_least_squares(beams, corrected)
     beams_t = np.swapaxes(beams, -1, -2)                           # (..., 3, b)
     return np.linalg.solve(beams_t @ beams, beams_t @ corrected)

@@ -78,6 +78,8 @@ def declined(scene, outputs, errors, scene_draws=False):
         return "a time-resolved scene"
     if scene.probe is not None:
         return "a probe volume"
+    if scene.tilt != 0:
+        return "a tilted mount (lidar.mount.tilt): the numpy model's clock-position beams"
     if not set(outputs) <= _OUTPUT_SET:
         return f"output(s) {', '.join(sorted(set(outputs) - _OUTPUT_SET))}"
     lacked = modelinputs.lacks(STATIC_COMPILED, errors)
@@ -102,6 +104,8 @@ def measurement_model(scene, outputs, scene_draws=False, **errors):
 def evaluate(scene, outputs, scene_draws, errors):
     """:func:`measurement_model` where :func:`applicable`, else None (one pass over the
     arguments for both: the model is called once per slice of ~2^13 trials)."""
+    if scene.tilt != 0:             # a tilted mount: the numpy model (declined)
+        return None
     prepared = _prepared(scene, outputs, errors, scene_draws)
     return None if prepared is None else _run(scene, outputs, scene_draws, *prepared)
 

@@ -69,6 +69,8 @@ def declined(scene, outputs, errors, scene_draws=False):
         return "a static scene"
     if scene.probe is not None:
         return "a probe volume"
+    if scene.tilt != 0:
+        return "a tilted mount (lidar.mount.tilt): the numpy model's clock-position beams"
     if not set(outputs) <= set(FUSED_OUTPUTS):
         return f"output(s) {', '.join(sorted(set(outputs) - set(FUSED_OUTPUTS)))}"
     lacked = modelinputs.lacks(MOTION_COMPILED, errors)

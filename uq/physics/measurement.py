@@ -53,7 +53,9 @@ from uq.physics.correction import correction_rotation, correction_ship_velocity,
 from uq.physics.rotation import attitude_matrix, rotate_vectors
 from uq.physics import modelinputs
 from uq.physics.modelinputs import STATIC, STATIC_COMPILED
-from uq.physics.scene import ANGULAR_NAVIGATION, NAVIGATION, OUTPUTS, sample_count
+from uq.physics import nacelle
+from uq.physics.scene import (ANGULAR_NAVIGATION, NACELLE_OUTPUTS, NAVIGATION, OUTPUTS,
+                              sample_count)
 
 def true_wind(scene, heights, trailing=1):
     """True wind (north, east, up) [m s-1] at `heights` [m] of shape (..., *S, *T) with
@@ -174,9 +176,10 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
            for name in modelinputs.names(STATIC)}
     measured, navigation, beams_earth = _measure(scene, err, (n,) + scenes)
     unit_vectors = scene.nominal_unit_vectors()
-    operator = least_squares_operator(unit_vectors)
+    operator = None if scene.horizontal_only else least_squares_operator(unit_vectors)
     wind_vector = reconstruct_wind(measured, scene.correction, unit_vectors, operator,
-                                   navigation, scene.field("heading", 1))
+                                   navigation, scene.field("heading", 1),
+                                   horizontal_only=scene.horizontal_only)
     result = _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors)
     if "gate_height" in outputs:
         result["gate_height"] = _gate_height(scene, beams_earth, err["lidar_height"])
@@ -215,7 +218,7 @@ def _measure(scene, err, batch):
     half_cone = scene.half_cone + complexstep.radians(err["lidar_half_cone"]) + zero
     misalignment = scene.misalignment + complexstep.radians(err["lidar_misalignment"]) + zero
     true_beams = beam_unit_vectors(half_cone, np.asarray(scene.azimuths), misalignment,
-                                   scene.vertical_beam)                    # ([n], *S, b, 3)
+                                   scene.vertical_beam, scene.tilt)        # ([n], *S, b, 3)
     attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)    # (*S, 3, 3)
     beams_earth = rotate_vectors(attitude, true_beams)
     probe_errors = {key: _trailing(err[f"lidar_{key}"], 2) for key in PROBE_ERRORS}
@@ -250,21 +253,36 @@ def _ship_velocity(scene):
 
 
 def _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors):
+    nacelle_wanted = set(outputs) & set(NACELLE_OUTPUTS)
+    pair = nacelle.level_pair(scene.azimuths) if scene.tilt != 0 and \
+        not scene.horizontal_only else None
+    if "radial_velocity" in outputs or nacelle_wanted or pair:
+        corrected, beams = _corrected_radial(scene, measured, navigation, unit_vectors)
+    if pair:                   # a nacelle lidar's hub-height wind: its level beams'
+        wind_vector = nacelle.hub_height_wind(wind_vector, beams, corrected, pair)
     result = wind.wind_outputs(wind_vector, outputs)
     if "radial_velocity" in outputs:
-        result["radial_velocity"] = _corrected_radial(scene, measured, navigation,
-                                                      unit_vectors)
+        result["radial_velocity"] = corrected
+    if nacelle_wanted:
+        slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
+                                scene.vertical_beam)                    # (*S, b, g)
+        heights = scene.field("lidar_height", 2) + slant * beams[..., 2:3]  # believed
+        result.update(nacelle.nacelle_outputs(
+            outputs, wind_vector, result, scene.field("heading", 1), beams, corrected,
+            heights, nacelle.upper_lower(scene.azimuths)))
     return result
 
 
 def _corrected_radial(scene, measured, navigation, unit_vectors):
-    """Radial velocity freed of the believed ship motion, along the believed beam."""
+    """Radial velocity freed of the believed ship motion, along the believed beam, and
+    the believed earth-frame beams (n, *S, b, 3)."""
     nav = navigation
     rotation = correction_rotation(scene.correction, nav["heading"], nav["pitch"],
                                    nav["roll"], scene.field("heading", 1))
     ship = correction_ship_velocity(scene.correction, nav["sog"], nav["cog"], nav["heave"])
     beams = (rotation @ unit_vectors[..., None])[..., 0]               # (n, *S, k|b, 3)
-    return measured + np.sum(beams * ship, axis=-1)[..., None]
+    corrected = measured + np.sum(beams * ship, axis=-1)[..., None]
+    return corrected, np.broadcast_to(beams, corrected.shape[:-1] + (3,))
 
 
 def true_values(scene, outputs=OUTPUTS):
@@ -290,6 +308,11 @@ def true_values(scene, outputs=OUTPUTS):
              "wind_speed": wind.wind_speed(north, east),
              "wind_direction": wind.wind_direction(north, east),
              "vertical_wind": wind_vector[..., 2]}
+    if "yaw_misalignment" in outputs:       # the wind's direction from the rotor axis
+        truth["yaw_misalignment"] = nacelle.yaw_misalignment(truth["wind_direction"],
+                                                             scene.field("heading", 1))
+    if "shear_exponent" in outputs:         # the power law's exponent of the scene
+        truth["shear_exponent"] = scene.field("shear", 1) + 0.0 * north
     if "radial_velocity" in outputs:
         attitude = attitude_matrix(scene.heading, scene.pitch, scene.roll)
         beams_earth = scene.nominal_unit_vectors() @ np.swapaxes(attitude, -1, -2)

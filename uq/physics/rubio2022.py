@@ -273,7 +273,8 @@ def rubio2022_domain_mask(scene):
     -------
     ndarray of bool, shape S
     """
-    if _beam_order(scene) is None or scene.correction not in ("yaw", "tilt2d"):
+    if _beam_order(scene) is None or scene.correction not in ("yaw", "tilt2d") \
+            or getattr(scene, "tilt", 0) != 0:          # (a nacelle lidar: outside)
         return np.zeros(scene.shape, dtype=bool)
     if scene.correction == "yaw":
         return (np.asarray(scene.pitch) == 0) & (np.asarray(scene.roll) == 0) \

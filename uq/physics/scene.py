@@ -20,7 +20,13 @@ SCENE_FIELDS = ("wind_speed", "wind_direction", "vertical_wind", "shear", "refer
                 "sog", "cog", "heading", "pitch", "roll", "heave", "lidar_height",
                 "half_cone", "misalignment")
 OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity", "gate_height")
-#: The outputs the compiled model (:mod:`uq.physics.fused`) computes: all of them.
+#: The outputs of a tilted (nacelle) mount (:mod:`uq.physics.nacelle`): the wind direction
+#: relative to the rotor axis (the static heading) [deg] and the power-law exponent from
+#: the upper and lower beams [1].
+NACELLE_OUTPUTS = ("yaw_misalignment", "shear_exponent")
+#: Every per-trial output a scenario may request.
+ALL_OUTPUTS = OUTPUTS + NACELLE_OUTPUTS
+#: The outputs the compiled model (:mod:`uq.physics.fused`) computes: those of OUTPUTS.
 COMPILED_OUTPUTS = OUTPUTS
 #: What the INS reports with an error, and the angles among them (:mod:`uq.physics.modelinputs`).
 NAVIGATION = navigation_keys()
@@ -63,6 +69,11 @@ class Scene:
     probe : uq.physics.probe.PulsedProbe, ContinuousWaveProbe or None
         The range weighting of the radial velocities along each beam; None is the
         point-wise measurement at the gate centre.
+    tilt : float
+        Mount tilt of the boresight from the deck's vertical towards the bow [rad]
+        (``lidar.mount.tilt``); 0 is the upward lidar. For tilt > 0 `azimuths` are clock
+        positions about the boresight (0 up, pi/2 starboard, pi down) and `ranges`
+        preview distances along it (:mod:`uq.physics.beams`).
     """
 
     wind_speed: float
@@ -85,6 +96,7 @@ class Scene:
     correction: str
     time_resolved: object = None
     probe: object = None
+    tilt: float = 0.0
 
     @property
     def shape(self):
@@ -104,11 +116,22 @@ class Scene:
     def nominal_unit_vectors(self):
         """Configured beam vectors in the ship frame, shape (n_beams, 3)."""
         return beam_unit_vectors(self.half_cone, np.asarray(self.azimuths),
-                                 self.misalignment, self.vertical_beam)
+                                 self.misalignment, self.vertical_beam, self.tilt)
+
+    @property
+    def horizontal_only(self):
+        """True where the beams see only the horizontal wind and w = 0 is assumed: a
+        tilted mount with two beams (e.g. a nacelle lidar's clock positions 90 and 270)."""
+        return self.tilt != 0 and self.n_beams == 2
 
     def gate_heights(self):
-        """Nominal measurement heights above sea level [m], shape (*S, n_gates)."""
-        return self.field("lidar_height", 1) + np.asarray(self.ranges, dtype=float)
+        """Nominal measurement heights above sea level [m], shape (*S, n_gates): the
+        lidar's height plus the gate's range along the boresight's vertical,
+        ``range cos(tilt)`` (the range itself for the upward lidar)."""
+        ranges = np.asarray(self.ranges, dtype=float)
+        if self.tilt != 0:
+            ranges = ranges * np.cos(self.tilt)
+        return self.field("lidar_height", 1) + ranges
 
 
 @dataclass(frozen=True)

@@ -53,9 +53,9 @@ from uq.physics.probe import PARAMETER_SCALE
 from uq.physics.rotation import (attitude_from_matrix_analytic, attitude_matrix,
                                  attitude_matrix_rate, interpolate_rotation,
                                  rotation_about_vertical)
-from uq.physics import modelinputs
+from uq.physics import modelinputs, nacelle
 from uq.physics.modelinputs import MOTION, MOTION_COMPILED
-from uq.physics.scene import sample_count
+from uq.physics.scene import NACELLE_OUTPUTS, sample_count
 from uq.physics.timing import dwell_frequency
 
 #: The inputs a scan in motion adds to the static model's (:mod:`uq.physics.modelinputs`).
@@ -120,21 +120,54 @@ def single_scene(scene, outputs, **errors):
     measured, heights = _measure(scene, resolved, phases, err, n)
     navigation = _navigation(scene, resolved, phases, err, n)
     unit_vectors = scene.nominal_unit_vectors()                        # configured, (b, 3)
+    horizontal = scene.horizontal_only
+    lidar_lift = 0.0                    # the lidar's height above its static one, as read
     if scene.correction == "pointwise":
         rotation, velocity = _pointwise_reading(navigation, resolved)
-        wind_vector = pointwise_wind(measured, unit_vectors, rotation, velocity)
+        wind_vector = pointwise_wind(measured, unit_vectors, rotation, velocity, horizontal)
         believed = (rotation @ unit_vectors[..., None])[..., 0]        # (n, b, 3)
         along = np.sum(believed * velocity, axis=-1)[..., None]
+        if set(outputs) & set(NACELLE_OUTPUTS):
+            lidar_lift = _lever_arm_lift(scene, resolved, rotation)
     else:
-        operator = least_squares_operator(unit_vectors)
         rotation = correction_rotation(scene.correction, navigation["heading"][:, 0],
                                        navigation["pitch"][:, 0], navigation["roll"][:, 0],
                                        scene.heading)                  # (n, 3, 3)
         velocity = removed_velocity(scene.correction, navigation["velocity"][:, 0])
-        wind_vector = scan_wind(measured, scene.correction, operator, rotation, velocity)
-        believed = rotation[:, None] @ unit_vectors[..., None]          # (n, b, 3, 1)
-        along = np.sum(believed[..., 0] * velocity[:, None, :], axis=-1)[..., None]
-    return _outputs(scene, outputs, wind_vector, measured + along, heights)
+        if horizontal:
+            if scene.correction == "tilt2d":
+                raise ValueError("tilt2d needs beams that determine the 3-D wind")
+            wind_vector = pointwise_wind(measured, unit_vectors, rotation[:, None],
+                                         velocity[:, None], True)
+        else:
+            operator = least_squares_operator(unit_vectors)
+            wind_vector = scan_wind(measured, scene.correction, operator, rotation, velocity)
+        believed = (rotation[:, None] @ unit_vectors[..., None])[..., 0]   # (n, b, 3)
+        along = np.sum(believed * velocity[:, None, :], axis=-1)[..., None]
+    pair = nacelle.level_pair(scene.azimuths) if scene.tilt != 0 and not horizontal else None
+    if pair:                   # a nacelle lidar's hub-height wind: its level beams'
+        wind_vector = nacelle.hub_height_wind(wind_vector, believed, measured + along, pair)
+    result = _outputs(scene, outputs, wind_vector, measured + along, heights)
+    if set(outputs) & set(NACELLE_OUTPUTS):
+        slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
+                                scene.vertical_beam)                    # (b, g)
+        lidar = scene.lidar_height + np.asarray(lidar_lift)
+        believed_heights = nacelle.believed_heights(lidar, slant, believed)
+        extra = nacelle.nacelle_outputs(outputs, wind_vector, result, scene.heading,
+                                        believed, measured + along, believed_heights,
+                                        nacelle.upper_lower(scene.azimuths))
+        n = max(np.shape(v)[0] for v in result.values())
+        result.update({q: np.broadcast_to(v, (n,) + np.shape(v)[1:]) for q, v in extra.items()})
+    return result
+
+
+def _lever_arm_lift(scene, resolved, rotation):
+    """How far the attitude read, (n, b, 3, 3), lifts the lidar above its height at the
+    static attitude through the lever arm r: ``[(R_k - R_static) r]_up`` [m], (n, b).
+    (The translation, surge to heave, is not read: the INS reports velocities.)"""
+    arm = np.asarray(resolved.motion.lever_arm, dtype=float)
+    static = attitude_matrix(scene.heading, scene.pitch, scene.roll) @ arm
+    return (rotation @ arm)[..., 2] - static[2]
 
 
 
@@ -165,7 +198,8 @@ def _measure(scene, resolved, phases, err, n):
     half_cone = scene.half_cone + complexstep.radians(err["lidar_half_cone"])
     misalignment = scene.misalignment + complexstep.radians(err["lidar_misalignment"])
     ship_beams = beam_unit_vectors(np.reshape(half_cone, (-1,)), np.asarray(scene.azimuths),
-                                   np.reshape(misalignment, (-1,)), scene.vertical_beam)
+                                   np.reshape(misalignment, (-1,)), scene.vertical_beam,
+                                   scene.tilt)
     ship_beams = ship_beams[:, :, None, :, None]                        # (n', b, 1, 3, 1)
     beams = (kin["attitude"] @ ship_beams)[..., 0]                      # (n, b, q, 3)
     slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),

@@ -36,6 +36,10 @@ QUANTITIES = {
                         "standard_name": "radial_velocity_of_scatterers_away_from_instrument"},
     "gate_height": {"units": "m", "long_name": "height above sea level of the range gate "
                     "(mean of the slanted beams' true heights)", "standard_name": "height_above_mean_sea_level"},
+    "yaw_misalignment": {"units": "degree", "long_name": "yaw misalignment: wind direction "
+                         "(from) minus the rotor axis (ship.heading), clockwise, in [-180, 180)"},
+    "shear_exponent": {"units": "1", "long_name": "power-law shear exponent from the upper and "
+                       "lower beams of a nacelle lidar (w = 0 assumed)"},
 }
 
 STATISTICS = {
@@ -71,7 +75,7 @@ STATISTICS = {
     "gum_covariance": ("first-order GUM covariance between range gates, J V J^T", None),
 }
 
-SQUARED_UNITS = {"m s-1": "m2 s-2", "degree": "degree2", "m": "m2"}
+SQUARED_UNITS = {"m s-1": "m2 s-2", "degree": "degree2", "m": "m2", "1": "1"}
 
 
 def variable_attributes(quantity, statistic):
@@ -87,6 +91,8 @@ def variable_attributes(quantity, statistic):
         attrs.update(flag_attributes(FLAG_MEANINGS[statistic]))
     else:
         attrs["units"] = base["units"]
+    if "standard_name" not in base:          # (no CF name: yaw misalignment, shear exponent)
+        return attrs
     if statistic in ("true", "nominal", "gum_value", "mc_mean"):
         attrs["standard_name"] = base["standard_name"]
     elif modifier:

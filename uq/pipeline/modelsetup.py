@@ -40,7 +40,8 @@ def scene_from_settings(settings):
         misalignment=rad(lid["misalignment"]), azimuths=tuple(rad(lid["azimuths"])),
         vertical_beam=lid["vertical_beam"], correction=settings["correction"],
         time_resolved=motionsection.time_resolved(settings),
-        probe=probesection.make_probe(lid.get("probe")))
+        probe=probesection.make_probe(lid.get("probe")),
+        tilt=rad(lid["mount"]["tilt"]) if "mount" in lid else 0.0)
 
 
 def error_inputs(settings, n_beams, n_gates):

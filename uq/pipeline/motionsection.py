@@ -11,6 +11,8 @@ validated settings unless given).
       roll:  {amplitude: 5.0, period: 5.0, phase: random}   # deg, s, deg or random
       pitch: {amplitude: 3.0, period: 6.0, phase: 90}
       heave: {amplitude: 1.0, period: 8.0}                  # surge, sway, heave in m
+      # or a list of harmonics for one degree of freedom, each with its own phase:
+      # pitch: [{amplitude: 3.0, period: 25.0}, {amplitude: 1.0, period: 8.0}]
       spectrum: {kind: jonswap, hs: 2.0, tp: 8.0, gamma: 3.3, components: 32,
                  band: [0.0625, 0.5]}                       # m, s, 1, 1, Hz
       response:                  # per metre of wave amplitude: deg/m or m/m; lag in deg
@@ -87,7 +89,7 @@ def validate_motion(check, value):
     out = {}
     for dof in DEGREES_OF_FREEDOM:
         if dof in value:
-            out[dof] = _harmonic(check, value[dof], f"motion.{dof}", dof in ANGULAR_DOFS)
+            out[dof] = _harmonics(check, value[dof], f"motion.{dof}", dof in ANGULAR_DOFS)
     if ("spectrum" in value) != ("response" in value):
         check.fail("motion.spectrum" if "response" in value else "motion.response",
                    "a wave spectrum and the platform's response go together; allowed: "
@@ -250,6 +252,23 @@ def _response(check, value):
     return out
 
 
+def _harmonics(check, value, key, angular):
+    """One harmonic ``{amplitude, period, phase}`` or a list of them for one degree of
+    freedom (e.g. a floater's slow pitch and its wave-frequency pitch), each its own
+    component with its own phase."""
+    if not isinstance(value, list):
+        return _harmonic(check, value, key, angular)
+    if not value or len(value) > MAX_WAVE_COMPONENTS:
+        check.fail(key, f"a list of {len(value)} harmonics; allowed: 1 to "
+                   f"{MAX_WAVE_COMPONENTS} mappings of amplitude, period and phase")
+    return [_harmonic(check, item, f"{key}[{i}]", angular) for i, item in enumerate(value)]
+
+
+def _listed(spec):
+    """The harmonics of one degree of freedom's validated settings, as a list."""
+    return spec if isinstance(spec, list) else [spec]
+
+
 def _harmonic(check, value, key, angular):
     check.mapping(value, key)
     check.keys(value, key, HARMONIC_KEYS)
@@ -356,8 +375,8 @@ def time_resolved(settings):
         return None
     lidar, ins = settings["lidar"], settings["ins"]
     motion_settings = settings.get("motion") or {}
-    components = tuple(_component(dof, spec) for dof, spec in motion_settings.items()
-                       if dof in DEGREES_OF_FREEDOM)
+    components = tuple(_component(dof, one) for dof, spec in motion_settings.items()
+                       if dof in DEGREES_OF_FREEDOM for one in _listed(spec))
     components += _wave_components(motion_settings)
     record = series_motion(motion_settings)[0]
     motion = Motion(components + record, tuple(lidar.get("lever_arm", (0.0, 0.0, 0.0))),
@@ -404,8 +423,8 @@ def random_phase_count(settings):
     """Components of the motion with a random phase (each a Monte Carlo input): the
     harmonics with ``phase: random`` and every component of a wave spectrum."""
     motion = settings.get("motion") or {}
-    harmonics = sum(spec["phase"] == "random" for dof, spec in motion.items()
-                    if dof in DEGREES_OF_FREEDOM)
+    harmonics = sum(one["phase"] == "random" for dof, spec in motion.items()
+                    if dof in DEGREES_OF_FREEDOM for one in _listed(spec))
     return harmonics + (motion["spectrum"]["components"] if "spectrum" in motion else 0)
 
 

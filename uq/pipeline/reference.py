@@ -39,6 +39,7 @@ EXEMPLAR_OPTIONAL = {
                          "wavelength": {"dist": "normal", "u": 0.001},
                          "beam_radius": {"dist": "normal", "u": 1.0}},
               "lever_arm": [0.0, 0.0, 2.0],
+              "mount": {"tilt": 90.0},
               "scan": {},
               "probe": {"kind": "cw", "gate_length": 30.0, "pulse_fwhm": 22.5,
                         "wavelength": 1.565, "beam_radius": 28.0, "truncation": 0.02}},
@@ -54,6 +55,7 @@ EXEMPLAR_OPTIONAL = {
 }
 #: Keys checked only in the alternative form of a section (digits instead of n).
 EXEMPLAR_ALTERNATIVE = {"sampling": {"digits": 2, "stop_when_gum_valid": True},
+                        "lidar": {"mount": {"tilt": 90.0}},
                         "ins": {"sog": {"dist": "normal", "u": 0.1, "correlation_time": 2.0}}}
 
 #: Dotted key (``*`` for any name) -> (unit, meaning). Keys of error distributions
@@ -115,11 +117,15 @@ MEANINGS = {
     "sampling.stop_when_gum_valid": ("", "stop a scene once clause 8 validates its GUM "
                                      "(with digits)"),
     "outputs": ("", "quantities to report (wind_speed_motion_ti: the motion-induced "
-                "turbulence-intensity increment, u of Vh from motion over Vh; needs motion)"),
+                "turbulence-intensity increment, u of Vh from motion over Vh; needs motion; "
+                "yaw_misalignment: wind_direction minus ship.heading, the rotor axis, in "
+                "[-180, 180) deg; shear_exponent: the power-law exponent from the upper and "
+                "lower beams of a tilted mount, w = 0 assumed)"),
     "motion.<dof>.amplitude": ("deg or m", "amplitude of a harmonic motion of a degree of "
                                "freedom, added to the static attitude: roll, pitch, yaw in "
                                "deg (at most 45); surge, sway, heave in m"),
-    "motion.<dof>.period": ("s", "period of the harmonic"),
+    "motion.<dof>.period": ("s", "period of the harmonic (a degree of freedom may also "
+                            "take a list of harmonics, each {amplitude, period, phase})"),
     "motion.<dof>.phase": ("deg", "phase at the start of the scan (0: at the static "
                            "attitude, moving positive), or random: uniform over the cycle, "
                            "per trial (default)"),
@@ -143,6 +149,13 @@ MEANINGS = {
     "motion.series.components": ("1", "Fourier harmonics of the record kept (those with "
                                  "the most motion)"),
     "lidar.lever_arm": ("m", "(bow, starboard, up) from the INS to the lidar"),
+    "lidar.mount.tilt": ("deg", "boresight tilted from vertical towards the bow (0: the "
+                         "upward lidar, as without mount; 90: a nacelle lidar looking "
+                         "along the bow); for tilt > 0 lidar.azimuths are clock positions "
+                         "about the boresight (0 up, 90 starboard, 180 down, 270 port: "
+                         "clockwise looking along it), lidar.half_cone the opening from it "
+                         "and lidar.ranges preview distances along it; 2 beams (90, 270) "
+                         "assume w = 0; no vertical beam"),
     "lidar.scan.beam_duration": ("s", "dwell per line of sight; beams in the order of "
                                  "azimuths, then the vertical beam"),
     "lidar.scan.timestamp": ("", "a beam's time stamp: start, mid or end of its dwell"),
@@ -292,7 +305,7 @@ def _recorded(series):
     for overlay in (_merge(copy.deepcopy(EXEMPLAR_OPTIONAL), series), EXEMPLAR_ALTERNATIVE):
         checker.overlay = overlay
         raw = _merge(copy.deepcopy(DEFAULTS), overlay)
-        raw["outputs"] = list(scenario_module.OUTPUTS)
+        raw["outputs"] = list(scenario_module.ALL_OUTPUTS)
         scenario_module._validate(raw, checker.source, checker)
     required = checker.required_keys | {f"lidar.probe.{name}" for name in
                                         KIND_PARAMETERS["pulsed"] + KIND_PARAMETERS["cw"]}

@@ -24,7 +24,7 @@ from uq.pipeline.modelsetup import (MOTION_INPUTS, error_inputs, input_label, sc
 from uq.physics.correction import describe_corrections
 from uq.physics import probe as probe_volume
 from uq.physics.measurement import measurement_model, true_values
-from uq.physics.scene import ANGULAR_NAVIGATION, NAVIGATION, OUTPUTS
+from uq.physics.scene import ALL_OUTPUTS, ANGULAR_NAVIGATION, NAVIGATION, OUTPUTS
 from uq.pipeline.metadata import (COORDINATES, QUANTITIES, ancillary_variables, cf_encode,
                                   history, swept_key_attributes, variable_attributes)
 from uq.engine.propagate import propagate
@@ -142,7 +142,7 @@ def wants_motion_ti(settings):
 
 def model_outputs(outputs):
     """The per-trial outputs the model evaluates (derived ones need wind_speed)."""
-    model = [q for q in outputs if q in OUTPUTS]
+    model = [q for q in outputs if q in ALL_OUTPUTS]
     if "wind_speed_motion_ti" in outputs and "wind_speed" not in model:
         model.insert(0, "wind_speed")
     return tuple(model)
@@ -189,7 +189,7 @@ def _propagate(scene, settings, outputs, inputs, seed, compiled):
     return propagate(model, inputs,
                        n=sampling.get("n"), digits=sampling.get("digits"),
                        method=sampling["method"], seed=seed, circular=("wind_direction",),
-                       output_dims={q: _dims(q) for q in OUTPUTS},
+                       output_dims={q: _dims(q) for q in ALL_OUTPUTS},
                        interval=sampling["interval"], chunk_size=sampling.get("chunk_size"),
                        control_variate=sampling["control_variate"],
                        stopping=sampling["stopping"],
@@ -284,7 +284,7 @@ def _paper_uncertainty(scene, settings, gate_speeds):
                                             u["pitch"], u["roll"], u["sog"], u["cog"])
                 for i in range(gate_speeds.shape[-1])]
     return {q: np.stack([g[q] for g in per_gate], axis=-1) if q in per_gate[0]
-            else np.full(gate_speeds.shape, np.nan) for q in OUTPUTS}
+            else np.full(gate_speeds.shape, np.nan) for q in ALL_OUTPUTS}
 
 
 def _standard_uncertainty(spec):

@@ -33,7 +33,9 @@ from uq.pipeline.motionsection import (check_dwell, check_record, random_phase_c
                                        validate_scan)
 from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
 from uq.physics.modelinputs import error_keys
-from uq.physics.scene import OUTPUTS
+from uq.physics.scene import ALL_OUTPUTS
+from uq.pipeline.mountsection import (check_mount_settings, check_mounted_beams, tilt_of,
+                                      validate_mount)
 from uq.engine.sampling import PROPAGATION_METHODS
 from uq.engine.statistics import INTERVALS
 from uq.engine.stopping import STOPPING_RULES
@@ -82,7 +84,7 @@ DEFAULTS = {
 }
 #: Optional keys of a section that enter the settings only when given (so a scenario
 #: without them is today's, to the text of its ``scenario`` attribute).
-OPTIONAL_LIDAR_KEYS = ("lever_arm", "scan", "probe")
+OPTIONAL_LIDAR_KEYS = ("lever_arm", "scan", "probe", "mount")
 OPTIONAL_INS_KEYS = ("rate", "interpolation", "clock_offset")
 #: Outputs derived from the results rather than evaluated per trial.
 DERIVED_OUTPUTS = ("wind_speed_motion_ti",)
@@ -305,6 +307,7 @@ def _validate(raw, source, check=None):
     if raw.get("motion") is not None:                # optional: motion within the scan
         settings["motion"] = validate_motion(check, raw["motion"])
     _check_time_resolved(check, settings)
+    check_mount_settings(check, settings)
     return settings
 
 
@@ -377,11 +380,16 @@ def _lidar(check, value):
            "misalignment": check.angle(lid["misalignment"], "lidar.misalignment")}
     check.unique(out["ranges"], "lidar.ranges")
     check.unique([a % FULL_CIRCLE_DEG for a in out["azimuths"]], "lidar.azimuths")
-    if len(out["azimuths"]) + out["vertical_beam"] < 3 or len(out["azimuths"]) < 2:
+    if "mount" in lid:
+        out["mount"] = validate_mount(check, lid["mount"])
+    if tilt_of(out) != 0:
+        check_mounted_beams(check, out)
+    elif len(out["azimuths"]) + out["vertical_beam"] < 3 or len(out["azimuths"]) < 2:
         raise ScenarioError(check.source, "lidar.azimuths", "need at least 3 beams (and 2 "
                             "slanted ones) to reconstruct the 3-D wind; allowed: >= 3 "
                             "azimuths, or 2 non-opposite ones with vertical_beam: true")
-    _check_beams_determine_wind(check, out)
+    else:
+        _check_beams_determine_wind(check, out)
     errors = lid["errors"] if lid["errors"] is not None else {}
     check.mapping(errors, "lidar.errors")
     check.keys(errors, "lidar.errors", error_keys("lidar"))
@@ -485,10 +493,10 @@ def _sampling(check, value):
 def _outputs(check, value):
     items = check.list(value, "outputs")
     for item in items:
-        check.choice(item, "outputs", OUTPUTS + DERIVED_OUTPUTS)
+        check.choice(item, "outputs", ALL_OUTPUTS + DERIVED_OUTPUTS)
     check.unique(items, "outputs")
     if not items:
-        raise ScenarioError(check.source, "outputs", f"empty; allowed: any of {', '.join(OUTPUTS)}")
+        raise ScenarioError(check.source, "outputs", f"empty; allowed: any of {', '.join(ALL_OUTPUTS)}")
     return list(items)
 
 
