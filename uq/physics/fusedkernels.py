@@ -79,10 +79,10 @@ GEO_ORDER = ("half_cone", "misalignment", "height")
 #: How the kernels' helpers are compiled: as functions of their own that LLVM inlines
 #: into the kernel (the small ones: the same machine code, the same numbers), not numba's
 #: ``inline="always"``, which re-runs numba's front end on the helper at every call site
-#: and made the first compile 4x longer (wind_scan: 19.7 s of CPU time against 4.9 s;
-#: measured with numba 0.68 in issue 26). The two helpers called once per trial with
-#: arrays (the true radial velocities and gate heights) stay inlined by numba: as calls
-#: they cost ~4 % on floating_lidar_full.
+#: and made the first compile 2-3x longer (wind_scan: 19.7 s of CPU time against 7-9 s,
+#: a whole cold ``uq run rubio2022_case_i`` 115 s against 34 s; numba 0.68, issue 26).
+#: The two helpers called once per trial with arrays (the true radial velocities and gate
+#: heights) stay inlined by numba: as calls they cost ~4 % on floating_lidar_full.
 _helper = njit(nogil=True)
 
 
