@@ -22,7 +22,7 @@ import pytest
 import yaml
 from conftest import child_failure, cpu_limited
 
-from uq.cli import main
+from uq.cli import compiling, main
 
 ROOT = Path(__file__).resolve().parents[2]
 GOOD = {"name": "tiny", "ins": {"heading": {"dist": "normal", "u": 0.1}},
@@ -1247,7 +1247,7 @@ def test_bad_input_is_refused_cleanly(name, tmp_path, capsys, monkeypatch):
         # (with numba's cache cold, as on a fresh clone, a run first says that it compiles
         # its kernels: a notice, not part of the error message)
         lines = [line for line in err.strip().splitlines()
-                 if not line.startswith("uq: compiling the model's kernels")]
+                 if not line.startswith(compiling.PREFIX)]
         assert status == 2, (name, argv, err)
         assert len(lines) == 1 and "Traceback" not in err, (name, err)
         for word in words:

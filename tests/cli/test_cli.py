@@ -221,58 +221,6 @@ def test_quiet_prints_nothing_and_results_go_to_stdout(tmp_path):
     assert "wrote l.nc" in loud.stdout and "wrote" not in loud.stderr
 
 
-class ManualTimer:
-    """threading.Timer whose interval elapses when the test says so (:meth:`elapse`), not
-    on the clock: what the kernel notice does is then independent of the machine's load."""
-
-    made = []
-
-    def __init__(self, interval, function):
-        self.interval, self.function, self.cancelled = interval, function, False
-        ManualTimer.made.append(self)
-
-    daemon = False
-
-    def start(self):
-        pass
-
-    def cancel(self):
-        self.cancelled = True
-
-    def elapse(self):
-        if not self.cancelled:
-            self.function()
-
-
-@pytest.mark.parametrize("slow, said", [(True, True), (False, False)])
-def test_a_slow_kernel_load_is_announced(slow, said, tmp_path, monkeypatch, capsys):
-    """The first run after an install compiles numba's kernels for a minute or more: `uq
-    run` says so on stderr when loading them takes longer than KERNEL_NOTICE_AFTER (here
-    the interval elapses during the load), and says nothing when the load ends first (the
-    interval elapses after it)."""
-    import threading
-
-    from uq.cli import run as run_command
-    from uq.physics import fusedkernels
-    original = fusedkernels.compiled
-
-    def load(dtype):
-        if slow:
-            ManualTimer.made[-1].elapse()
-        return original(dtype)
-
-    ManualTimer.made = []
-    monkeypatch.setattr(threading, "Timer", ManualTimer)
-    monkeypatch.setattr(fusedkernels, "compiled", load)
-    monkeypatch.chdir(tmp_path)
-    assert main(["run", "rubio2022_case_i", "--set", "sampling.n=100",
-                 "--set", "sweep={}", "-o", "out.nc"]) == 0
-    notice, = ManualTimer.made
-    assert notice.interval == run_command.KERNEL_NOTICE_AFTER and notice.cancelled
-    notice.elapse()                        # after the load: too late to say anything
-    assert ("compiling the model's kernels" in capsys.readouterr().err) == said
-
-
 @pytest.mark.parametrize("text, shown", [
     ("name: y\nlidar:\n  ranges: [100, 200,, 300]\n",
      "at line 3, column 21: expected the node content, but found ',' "

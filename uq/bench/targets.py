@@ -14,6 +14,8 @@ Fig. 2 GUM grid, 518,400 scenes         the numpy model's complex step (before) 
 10^6 point-wise scans in motion         10^6 static scans                           <= 4x
 conical scan, 50 lines of sight         a 4-beam scan in motion, per trial          <= 15x
 pulsed probe, ``floating_lidar_full``   the compiled point model, ``uq.run``        <= 3x
+``uq run rubio2022_case_i``, numba's    CPU time [s] (and peak memory [MB]) in a     <= 20 s
+cache empty (a fresh cache folder)      new process; the same run with it filled     600 MB
 =====================================  ==========================================  ======
 
 The probe's figure (issue 26) is a whole ``uq.run`` of ``floating_lidar_full`` with a
@@ -49,7 +51,8 @@ TARGETS = {"floating_lidar_full_mc_over_draw_floor": (3.0, "max"),
            "scans_over_numpy": (1.0, "max"),
            "pointwise_motion_over_static": (4.0, "max"),
            "conical_over_four_beam": (15.0, "max"),
-           "pulsed_probe_over_point": (3.0, "max")}
+           "pulsed_probe_over_point": (3.0, "max"),
+           "cold_start_cpu_s": (20.0, "max"), "cold_start_peak_rss_mb": (600.0, "max")}
 #: Imports of ``uq run`` that a new process pays before any work.
 START_SCRIPT = ("import numpy, scipy.stats, xarray, netCDF4, numba, matplotlib.pyplot; "
                 "import uq.cli.run, uq.pipeline.runner, uq.physics.fused, uq.outputs.plots")
@@ -269,6 +272,35 @@ def probe_against_point(n=2**16, repeats=5):
     return tuple(times)
 
 
+def child_usage(argv, env=None, cwd=None):
+    """(CPU time [s], peak resident memory [MB]) of a child process `argv`: user + system
+    time of the process and its own children (numba compiles in the process itself),
+    and its largest resident set, from wait4's resource usage."""
+    child = subprocess.Popen(argv, env=env, cwd=cwd, stdout=subprocess.DEVNULL)
+    _, status, usage = os.wait4(child.pid, 0)
+    child.returncode = os.waitstatus_to_exitcode(status)
+    if child.returncode != 0:
+        raise RuntimeError(f"{' '.join(argv)} failed with status {child.returncode}")
+    return usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
+
+
+def cold_start(name="rubio2022_case_i"):
+    """The README's first command, ``uq run NAME``, in a new process with an empty numba
+    cache (a fresh ``NUMBA_CACHE_DIR``: every kernel it calls compiles), then again with
+    that cache filled: {cold CPU [s], cold peak RSS [MB], warm CPU [s]}. CPU time, not
+    wall time: on a loaded machine the wall time says how busy it is; on an idle one
+    the wall time of the single-threaded compile is about its CPU time."""
+    with tempfile.TemporaryDirectory() as folder:
+        env = {**os.environ, "NUMBA_CACHE_DIR": os.path.join(folder, "numba")}
+        argv = uq_command() + ["run", name, "-q", "-o", os.path.join(folder, "out.nc")]
+        cold_cpu, cold_mb = child_usage(argv, env)
+        os.remove(os.path.join(folder, "out.nc"))
+        warm_cpu, warm_mb = child_usage(argv, env)
+    return {"cold_start_cpu_s": cold_cpu, "cold_start_peak_rss_mb": cold_mb,
+            "warm_start_cpu_s": warm_cpu, "warm_start_peak_rss_mb": warm_mb,
+            "cold_over_warm_start": cold_cpu / warm_cpu}
+
+
 def measure(quick=False, progress=None, scale=1):
     """Every figure of the table above as ``{name: value}`` (times [s], ratios [1]);
     `quick` leaves out the two slow ones (every shipped scenario end to end, the GUM
@@ -313,6 +345,10 @@ def measure(quick=False, progress=None, scale=1):
         f"{1e3 * floor:.3f} ms")
     if quick:
         return figures
+    figures.update(cold_start())
+    say(f"uq run rubio2022_case_i, numba's cache empty: {figures['cold_start_cpu_s']:.1f} s "
+        f"of CPU time, peak {figures['cold_start_peak_rss_mb']:.0f} MB; the cache filled "
+        f"{figures['warm_start_cpu_s']:.1f} s")
     new_s, old_s, scenes = gum_grid()
     figures.update(gum_grid_scenes=scenes, gum_grid_s=new_s, gum_grid_numpy_s=old_s,
                    gum_grid_us_per_scene=1e6 * new_s / scenes, gum_grid_speedup=old_s / new_s)

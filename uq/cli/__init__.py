@@ -1,5 +1,5 @@
 """Command line: ``uq run``, ``uq check``, ``uq list``, ``uq plot``, ``uq report``,
-``uq export``, ``uq bench``, ``uq fit``, ``uq golden``, ``uq --version``; one module per
+``uq export``, ``uq bench``, ``uq fit``, ``uq golden``, ``uq warmup``, ``uq --version``; one module per
 subcommand.
 
 The command line dispatches; it computes nothing. Each subcommand module adds its
@@ -10,16 +10,19 @@ Exit status: 0 success; 2 bad input (one line naming the file, the key and what 
 allowed; no traceback; no output file); 1 anything else; 130 interrupted (Ctrl-C);
 143 terminated (SIGTERM: a batch system's time limit), cleaned up as after Ctrl-C.
 """
+import contextlib
 import sys
 
 from uq._version import __version__
-from uq.cli import bench, check, export, fit, golden, listing, plot, report, run
+from uq.cli import bench, check, export, fit, golden, listing, plot, report, run, warmup
 from uq.cli.common import (EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK,  # noqa: F401
                            EXIT_TERMINATED, Parser, add_common_options, configure_logging,
                            interrupted_status, parse_overrides, stop_on_sigterm)
 from uq.errors import InputError
 
-SUBCOMMANDS = (run, check, listing, plot, report, export, bench, fit, golden)
+SUBCOMMANDS = (run, check, listing, plot, report, export, bench, fit, golden, warmup)
+#: Commands that may compile numba kernels: they say so on stderr (uq.cli.compiling).
+COMPILING = ("run", "plot", "report", "bench", "fit", "golden", "warmup")
 
 
 def build_parser():
@@ -44,7 +47,7 @@ def main(argv=None):
             parser.print_help(sys.stderr)
             return EXIT_BAD_INPUT
         configure_logging(args)
-        with stop_on_sigterm():
+        with stop_on_sigterm(), _compile_notice(args):
             return args.handler(args)
     except InputError as error:
         print(f"uq: error: {error}", file=sys.stderr)
@@ -54,6 +57,18 @@ def main(argv=None):
         print(f"\nuq: {'terminated' if status == EXIT_TERMINATED else 'interrupted'}",
               file=sys.stderr)
         return status
+
+
+@contextlib.contextmanager
+def _compile_notice(args):
+    """Say on stderr when the command compiles numba kernels (uq.cli.compiling; imports
+    numba: only for the commands that may compile)."""
+    if args.command not in COMPILING:
+        yield
+        return
+    from uq.cli import compiling
+    with compiling.notice(args) as args.compile_notice:
+        yield
 
 
 if __name__ == "__main__":

@@ -70,7 +70,9 @@ def command(args):
     check_target(output)                     # before any work: refused targets cost nothing
     check_scale_out(args)
     check_device(args, scenario)
+    compiling = getattr(args, "compile_notice", None)
     load_kernels(args, scenario)
+    before_run = compiling.seconds if compiling else 0.0     # compiled before the run
     progress = None if args.quiet else ProgressBar()
     new_folders = missing_folders(output.parent)
     checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume).acquire()
@@ -78,6 +80,7 @@ def command(args):
         with dask_client(args) as client:
             dataset = run(scenario, progress=progress, client=client, checkpoint=checkpoint,
                           model=args.model)
+        dataset.attrs["runtime_s"] += before_run  # the user's wait, compiles included
         write_netcdf(dataset, output)
         checkpoint.clear()                   # still locked: no other run can be in it
     except KeyboardInterrupt as stop:
@@ -101,40 +104,28 @@ def command(args):
         raise
     finally:
         checkpoint.release()
-    say(args, summary_table(dataset))
+    say(args, summary_table(dataset, compile_s=compiling.seconds if compiling else 0.0))
     say(args, f"wrote {output}")
     return EXIT_OK
 
 
-#: Seconds a kernel load may take before the user is told it is compiling [s] (a load from
-#: numba's cache takes ~0.6 s; the first compile after an install ~90 s).
-KERNEL_NOTICE_AFTER = 3.0
-
-
 def load_kernels(args, scenario):
-    """Load the compiled kernels the run uses (the statistics', and the static model's in
-    real and complex arithmetic or the time-resolved model's), and say so on stderr if
-    that takes longer than KERNEL_NOTICE_AFTER: the first run after an install compiles
-    them into numba's cache, silently for a minute or more."""
+    """Load the compiled kernels the run surely uses before its progress bar starts: the
+    statistics', and the static model's geometry in real and complex arithmetic or the
+    time-resolved model's. The wind kernel (scan-wise or point-wise) loads when first
+    called. The first run after an install compiles them into numba's cache; the
+    command's :class:`~uq.cli.compiling.CompileNotice` says so, kernel by kernel."""
     from uq.pipeline import motionsection
-    import threading
-    notice = threading.Timer(KERNEL_NOTICE_AFTER, lambda: None if args.quiet else print(
-        "uq: compiling the model's kernels into numba's cache (once after an install, "
-        "about 1-2 min)...", file=sys.stderr, flush=True))
-    notice.daemon = True
-    notice.start()
-    try:
-        import uq.engine.statkernels  # noqa: F401  (numba compiles or loads on import)
-        if getattr(args, "model", "compiled") == "numpy":
-            return                                    # no model kernel is called
-        if motionsection.is_time_resolved(scenario.settings):   # the static model unused
-            import uq.physics.fusedmotionkernels  # noqa: F401
-        else:
-            from uq.physics import fusedkernels
-            fusedkernels.compiled(float)
-            fusedkernels.compiled(complex)            # the GUM's complex steps
-    finally:
-        notice.cancel()
+    import uq.engine.statkernels  # noqa: F401  (numba compiles or loads on import)
+    if getattr(args, "model", "compiled") == "numpy":
+        return                                    # no model kernel is called
+    if motionsection.is_time_resolved(scenario.settings):   # the static model unused
+        import uq.physics.fusedmotionkernels  # noqa: F401
+        return
+    from uq.physics import fusedkernels
+    for number in (float, complex):               # complex: the GUM's complex steps
+        for name in ("ins_trig", "geometry"):
+            fusedkernels.compiled(number)[name]
 
 
 def check_scale_out(args):

@@ -14,17 +14,20 @@ DIRECTION_ROUNDING = 0.05
 _GAP = 3
 
 
-def summary_table(dataset):
+def summary_table(dataset, compile_s=0.0):
     """A few lines: per output (and gate), each column's value or min..max over the sweep.
 
     Columns with no value anywhere (the paper's model outside its domain, Monte Carlo
     when it did not run) are left out; widths follow the content, so cells never run
     together. The last column counts the scenes whose GUM interval Monte Carlo validates
     (JCGM 101 clause 8) out of all scenes, and in brackets those where Monte Carlo was
-    precise enough for that verdict to be conclusive; a footnote says so.
+    precise enough for that verdict to be conclusive; a footnote says so. `compile_s`:
+    seconds of the run's time spent compiling kernels (said in the title when > 0).
     """
+    compiled = f", of which {compile_s:.1f} s compiling kernels" if compile_s > 0 else ""
     title = (f"{dataset.attrs.get('title', '')}  (n = {dataset.attrs.get('n_samples')}, "
-             f"seed = {dataset.attrs.get('seed')}, {dataset.attrs.get('runtime_s', 0):.1f} s)")
+             f"seed = {dataset.attrs.get('seed')}, {dataset.attrs.get('runtime_s', 0):.1f} s"
+             f"{compiled})")
     rows, shown = [], []
     for q in QUANTITIES:
         if f"{q}_gum_u" not in dataset or q == "radial_velocity":

@@ -76,6 +76,16 @@ _READING_BASES = tuple(TABLE.index(name) for name in TRIG[:4])
 GEO_ORDER = ("half_cone", "misalignment", "height")
 
 
+#: How the kernels' helpers are compiled: as functions of their own that LLVM inlines
+#: into the kernel (the small ones: the same machine code, the same numbers), not numba's
+#: ``inline="always"``, which re-runs numba's front end on the helper at every call site
+#: and made the first compile 2-3x longer (wind_scan: 19.7 s of CPU time against 7-9 s,
+#: a whole cold ``uq run rubio2022_case_i`` 115 s against 34 s; numba 0.68, issue 26).
+#: The two helpers called once per trial with arrays (the true radial velocities and gate
+#: heights) stay inlined by numba: as calls they cost ~4 % on floating_lidar_full.
+_helper = njit(nogil=True)
+
+
 def _signature(kind, dtype):
     """The explicit signature of a kernel for float64 or complex128 numbers, any-layout
     arrays: one compilation (cached on disk) for strided views and length-1
@@ -95,7 +105,7 @@ def _signature(kind, dtype):
                       a3, a3, a3, a3, a4, a3)
 
 
-@njit(inline="always")
+@_helper
 def _angle(base, cos_base, sin_base, x, cos_x, sin_x):
     """cos and sin of base + x [rad]: the addition theorem with the error's (cos_x,
     sin_x) from :func:`~uq.physics.kernelbase.taylor_cos_sin` where |x| <= SMALL_ANGLE,
@@ -105,7 +115,7 @@ def _angle(base, cos_base, sin_base, x, cos_x, sin_x):
     return np.cos(base + x), np.sin(base + x)
 
 
-@njit(inline="always")
+@_helper
 def _fixed(base, cos_base, sin_base, x):
     """cos and sin of base + x for an error x constant over trials: where x is 0, the
     scene's own from the table (base + 0 is base), or (1, +0) for a zero base (+-0 + 0
@@ -117,14 +127,14 @@ def _fixed(base, cos_base, sin_base, x):
     return np.cos(base + x), np.sin(base + x)
 
 
-@njit(inline="always")
+@_helper
 def _pick(array, i, s, k):
     """Element (i, s, k) of an error array whose axes of length 1 broadcast."""
     return array[i if array.shape[0] > 1 else 0, s if array.shape[1] > 1 else 0,
                  k if array.shape[2] > 1 else 0]
 
 
-@njit(inline="always")
+@_helper
 def _readings(error, a, base, cos_base, sin_base, s, t0, count, tr0, cos_trig, sin_trig,
               cos_out, sin_out):
     """cos and sin of INS angle a (base + error) of scene s for trials [t0, t0 + count)
@@ -174,7 +184,7 @@ def ins_trig(ins, table, s0, s1, t0, t1, per_scene, cos_out, sin_out, scratch):
                     sin_out[a, k, at + j] = sin_x
 
 
-@njit(inline="always")
+@_helper
 def _geometry_offsets(n_slanted, n_beams, n_gates):
     """Columns of the operator, slant distances and configured beams in a row of the
     geometry table (the azimuths' cos and sin come first), and the row's length."""
@@ -208,7 +218,7 @@ def fill_table(fields, index, out):
         out[s, _GEOMETRY_ROW] = index[s]
 
 
-@njit(inline="always")
+@_helper
 def _attitude(table, s):
     """The scene's true body-to-earth rotation Rz(heading) Ry(pitch) Rx(roll), row-major
     (the expressions of :func:`uq.physics.rotation.attitude_matrix`)."""
@@ -217,7 +227,7 @@ def _attitude(table, s):
                      table[s, _COS + _T_ROLL], table[s, _SIN + _T_ROLL], 1.0, 0.0)
 
 
-@njit(inline="always")
+@_helper
 def _angle_block(error, s, t0, count, base, cos_base, sin_base, out, row):
     """cos and sin of base + error [deg] of trials [t0, t0 + count) of scene s into
     out[row, :count], out[row + 1, :count]: the errors' Taylor polynomials and the
@@ -290,7 +300,7 @@ def geometry(table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams, ra
             row += 1
 
 
-@njit(inline="always")
+@_helper
 def _rotation(model, ch, sh, cp, sp, cr, sr, cos_nominal, sin_nominal):
     """Row-major body-to-earth rotation the correction believes: Rz(heading) Ry(pitch)
     Rx(roll) of the INS reading (tilt2d, full), its heading alone (yaw) or the
@@ -304,7 +314,7 @@ def _rotation(model, ch, sh, cp, sp, cr, sr, cos_nominal, sin_nominal):
             sp, -cp * sr, cp * cr)
 
 
-@njit(inline="always")
+@_helper
 def _solve3(m, rhs):
     """Solution of the 3 x 3 system m x = rhs (Gaussian elimination with partial
     pivoting on the real parts, as LAPACK's gesv; m and rhs are overwritten)."""
@@ -327,7 +337,7 @@ def _solve3(m, rhs):
     rhs[0] = (rhs[0] - m[0, 1] * rhs[1] - m[0, 2] * rhs[2]) / m[0, 0]
 
 
-@njit(inline="always")
+@_helper
 def _mean_reading(error, base, i, s, zero):
     """The mean over the beams' readings of an INS angle, base + error [rad]."""
     total = zero
@@ -362,7 +372,7 @@ def _true_radials(beams, profile, r, speed_ref, w, to_north, to_east, true_ship,
             truth[b, g] = speed_ref * profile[r, b, g] * along_wind + beams[r, b, 2] * w - moving
 
 
-@njit(inline="always")
+@_helper
 def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile, height_error,
           s0, s1, t0, t1, per_scene, per_trial, speed, vertical, from_north, from_east,
           radial, gate_height, pointwise):
@@ -628,13 +638,27 @@ def wind_pointwise(table, shapes, structure, ins, noise, cos_trig, sin_trig, bea
 #: The kernels, each with its kind of signature.
 _KERNELS = {"ins_trig": (ins_trig, "trig"), "geometry": (geometry, "geometry"),
             "wind_scan": (wind_scan, "wind"), "wind_pointwise": (wind_pointwise, "wind")}
+#: The kernels' names (each compiled for float64 and complex128 by :func:`compiled`).
+KERNEL_NAMES = tuple(_KERNELS)
 
 
 @functools.cache
 def compiled(dtype):
     """The kernels compiled for float64 or complex128 (the complex-step GUM), by name:
-    each number type is compiled (or loaded from numba's on-disk cache) on first use,
-    so a Monte Carlo run never compiles the complex kernels."""
-    number = types.complex128 if np.dtype(dtype).kind == "c" else types.float64
-    return {name: njit(_signature(kind, number), cache=True, nogil=True)(function)
-            for name, (function, kind) in _KERNELS.items()}
+    each kernel is compiled (or loaded from numba's on-disk cache) on first use, so a
+    Monte Carlo run never compiles the complex kernels, nor a scan-wise run the
+    point-wise one."""
+    return _Kernels(types.complex128 if np.dtype(dtype).kind == "c" else types.float64)
+
+
+class _Kernels(dict):
+    """name -> compiled kernel of one number type, each compiled when first asked for."""
+
+    def __init__(self, number):
+        super().__init__()
+        self.number = number
+
+    def __missing__(self, name):
+        function, kind = _KERNELS[name]
+        self[name] = njit(_signature(kind, self.number), cache=True, nogil=True)(function)
+        return self[name]
