@@ -190,8 +190,9 @@ def record_generator(seed, record):
                                                                          record)))
 
 
-def turbulence_box(settings, geometry, rng):
-    """A box of the scenario's turbulence holding every probe point of a record
+def turbulence_box(settings, geometry, rng, motion_margin=0.0):
+    """A box of the scenario's turbulence holding every probe point of a record, each
+    moved by up to `motion_margin` [m] by the platform's motion
     (:func:`uq.physics.turbulencebox.box_for`), and the variance of u it keeps of the
     model's point variance [1] (Mann: its discrete wavenumbers, ``box_variance``;
     Kaimal: NaN, not computed: its box misses the frequencies below 1 / (its length /
@@ -200,7 +201,8 @@ def turbulence_box(settings, geometry, rng):
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
     model = turbulence_model(turbulence, speed)
     if turbulence["model"] == "mann":
-        grid = turbulencebox.box_for(geometry, turbulence["length_scale"], "mann")
+        grid = turbulencebox.box_for(geometry, turbulence["length_scale"], "mann",
+                                     motion_margin=motion_margin)
         box = turbulencebox.mann_box(grid, model.alpha_epsilon, model.length_scale,
                                      model.anisotropy, rng)
         kept = turbulencebox.box_variance(grid, model.alpha_epsilon, model.length_scale,
@@ -208,7 +210,7 @@ def turbulence_box(settings, geometry, rng):
                                                                   * speed) ** 2
         return box, float(kept)
     scale = turbulence["length_scale"] / LENGTH_FACTORS_KAIMAL
-    grid = turbulencebox.box_for(geometry, scale, "kaimal")
+    grid = turbulencebox.box_for(geometry, scale, "kaimal", motion_margin=motion_margin)
     return turbulencebox.kaimal_box(grid, turbulence["intensity"] * speed, speed, scale,
                                     rng), np.nan
 
@@ -253,23 +255,30 @@ def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True, radial=F
     included) and the u-variance fraction the box keeps [1]; with `radial` also the
     corrected radial velocities (n_scans, n_beams, n_gates) [m s-1] (a fourth item).
 
-    The turbulence's radial velocity at the nominal probe points and beam times
+    The turbulence's radial velocity along each beam at its beam time
     (:func:`uq.physics.turbulencesampling.record_radial_velocities`) enters the
     measurement model as an additive radial velocity per beam and gate, as the radial
     noise does; the scenario's motion, INS errors and correction act as in a single
-    scan. The probe points are not moved by the platform's motion (its displacement,
-    ~1 m, is small against the eddies that carry the variance, L ~ 30 m).
+    scan. With motion, the turbulence is sampled at the beams' true positions and
+    directions (:func:`uq.pipeline.beammotion.moving_beams`: the lidar displaced by the
+    platform's translation and its attitude times the lever arm, each beam turned by the
+    attitude, at the middle of its dwell, with the same phases as the measurement
+    model's); the box is widened by the largest displacement of a probe point. Without
+    motion, at the nominal points (the random streams are then drawn as before: the
+    phases draw nothing).
     """
     from uq.physics import turbulencesampling
     from uq.physics.measurement import measurement_model
     from uq.pipeline.modelsetup import scene_from_settings
-    box, kept = turbulence_box(settings, geometry, rng)
-    seen = np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans))
+    scene = probe_volume_resolved(scene_from_settings(settings))
+    scene, phases = coherent_phases(scene, n_scans, geometry.scan_period, rng)
+    moving, margin = moving_probes(settings, scene, phases, geometry)
+    box, kept = turbulence_box(settings, geometry, rng, margin)
+    seen = np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans,
+                                                                  **moving))
     times = turbulencesampling.scan_times(geometry, n_scans)
     reference = np.asarray(turbulencesampling.reference_series(box, geometry.speed, times))
     del box
-    scene = probe_volume_resolved(scene_from_settings(settings))
-    scene, phases = coherent_phases(scene, n_scans, geometry.scan_period, rng)
     errors = scan_errors(settings, scene, n_scans, rng)
     errors["lidar_radial_velocity"] = errors.get("lidar_radial_velocity", 0.0) + seen
     if phases is not None:
@@ -281,6 +290,25 @@ def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True, radial=F
     if radial:
         found += (np.real(result["radial_velocity"]).reshape(n_scans, scene.n_beams, -1),)
     return found
+
+
+def moving_probes(settings, scene, phases, geometry):
+    """The keyword arguments of :func:`~uq.physics.turbulencesampling.
+    record_radial_velocities` that move its beams with the platform (``displacements``,
+    ``directions``, ``position``: the nominal lidar, on the reference point's vertical
+    at ``lidar.height``), and the largest displacement of a probe point [m]; ({}, 0.0)
+    where the scan has no motion (`phases` None, :func:`coherent_phases`)."""
+    if phases is None:
+        return {}, 0.0
+    from uq.pipeline import beammotion
+    position = np.array([0.0, 0.0, settings["lidar"]["height"]
+                         - settings["wind"]["reference_height"]])
+    displacements, directions = beammotion.moving_beams(
+        scene, scene.time_resolved.motion.unit_phases(phases), geometry,
+        settings["wind"]["direction"])
+    margin = beammotion.motion_margin(geometry, position, displacements, directions)
+    return {"displacements": displacements, "directions": directions,
+            "position": position}, margin
 
 
 def probe_volume_resolved(scene):
