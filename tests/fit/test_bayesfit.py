@@ -12,6 +12,7 @@ from scipy.optimize import curve_fit
 from scipy.signal import lfilter
 from scipy.stats import chi2, multivariate_normal, norm
 
+from uq.constants import VON_KARMAN
 from uq.fit.bayesfit import (NotConverged, ProfilePosterior, SamplingSpace, posterior_summary,
                              profile_data, quantile_standard_errors, rank_rhat,
                              sample_posterior)
@@ -194,9 +195,11 @@ def test_log_law_tail_error_covers_the_spread_over_independent_chains():
     assert set(result["quantile_mcse"]) == {"low95", "low68", "median", "high68", "high95"}
 
 
-def test_log_uniform_parameters_are_sampled_as_their_logarithm():
-    """The sampled space of z0 is ln z0 and its density there is the posterior times z0
-    (the Jacobian); for a log-uniform prior that makes the prior flat in ln z0."""
+def test_log_law_is_sampled_as_friction_velocity_and_central_speed():
+    """The log law is sampled as (u*, U_c), U_c = (u*/kappa)(ln z_c - ln z0) the speed at
+    z_c = exp(mean ln z); the density there is the posterior times |d(u*, z0)/d(u*, U_c)|
+    = z0 kappa / u*. The Jacobian is checked against central differences of the map
+    back (rtol 1e-6: truncation error of a 1e-6 relative step, squared)."""
     heights = np.array([20.0, 40.0, 80.0, 160.0])
     data = profile_data(heights, log_law_profile(heights, 0.4, 0.01),
                         speed_covariance=np.full(heights.size, 0.1))
@@ -204,11 +207,17 @@ def test_log_uniform_parameters_are_sampled_as_their_logarithm():
     space = SamplingSpace(posterior)
     theta = np.array([[0.4, 0.01], [0.41, 0.002]])
     points = space.to_sampled(theta)
-    np.testing.assert_allclose(points[:, 1], np.log(theta[:, 1]), rtol=1e-15)
-    np.testing.assert_allclose(space.to_natural(points), theta, rtol=1e-15)
-    np.testing.assert_allclose(space.log_probability(points),
-                               posterior.log_probability(theta) + np.log(theta[:, 1]),
-                               rtol=1e-12)
+    np.testing.assert_allclose(points[:, 1], log_law_profile(np.exp(np.mean(np.log(
+        heights))), theta[:, 0], theta[:, 1]), rtol=1e-14)
+    np.testing.assert_allclose(space.to_natural(points), theta, rtol=1e-13)
+    for point, natural in zip(points, theta):
+        step = 1e-6 * np.abs(point)
+        columns = [(space.to_natural(point + e) - space.to_natural(point - e)) / (2 * e.sum())
+                   for e in np.diag(step)]
+        determinant = abs(np.linalg.det(np.array(columns).T))
+        np.testing.assert_allclose(np.exp(space.log_jacobian(natural)), determinant, rtol=1e-6)
+    np.testing.assert_allclose(space.log_probability(points), posterior.log_probability(
+        theta) + np.log(theta[:, 1] * VON_KARMAN / theta[:, 0]), rtol=1e-12)
 
 
 def test_least_squares_interval_of_z0_is_the_delta_method_on_ln_z0():
