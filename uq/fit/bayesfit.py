@@ -203,7 +203,10 @@ class ProfilePosterior:
         speed = variances(self.data.speed_covariance)
         if self.relative:
             speed = speed * self._profile(self.data.heights, parameters) ** 2
-        return speed + self._slope(parameters) ** 2 * variances(self.data.height_covariance)
+        height = variances(self.data.height_covariance)
+        if not np.any(height):                  # exact heights: no slope (a second profile)
+            return np.broadcast_to(speed, parameters.shape[:-1] + speed.shape[-1:])
+        return speed + self._slope(parameters) ** 2 * height
 
     def _independent_log_likelihood(self, theta, residual):
         """The same for diagonal covariances: no factorisation, O(n) per walker."""
@@ -278,7 +281,7 @@ def rank_rhat(chains):
     return max(split_rhat(normalised(chains)), split_rhat(normalised(folded)))
 
 
-def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=2000,
+def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=500,
                      max_steps=50000):
     """Sample with several independent emcee ensembles until converged.
 
@@ -320,7 +323,7 @@ def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=20
         target = space.log_probability if space.logarithmic.any() or space.centred else \
             posterior.log_probability                   # nothing to transform: no wrapper
         samplers.append(emcee.EnsembleSampler(walkers, centre.size, target, vectorize=True))
-    chains, taus = _run_until_converged(samplers, states, steps, max_steps)
+    chains, taus = _run_until_converged(samplers, states, steps, max_steps, space)
     tau = np.max(taus, axis=0)
     burn, thin = int(np.ceil(2 * tau.max())), max(1, int(tau.min() / 2))
     chains = space.to_natural(np.array(chains))         # (ensembles, steps, walkers, k)
@@ -387,6 +390,14 @@ class SamplingSpace:
                 out[..., self.roughness_index] = self.ln_centre_height - VON_KARMAN * \
                     out[..., self.roughness_index] / out[..., self.speed_index]
             out[..., self.logarithmic] = np.exp(out[..., self.logarithmic])  # beyond: -inf
+        return out
+
+    def to_reported(self, sampled):
+        """Points (..., k) of the sampled space -> the parameters as reported, with the
+        logarithm of each log-uniform one (ln z0): the coordinates of tau's check."""
+        out = self.to_natural(sampled)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out[..., self.logarithmic] = np.log(out[..., self.logarithmic])
         return out
 
     def log_jacobian(self, natural):
@@ -492,13 +503,19 @@ def _starting_ball(space, centre, rng, walkers):
     return centre + offsets
 
 
-def _run_until_converged(samplers, states, steps, max_steps):
+def _run_until_converged(samplers, states, steps, max_steps, space):
     """Run every ensemble in rounds of `steps`, all to the same length, until that length
-    is above TAU_FACTOR x the largest tau of any ensemble (or `max_steps`)."""
+    is above TAU_FACTOR x the largest tau of any ensemble (or `max_steps`).
+
+    tau is per parameter the larger of the walkers' own coordinates and the parameters
+    as reported (ln z0 for a log-uniform one, :meth:`SamplingSpace.to_reported`): a
+    function of a well-mixed chain may still be autocorrelated longer (z0 from u* and
+    U_c), and the criterion must hold for what the user reads."""
     while True:
         states = [sampler.run_mcmc(state, steps, progress=False)
                   for sampler, state in zip(samplers, states)]
-        taus = [sampler.get_autocorr_time(tol=0) for sampler in samplers]
+        taus = [np.maximum(sampler.get_autocorr_time(tol=0), emcee.autocorr.integrated_time(
+            space.to_reported(sampler.get_chain()), tol=0)) for sampler in samplers]
         iteration = samplers[0].iteration
         if iteration > TAU_FACTOR * np.max(taus) or iteration >= max_steps:
             return [sampler.get_chain() for sampler in samplers], taus
