@@ -135,6 +135,7 @@ class ProfilePosterior:
         self.relative = relative
         self.diagonal = all(np.ndim(c) == 1 or np.count_nonzero(c - np.diag(np.diag(c))) == 0
                             for c in (data.speed_covariance, data.height_covariance))
+        self.exact_heights = not np.any(data.height_covariance)
 
     def model(self, heights, *parameters):
         return self.function(heights, *parameters, **self.fixed)
@@ -203,10 +204,9 @@ class ProfilePosterior:
         speed = variances(self.data.speed_covariance)
         if self.relative:
             speed = speed * self._profile(self.data.heights, parameters) ** 2
-        height = variances(self.data.height_covariance)
-        if not np.any(height):                  # exact heights: no slope (a second profile)
+        if self.exact_heights:                  # no slope (a second profile) to carry
             return np.broadcast_to(speed, parameters.shape[:-1] + speed.shape[-1:])
-        return speed + self._slope(parameters) ** 2 * height
+        return speed + self._slope(parameters) ** 2 * variances(self.data.height_covariance)
 
     def _independent_log_likelihood(self, theta, residual):
         """The same for diagonal covariances: no factorisation, O(n) per walker."""
@@ -320,7 +320,7 @@ def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=50
         start = _starting_ball(space, space.to_sampled(centre), ball, walkers)
         states.append(emcee.State(start, random_state=np.random.RandomState(
             np.random.MT19937(stream)).get_state()))
-        target = space.log_probability if space.logarithmic.any() or space.centred else \
+        target = space.log_probability if space.transformed else \
             posterior.log_probability                   # nothing to transform: no wrapper
         samplers.append(emcee.EnsembleSampler(walkers, centre.size, target, vectorize=True))
     chains, taus = _run_until_converged(samplers, states, steps, max_steps, space)
@@ -372,6 +372,7 @@ class SamplingSpace:
             self.speed_index = names.index("friction_velocity")
             self.roughness_index = names.index("roughness_length")
             self.ln_centre_height = float(np.mean(np.log(posterior.data.heights)))
+        self.transformed = bool(self.logarithmic.any() or self.centred)
 
     def to_sampled(self, theta):
         """Parameters (..., k) in their own units -> the sampled space."""
@@ -413,7 +414,7 @@ class SamplingSpace:
 
     def log_probability(self, points):
         """log density of walkers (W, k) in the sampled space, for emcee; shape (W,)."""
-        if not (self.logarithmic.any() or self.centred):   # the posterior itself
+        if not self.transformed:                        # the posterior itself
             return self.posterior.log_probability(points)
         natural = self.to_natural(np.asarray(points, float))
         result = self.posterior.log_probability(natural)
