@@ -515,11 +515,14 @@ def _run_until_converged(samplers, states, steps, max_steps, space):
     while True:
         states = [sampler.run_mcmc(state, steps, progress=False)
                   for sampler, state in zip(samplers, states)]
-        taus = [np.maximum(sampler.get_autocorr_time(tol=0), emcee.autocorr.integrated_time(
-            space.to_reported(sampler.get_chain()), tol=0)) for sampler in samplers]
+        taus = [sampler.get_autocorr_time(tol=0) for sampler in samplers]
         iteration = samplers[0].iteration
         if iteration > TAU_FACTOR * np.max(taus) or iteration >= max_steps:
-            return [sampler.get_chain() for sampler in samplers], taus
+            if space.transformed:                       # only then: the check costs FFTs
+                taus = [np.maximum(tau, emcee.autocorr.integrated_time(space.to_reported(
+                    sampler.get_chain()), tol=0)) for tau, sampler in zip(taus, samplers)]
+            if iteration > TAU_FACTOR * np.max(taus) or iteration >= max_steps:
+                return [sampler.get_chain() for sampler in samplers], taus
 
 
 def posterior_summary(samples, names):
