@@ -12,7 +12,7 @@ with covariance
 * ``sigma = exp(ln_sigma)``: a free extra scatter (turbulence), optional.
 
 Priors are uniform within bounds (:data:`DEFAULT_PRIORS`, documented there),
-log-uniform where marked, or normal ``(mean, u, "normal")`` when configured. The posterior is sampled by emcee's ensemble with differential-evolution moves [4]
+log-uniform where marked, or normal ``(mean, u, "normal")`` when configured. The posterior is sampled by emcee's affine-invariant ensemble
 (Foreman-Mackey et al. 2013) in several independent ensembles, each started in a small
 ball about the maximum a posteriori and seeded through emcee's State random_state.
 Convergence is decided, and failure raised, from the integrated autocorrelation time
@@ -38,10 +38,6 @@ References
    improved R-hat. Bayesian Analysis 16(2), 667-718.
 .. [3] Peelle, R. W. (1987). Peelle's pertinent puzzle. Informal memorandum, Oak Ridge
    National Laboratory; see Zhao, Z. and Perey, F. G. (1992), ORNL/TM-12106.
-.. [4] ter Braak, C. J. F. (2006). A Markov chain Monte Carlo version of the genetic
-   algorithm Differential Evolution. Statistics and Computing 16, 239-249; ter Braak,
-   C. J. F. and Vrugt, J. A. (2008). Differential Evolution Markov chain with snooker
-   updater and fewer chains. Statistics and Computing 18, 435-446.
 """
 from dataclasses import dataclass
 
@@ -75,11 +71,6 @@ RHAT_LIMIT = 1.01
 BALL = 1e-4
 #: Probabilities of the posterior summary: the 95 % and 68 % central intervals and the
 #: median, by summary key.
-#: emcee's moves: differential evolution (ter Braak 2006), with 20 % snooker updates
-#: (ter Braak and Vrugt 2008), the mixture of emcee's "moves" tutorial [1]. On the
-#: near-Gaussian targets here it mixes ~2.5x faster than the stretch move (3-row log
-#: law with scatter: tau ~55-76 -> ~20-24 steps), the same posterior.
-MOVES = ((emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2))
 #: Sokal's window constant c of the integrated autocorrelation time (emcee's default) [1].
 AUTOCORRELATION_WINDOW = 5
 SUMMARY_PROBABILITIES = {"low95": 0.025, "low68": 0.16, "median": 0.5, "high68": 0.84,
@@ -331,8 +322,7 @@ def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=50
             np.random.MT19937(stream)).get_state()))
         target = space.log_probability if space.transformed else \
             posterior.log_probability                   # nothing to transform: no wrapper
-        samplers.append(emcee.EnsembleSampler(walkers, centre.size, target, vectorize=True,
-                                              moves=list(MOVES)))
+        samplers.append(emcee.EnsembleSampler(walkers, centre.size, target, vectorize=True))
     chains, taus = _run_until_converged(samplers, states, steps, max_steps, space)
     tau = np.max(taus, axis=0)
     burn, thin = int(np.ceil(2 * tau.max())), max(1, int(tau.min() / 2))
