@@ -2,7 +2,8 @@
 
 :mod:`uq.physics.turbulencebox` builds the box from the spectral factor C(k) (Mann 1998,
 Sec. 3) and :mod:`uq.physics.spectraltensor` writes Phi_ij(k) (Mann 1994, Eq. 3.13-3.16);
-they were written separately, so ``C C^T = Phi`` checks the algebra of both.
+their algebra was written separately (they share only the exact eddy lifetime), so
+``C C^T = Phi`` checks the algebra of both.
 """
 import numpy as np
 import pytest
@@ -33,7 +34,7 @@ def test_factor_squared_is_the_tensor_with_the_exact_lifetime(monkeypatch):
     # with the same (exact, hypergeometric) eddy lifetime in both, only rounding differs:
     # ~100 flops per element in double precision, 1e-11 leaves a margin over ~1e-13
     monkeypatch.setattr(turbulencebox, "eddy_lifetime",
-                        lambda kl, gamma, xp=np: turbulencebox.mann1994_eddy_lifetime(kl, gamma))
+                        lambda kl, gamma, xp=np: spectraltensor.mann_eddy_lifetime(kl, 1.0, gamma))
     k = _wavenumbers()
     phi = spectraltensor.MannTensor(LENGTH, ANISOTROPY, ALPHA_EPSILON).matrix(*k)
     assert _relative_difference(_factor_product(k), phi) < 1e-11

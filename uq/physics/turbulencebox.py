@@ -26,7 +26,8 @@ for a seed, no CuPy path, needs pydantic and toml. Neither runs on a GPU, which 
 item 7 asks for, so the generator is written here in ~100 lines against the numpy API that
 CuPy mirrors (``xp``): the same algorithm as both (Mann 1998 [2], Sec. 3), and its
 spectral factor is written from the paper, independently of the spectral path's tensor, so
-that ``C C^T = Phi`` cross-checks the two. The same box here: 1.3 s CPU, 0.6 GB peak
+that ``C C^T = Phi`` cross-checks the two (only the exact eddy lifetime, which the table
+below interpolates, and the Kaimal spectra and coherence are the spectral path's own). The same box here: 1.3 s CPU, 0.6 GB peak
 (numpy, scipy.fft on one thread); a ten-minute record: :mod:`uq.bench.turbulence`. The
 GPU path (CuPy) is written but was not timed (no GPU in the session that wrote it).
 
@@ -87,9 +88,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft
-import scipy.special
 
 from uq import constants
+from uq.physics.spectraltensor import KaimalSpectra, mann_eddy_lifetime
 
 
 def array_namespace(device="cpu"):
@@ -199,26 +200,11 @@ def von_karman_energy_spectrum(k, alpha_epsilon, length_scale):
             / (1.0 + kl**2) ** constants.VON_KARMAN_EXPONENT)      # von Karman, Sec. 3 [1]
 
 
-def mann1994_eddy_lifetime(kl, anisotropy):
-    """Mann's eddy lifetime beta [1] (times the shear), Mann (1994) Sec. 3.3, exact.
-
-    Parameters
-    ----------
-    kl : array_like
-        k L [1], > 0.
-    anisotropy : float
-        Gamma [1].
-    """
-    kl = np.asarray(kl, dtype=float)
-    hyp = scipy.special.hyp2f1(1.0 / 3.0, constants.VON_KARMAN_EXPONENT, 4.0 / 3.0, -kl**-2.0)
-    return anisotropy * kl ** (-2.0 / 3.0) / np.sqrt(hyp)         # lifetime, Sec. 3.3 [1]
-
-
 def _lifetime_table():
     """log(kL) nodes and log(beta / Gamma) on them (module constants)."""
     low, high = np.log10(constants.EDDY_LIFETIME_TABLE_RANGE)
     nodes = np.linspace(low, high, int((high - low) * constants.EDDY_LIFETIME_TABLE_PER_DECADE) + 1)
-    return nodes * np.log(10.0), np.log(mann1994_eddy_lifetime(10.0**nodes, 1.0))
+    return nodes * np.log(10.0), np.log(mann_eddy_lifetime(10.0**nodes, 1.0, 1.0))
 
 
 _TABLE = _lifetime_table()
@@ -229,7 +215,7 @@ def eddy_lifetime(kl, anisotropy, xp=np):
 
     Outside the table's kL range the asymptotes ``beta ~ (kL)^-1`` (kL -> 0) and ``beta ~
     (kL)^(-2/3)`` (kL -> inf) continue it. Same parameters as
-    :func:`mann1994_eddy_lifetime`; ``kl`` is an array of ``xp``.
+    :func:`uq.physics.spectraltensor.mann_eddy_lifetime`; ``kl`` is an array of ``xp``.
     """
     log_nodes, log_values = (xp.asarray(a) for a in _TABLE)
     step = float(_TABLE[0][1] - _TABLE[0][0])
@@ -495,36 +481,6 @@ def mann_box(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
     return TurbulenceBox(grid=grid, velocity=velocity)
 
 
-def kaimal_spectrum(frequency, sigma, length, speed):
-    """IEC 61400-1 Kaimal one-sided spectrum S(f) [m2 s-2 Hz-1], Annex B, Table B.1.
-
-    Parameters
-    ----------
-    frequency : array_like
-        f [Hz], >= 0.
-    sigma : float
-        Standard deviation of the component [m s-1].
-    length : float
-        Integral scale L_k [m].
-    speed : float
-        Mean wind speed V [m s-1].
-    """
-    f = np.asarray(frequency, dtype=float)
-    return sigma**2 * 4.0 * length / speed / (1.0 + 6.0 * f * length / speed) ** (5.0 / 3.0)
-
-
-def iec_coherence(separation, frequency, speed, coherence_length):
-    """IEC 61400-1 exponential coherence [1], Annex B (exponential coherence model).
-
-    ``exp(-a sqrt((f r / V)^2 + (b r / L_c)^2))`` with ``a`` and ``b`` of
-    :mod:`uq.constants`; ``separation`` r [m], ``frequency`` f [Hz], ``speed`` V [m s-1],
-    ``coherence_length`` L_c [m].
-    """
-    r, f = np.asarray(separation, dtype=float), np.asarray(frequency, dtype=float)
-    a, b = constants.IEC_COHERENCE_DECREMENT, constants.IEC_COHERENCE_SCALE_RATIO
-    return np.exp(-a * np.sqrt((f * r / speed) ** 2 + (b * r / coherence_length) ** 2))
-
-
 def kaimal_box(grid, sigma_u, speed, scale_parameter, rng, xp=np,
                slab_cells=constants.BOX_SLAB_CELLS):
     """A Kaimal field with IEC coherence on a box periodic along x (Veers' method).
@@ -557,25 +513,23 @@ def kaimal_box(grid, sigma_u, speed, scale_parameter, rng, xp=np,
     separation = np.linalg.norm(points[:, None] - points[None], axis=-1)
     k1 = 2.0 * np.pi * np.fft.rfftfreq(nx, dx)
     frequency = speed * k1 / (2.0 * np.pi)
-    lengths = np.multiply(constants.IEC_KAIMAL_LENGTH_FACTORS, scale_parameter)
-    sigmas = np.multiply(constants.IEC_KAIMAL_SIGMA_RATIOS, sigma_u)
-    coherence_length = constants.IEC_COHERENCE_LENGTH_FACTOR * scale_parameter
+    spectra = KaimalSpectra(tuple(np.multiply(constants.IEC_KAIMAL_SIGMA_RATIOS, sigma_u)),
+                            tuple(np.multiply(constants.IEC_KAIMAL_LENGTH_FACTORS, scale_parameter)),
+                            constants.IEC_COHERENCE_LENGTH_FACTOR * scale_parameter, speed)
     check_kaimal_points(ny * nz)
     fft = _fft(xp)
     noise = white_noise(rng, (3, nx, ny, nz), xp)
     half = fft.rfft(noise.reshape(3, nx, ny * nz), axis=1)            # (3, k1, points)
     del noise
     # two-sided densities in k1 [m3 s-2]: S(f) df / dk1 / 2, Table B.1 [3] via Taylor
-    density = np.stack([kaimal_spectrum(frequency, sigmas[c], lengths[c], speed)
-                        for c in range(3)]) * speed / (4 * np.pi)
+    density = np.stack([spectra.spectrum(c, frequency) for c in range(3)]) * speed / (4 * np.pi)
     density[:, 0] = 0.0                                                # the box's mean is zero
     amplitude = xp.asarray(np.sqrt(density * 2.0 * np.pi / dx))        # sqrt(nx dk1 F)
     per_slab = max(1, slab_cells // (ny * nz) ** 2)
     for a in range(0, k1.size, per_slab):
         part = slice(a, min(a + per_slab, k1.size))
         # one coherence, so one Cholesky factor, for the three components
-        coherence = iec_coherence(separation, frequency[part, None, None], speed,
-                                  coherence_length)
+        coherence = spectra.coherence(separation, frequency[part, None, None])
         factor = xp.asarray(np.linalg.cholesky(coherence))
         half[:, part] = xp.einsum("fpq,cfq->cfp", factor, half[:, part]) * amplitude[:, part, None]
     velocity = fft.irfft(half, n=nx, axis=1).reshape(3, nx, ny, nz)
