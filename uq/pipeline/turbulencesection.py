@@ -32,8 +32,7 @@ import math
 
 import numpy as np
 
-from uq.constants import (IEC_SCALE_HEIGHT, IEC_SCALE_PARAMETER, IEC_SCALE_SLOPE,
-                          KAIMAL_LENGTH_FACTOR, MANN_ANISOTROPY, MANN_LENGTH_FACTOR,
+from uq.constants import (KAIMAL_LENGTH_FACTOR, MANN_ANISOTROPY, MANN_LENGTH_FACTOR,
                           MAX_ANISOTROPY, MAX_LENGTH_SCALE, MAX_RECORD_DURATION,
                           MAX_RECORD_SCANS, MAX_RECORDS, MAX_TURBULENCE_INTENSITY,
                           DEFAULT_RECORDS, TURBULENCE_PROBE_NODES)
@@ -41,6 +40,7 @@ from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_di
 from uq.physics.probe import legendre
 from uq.physics.rotation import attitude_matrix, rotate_vectors
 from uq.physics.scangeometry import ScanGeometry, earth_to_wind_frame
+from uq.physics.spectraltensor import iec_scale_parameter
 from uq.pipeline import probesection
 from uq.pipeline.motionsection import SCAN_DEFAULTS
 
@@ -52,16 +52,6 @@ RECORD_KEYS = ("duration", "count")
 LENGTH_FACTORS = {"mann": MANN_LENGTH_FACTOR, "kaimal": KAIMAL_LENGTH_FACTOR}
 
 
-def iec_scale_parameter(height):
-    """IEC 61400-1 Ed. 3 (2005) turbulence scale parameter Lambda_1 [m] at `height` [m]:
-    ``0.7 z`` up to 60 m, 42 m above (Eq. 5).
-
-    >>> iec_scale_parameter(100.0), round(iec_scale_parameter(40.0), 12)
-    (42.0, 28.0)
-    """
-    return IEC_SCALE_SLOPE * height if height < IEC_SCALE_HEIGHT else IEC_SCALE_PARAMETER
-
-
 def default_length_scale(model, height):
     """The IEC 61400-1 length scale [m] of `model` at `height` [m]: Mann's L = 0.8
     Lambda_1, Kaimal's L_u = 8.1 Lambda_1.
@@ -69,7 +59,7 @@ def default_length_scale(model, height):
     >>> round(default_length_scale("mann", 100.0), 12), round(default_length_scale("kaimal", 100.0), 12)
     (33.6, 340.2)
     """
-    return LENGTH_FACTORS[model] * iec_scale_parameter(height)
+    return LENGTH_FACTORS[model] * float(iec_scale_parameter(height))   # Lambda_1, Eq. 5
 
 
 def validate_turbulence(check, value, reference_height):
