@@ -4,7 +4,7 @@
 in a thread of the process that drives the run. dask's periodic housekeeping is slowed
 down (:data:`CLUSTER_SETTINGS`): by default each event loop checks its own health every
 20 ms, every process samples its system load every 0.5 s and every worker samples its
-stacks every 10 ms for the dashboard's profile (uq starts no dashboard). On a busy
+stacks every 10 ms for the dashboard's profile. On a busy
 machine that costs the driving process about 0.03 s of CPU time per second of run and
 each worker as much again (measured with 2 workers, 2 cores, idle cluster: 0.034 -> 0.010
 s/s in the driver, 0.058 -> 0.011 s/s in the workers): CPU time taken from the sweep
@@ -24,7 +24,8 @@ CLUSTER_SETTINGS = {
 @contextlib.contextmanager
 def local_cluster(workers, starting=contextlib.nullcontext, **options):
     """A ``dask.distributed.Client`` of a new LocalCluster of `workers` processes, one
-    thread each, no dashboard, with :data:`CLUSTER_SETTINGS`; closed at the end of the
+    thread each, with :data:`CLUSTER_SETTINGS`, its HTTP server (and dashboard, where
+    bokeh is installed) on a free port; closed at the end of the
     block. `starting`: a context manager held while the worker processes start (the
     command line's, which keeps Ctrl-C from them); `options` go to LocalCluster (e.g.
     ``host``). The client is not made dask's default scheduler."""
@@ -33,6 +34,6 @@ def local_cluster(workers, starting=contextlib.nullcontext, **options):
     with dask.config.set(CLUSTER_SETTINGS):
         with starting():
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
-                                   processes=True, dashboard_address=None, **options)
+                                   processes=True, dashboard_address=":0", **options)
         with cluster, Client(cluster, set_as_default=False) as client:
             yield client
