@@ -175,8 +175,10 @@ def run_as_uq_run(scenario, folder, client=None):
     marks = {}
 
     def progress(done, total):                # after each chunk is saved
-        if done == 1 or done == total:
-            marks[done == total] = _process_cpu()
+        if done == 1:
+            marks["first"] = _process_cpu()
+        if done == total:
+            marks["last"] = _process_cpu()
     checkpoint = Checkpoint(Path(folder) / "out.nc.partial").acquire()
     cpu, wall = _process_cpu(), time.perf_counter()
     try:
@@ -185,7 +187,7 @@ def run_as_uq_run(scenario, folder, client=None):
         checkpoint.clear()
     finally:
         checkpoint.release()
-    return {"cpu": _process_cpu() - cpu, "window": marks[True] - marks[False],
+    return {"cpu": _process_cpu() - cpu, "window": marks["last"] - marks["first"],
             "wall": time.perf_counter() - wall, "dataset": dataset}
 
 
