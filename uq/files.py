@@ -232,15 +232,34 @@ def write_text(path, text, source="-o", replace_any=False):
     return Path(path)
 
 
+def write_bytes(path, data, source="-o"):
+    """Write the bytes `data` to `path` atomically; returns the path."""
+    with atomic_file(path, source) as temporary:
+        temporary.write_bytes(data)
+    return Path(path)
+
+
 def write_netcdf(dataset, path, source="-o"):
     """Write an xarray Dataset to netCDF4 at `path` atomically, stamped with
     ``uq_version`` (its mark of ownership); returns the path."""
-    if "uq_version" not in dataset.attrs:
-        dataset = dataset.copy(deep=False)
-        dataset.attrs["uq_version"] = __version__
     with atomic_file(path, source) as temporary:
-        dataset.to_netcdf(temporary, format="NETCDF4", engine="netcdf4")
+        _stamped(dataset).to_netcdf(temporary, format="NETCDF4", engine="netcdf4")
     return Path(path)
+
+
+def netcdf_bytes(dataset):
+    """The netCDF4 file :func:`write_netcdf` writes, as bytes made in memory (a dask
+    worker encodes a checkpoint chunk so; the run's own process only writes them)."""
+    return bytes(_stamped(dataset).to_netcdf(format="NETCDF4", engine="netcdf4"))
+
+
+def _stamped(dataset):
+    """`dataset` with ``uq_version`` among its attributes (a shallow copy if it lacks it)."""
+    if "uq_version" in dataset.attrs:
+        return dataset
+    dataset = dataset.copy(deep=False)
+    dataset.attrs["uq_version"] = __version__
+    return dataset
 
 
 def save_figure(figure, path, source="-o", **options):

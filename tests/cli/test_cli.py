@@ -183,8 +183,8 @@ def test_interrupted_run_keeps_its_checkpoint_and_resumes(tmp_path, capsys, monk
     import uq.pipeline.checkpoint
     save = uq.pipeline.checkpoint.Checkpoint.save
 
-    def save_then_interrupt(self, index, dataset):
-        save(self, index, dataset)
+    def save_then_interrupt(self, index, dataset, *encoded):
+        save(self, index, dataset, *encoded)
         raise KeyboardInterrupt
     monkeypatch.setattr(uq.pipeline.checkpoint.Checkpoint, "save", save_then_interrupt)
     status, err = uq_in_process(["run", str(path), "--quiet"], tmp_path, capsys, monkeypatch)

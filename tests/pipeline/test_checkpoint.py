@@ -370,3 +370,25 @@ def test_a_record_edited_during_the_run_is_not_mixed_in(tmp_path, monkeypatch):
     with pytest.raises(DataFileError, match="record.csv.*motion.series.file.*changed while"):
         run(scenario, progress=edit, checkpoint=Checkpoint(directory))
     assert len(list(directory.glob("chunk-*.nc"))) == 2
+
+
+def test_a_chunk_encoded_elsewhere_resumes_like_one_written_here(tmp_path,
+                                                                 one_scene_per_chunk):
+    """A dask worker encodes a chunk's file (encode_chunk) and the run's process writes
+    its bytes: --resume takes it as it takes a chunk written in the process."""
+    from uq.pipeline.checkpoint import encode_chunk
+    here = tmp_path / "here.partial"
+    direct = run(one_scene_per_chunk, checkpoint=Checkpoint(here))
+    plan = uq.pipeline.sweep.sweep_plan(one_scene_per_chunk)
+    written = Checkpoint(here, resume=True).acquire()
+    written.start(one_scene_per_chunk, 7, plan.chunks)
+    elsewhere = Checkpoint(tmp_path / "elsewhere.partial").acquire()
+    elsewhere.start(one_scene_per_chunk, 7, plan.chunks)
+    for index, dataset in written.load().items():
+        elsewhere.save(index, dataset, encode_chunk(dataset, elsewhere.digest))
+    written.release(), elsewhere.release()
+    seen = []
+    resumed = run(one_scene_per_chunk, progress=lambda done, total: seen.append(done),
+                  checkpoint=Checkpoint(tmp_path / "elsewhere.partial", resume=True))
+    assert seen == [8]                      # every chunk from the encoded files
+    same(resumed, direct)

@@ -158,11 +158,80 @@ def test_resume_refuses_a_checkpoint_of_another_run(tmp_path, many_chunks):
                checkpoint=Checkpoint(directory, resume=True))
 
 
-def test_distributed_run_is_identical_to_single_process(many_chunks):
-    from dask import distributed         # the 'test' extra installs it: no silent skip
+@pytest.fixture(scope="module")
+def cluster():
+    """A client of uq's local cluster of 2 worker processes (the 'test' extra installs
+    dask: no silent skip), shared by the module's distributed tests."""
+    from uq.pipeline.cluster import local_cluster
+    with local_cluster(2, host="127.0.0.1") as client:
+        yield client
+
+
+def test_distributed_run_is_identical_to_single_process(many_chunks, cluster):
     scenario = many_chunks.with_values({"sampling.seed": 11})
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  host="127.0.0.1", dashboard_address=None) as cluster, \
-            distributed.Client(cluster) as client:
-        remote = uq.run(scenario, client=client)
+    remote = uq.run(scenario, client=cluster)
     data_equal(remote, uq.run(scenario))
+
+
+class RecordingClient:
+    """A dask client that records what each task is submitted with."""
+
+    def __init__(self, client):
+        self.client, self.submitted = client, []
+
+    def submit(self, function, *arguments, **options):
+        self.submitted.append(arguments)
+        return self.client.submit(function, *arguments, **options)
+
+    def __getattr__(self, name):
+        return getattr(self.client, name)
+
+
+#: Bytes of a task's own arguments (its chunk, seed, model switch and the checkpoint's
+#: digest: ~250 bytes pickled); the scenario and the plan (a few kB, growing with the
+#: grid) go to the cluster once.
+TASK_BYTES = 1024
+
+
+def test_the_driver_evaluates_no_scene_and_encodes_no_chunk(tmp_path, many_chunks, cluster,
+                                                            monkeypatch):
+    """A distributed run with a checkpoint, as uq run --workers makes it: the driving
+    process evaluates no model (Monte Carlo, GUM, paper model) and encodes no checkpoint
+    file; each task carries its chunk and a few hundred bytes, the scenario and the plan
+    are sent once; the chunks the workers encoded resume to the same result."""
+    import pickle
+    from distributed import Future
+    import uq.pipeline.checkpoint
+    import uq.pipeline.runner
+    scenario = many_chunks.with_values({"sampling.seed": 11})
+    local = uq.run(scenario)
+
+    def in_the_driver(*arguments, **options):
+        raise AssertionError("work of a chunk done in the driving process")
+    for name in ("run_chunk", "run_scene", "_propagate", "_paper_uncertainty",
+                 "encode_chunk"):
+        monkeypatch.setattr(uq.pipeline.runner, name, in_the_driver)
+    monkeypatch.setattr(uq.pipeline.checkpoint, "encode_chunk", in_the_driver)
+    monkeypatch.setattr(uq.pipeline.checkpoint, "write_netcdf", in_the_driver)
+    client = RecordingClient(cluster)
+    directory = tmp_path / "out.nc.partial"
+    data_equal(uq.run(scenario, client=client, checkpoint=Checkpoint(directory)), local)
+    assert len(client.submitted) == len(sweep_plan(scenario).chunks) == 8
+    for arguments in client.submitted:
+        shared, own = arguments[:2], arguments[2:]
+        assert all(isinstance(item, Future) for item in shared)
+        assert len(pickle.dumps(own)) < TASK_BYTES
+    assert len(list(directory.glob("chunk-*.nc"))) == 8
+    seen = []                           # every chunk from the workers' files, none computed
+    resumed = uq.run(scenario, progress=lambda done, total: seen.append(done),
+                     checkpoint=Checkpoint(directory, resume=True))
+    assert seen == [8]
+    data_equal(resumed, local)
+
+
+def test_the_local_cluster_slows_dask_housekeeping(cluster):
+    """uq.pipeline.cluster's settings reach the worker processes."""
+    import dask
+    from uq.pipeline.cluster import CLUSTER_SETTINGS
+    seen = cluster.run(lambda: {key: dask.config.get(key) for key in CLUSTER_SETTINGS})
+    assert list(seen.values()) == [CLUSTER_SETTINGS] * 2

@@ -71,6 +71,132 @@ def draw_floor(repeats=200, draws=MC_DRAWS):
     return seconds / repeats
 
 
+#: Draws per scene of the serial-fraction benchmark: the user's run of issue 26.
+SERIAL_DRAWS = 100_000
+#: Workers whose Amdahl bound is reported [1].
+AMDAHL_WORKERS = (2, 4, 8, 16)
+
+
+def serial_fraction(workers=2, quick=False, draws=SERIAL_DRAWS):
+    """The serial share of a distributed sweep, from CPU times, not wall time.
+
+    ``rubio2022_misalignment`` at `draws` per scene (its whole grid: 3456 scenes, 108
+    chunks at 10^5; `quick`: 1 misalignment in 3 and 1 wind direction in 3, 12 chunks)
+    runs as ``uq run`` runs it (a checkpoint, then the results file), once in this
+    process and once on a local cluster of `workers` processes
+    (:func:`uq.pipeline.cluster.local_cluster`, started and warmed beforehand). CPU
+    times are user + system time of all threads of a process (getrusage):
+
+    - C_single: this process, the single-process run;
+    - C_driver: this process, the distributed run (dask's scheduler and client threads
+      live in it too); C_window: its part between the first chunk's result (received
+      and saved) and the last's, while at least one worker is computing;
+    - C_workers: the worker processes, the distributed run.
+
+    The serial fraction is the driver's CPU time that does not overlap the workers' (the
+    planning, the scattering and submitting, the wait for and saving of the first chunk;
+    then the assembly, the results file and the checkpoint's removal) over the
+    single-process run's::
+
+        f = (C_driver - C_window) / C_single
+
+    ``amdahl_speedup_N = 1 / (f + (1 - f) / N)`` is Amdahl's bound with N workers and
+    ``amdahl_efficiency_N`` that over N (the target, 0.6 up to 8 workers, needs f <=
+    0.095; issue 26 asks for f < 0.05).
+    Two more figures say what else could limit it: ``driver_cpu_over_single`` =
+    C_driver / C_single (the fraction if all the driver's work were serial: a bound
+    from above on f), and ``driver_throughput_speedup`` = C_single / C_window, the
+    speed-up at which the driver's work during the run (receiving and writing each
+    chunk, dask's scheduling) would fill its own core. ``speedup_N`` = C_single /
+    (C_driver - C_window + max(C_workers / N, C_window)) adds the workers' own overhead
+    (``worker_cpu_over_single`` = C_workers / C_single; 1: none), given N free cores.
+    The cluster's start is wall time before the first chunk, reported on its own
+    (``cluster_start_wall_s``). The results of the two runs are checked bit for bit.
+
+    Returns
+    -------
+    dict
+        Figures named ``serial_*``: the fraction, the CPU times [s], wall times [s]
+        (indicative: the machine may be loaded) and the bounds.
+    """
+    import tempfile
+    from uq.pipeline.cluster import local_cluster
+    scenario = _serial_scenario(quick, draws)
+    with tempfile.TemporaryDirectory() as folder:
+        run_as_uq_run(scenario.with_values({"sampling.n": 1000}), folder)  # kernels loaded
+        single = run_as_uq_run(scenario, folder)
+        started = time.perf_counter()
+        with local_cluster(workers) as client:
+            start_wall = time.perf_counter() - started
+            run_as_uq_run(scenario.with_values({"sampling.n": 1000}), folder, client)
+            before = client.run(_process_cpu)
+            distributed = run_as_uq_run(scenario, folder, client)
+            after = client.run(_process_cpu)
+    if not all(np.array_equal(single["dataset"][v].values, distributed["dataset"][v].values,
+                              equal_nan=True) for v in single["dataset"].data_vars):
+        raise AssertionError("the distributed sweep differs from the single-process one")
+    workers_cpu = sum(after[key] - before[key] for key in after)
+    c_single, c_driver, c_window = single["cpu"], distributed["cpu"], distributed["window"]
+    f = (c_driver - c_window) / c_single
+    figures = {"serial_workers": workers, "serial_draws": draws,
+               "serial_chunks": len(sweep.sweep_plan(scenario).chunks),
+               "serial_single_cpu_s": c_single, "serial_driver_cpu_s": c_driver,
+               "serial_driver_window_cpu_s": c_window, "serial_workers_cpu_s": workers_cpu,
+               "serial_fraction": f, "serial_driver_cpu_over_single": c_driver / c_single,
+               "serial_driver_throughput_speedup": c_single / c_window,
+               "serial_worker_cpu_over_single": workers_cpu / c_single,
+               "serial_single_wall_s": single["wall"],
+               "serial_distributed_wall_s": distributed["wall"],
+               "serial_wall_speedup": single["wall"] / distributed["wall"],
+               "serial_cluster_start_wall_s": start_wall}
+    for n in AMDAHL_WORKERS:
+        figures[f"serial_amdahl_speedup_{n}"] = 1 / (f + (1 - f) / n)
+        figures[f"serial_amdahl_efficiency_{n}"] = 1 / (f + (1 - f) / n) / n
+        figures[f"serial_speedup_{n}"] = c_single / (c_driver - c_window + max(
+            workers_cpu / n, c_window))
+    return figures
+
+
+def _serial_scenario(quick, draws):
+    """``rubio2022_misalignment`` at `draws` per scene, its grid (`quick`: a ninth)."""
+    changes = {"sampling.n": draws}
+    if quick:
+        changes.update({"sweep.lidar.misalignment": {"start": -180, "stop": 180, "step": 45},
+                        "sweep.wind.direction": {"start": 0, "stop": 360, "step": 30}})
+    return load_scenario(SCENARIO, changes)
+
+
+def run_as_uq_run(scenario, folder, client=None):
+    """Run `scenario` as ``uq run`` does (a checkpoint in `folder`, then the results
+    file): {"cpu": CPU time [s] of this process, all threads; "window": its part between
+    the first chunk saved and the last; "wall": wall time [s]; "dataset": the results}."""
+    from uq.files import write_netcdf
+    from uq.pipeline.checkpoint import Checkpoint
+    marks = {}
+
+    def progress(done, total):                # after each chunk is saved
+        if done == 1:
+            marks["first"] = _process_cpu()
+        if done == total:
+            marks["last"] = _process_cpu()
+    checkpoint = Checkpoint(Path(folder) / "out.nc.partial").acquire()
+    cpu, wall = _process_cpu(), time.perf_counter()
+    try:
+        dataset = run(scenario, client=client, checkpoint=checkpoint, progress=progress)
+        write_netcdf(dataset, Path(folder) / "out.nc")
+        checkpoint.clear()
+    finally:
+        checkpoint.release()
+    return {"cpu": _process_cpu() - cpu, "window": marks["last"] - marks["first"],
+            "wall": time.perf_counter() - wall, "dataset": dataset}
+
+
+def _process_cpu():
+    """CPU time [s] of this process, user + system, all its threads."""
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
 def main(out=Path("results") / "bench_sweep.json"):
     gum_s, gum_scenes = gum_grid()
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024

@@ -18,6 +18,8 @@ pulsed probe, ``floating_lidar_full``   the compiled point model, ``uq.run``    
 cache empty (a fresh cache folder)      new process; the same run with it filled     600 MB
 ``uq run floating_lidar_waves`` (the    the same                                    <= 30 s
 motion kernels), numba's cache empty                                                600 MB
+driver CPU of a distributed sweep not   the single-process run's CPU time (serial    <= 0.05
+overlapping its workers, 10^5 draws     fraction f; Amdahl's S(8)/8 >= 0.6)
 =====================================  ==========================================  ======
 
 The probe's figure (issue 26) is a whole ``uq.run`` of ``floating_lidar_full`` with a
@@ -27,6 +29,10 @@ own ratio (the measurement model alone, the same draws) is reported beside it.
 The draw floor of a run is measured by replaying the engine's own draws: the run is
 made once with :func:`uq.engine.propagate.normal_scores` recorded (the shape of every
 block it draws), then the same blocks are drawn again with numpy's Generator alone.
+The serial fraction (issue 26) is :func:`uq.bench.sweep.serial_fraction`:
+``rubio2022_misalignment`` at 10^5 draws per scene on 2 local workers, from the CPU
+times of the driving process and of the workers (the whole grid; ``--quick``: a ninth).
+
 The process start is a new interpreter that imports what ``uq run`` imports (numpy,
 scipy, xarray, netCDF4, numba, matplotlib and uq's modules) and exits.
 """
@@ -40,6 +46,7 @@ import time
 
 import numpy as np
 
+from uq.bench import sweep
 from uq.bench.sweep import MC_DRAWS
 from uq.pipeline.runner import run
 from uq.pipeline.scenario import MIN_SAMPLES, load_scenario
@@ -56,7 +63,8 @@ TARGETS = {"floating_lidar_full_mc_over_draw_floor": (3.0, "max"),
            "pulsed_probe_over_point": (3.0, "max"),
            "cold_start_cpu_s": (20.0, "max"), "cold_start_peak_rss_mb": (600.0, "max"),
            "cold_start_motion_cpu_s": (30.0, "max"),
-           "cold_start_motion_peak_rss_mb": (600.0, "max")}
+           "cold_start_motion_peak_rss_mb": (600.0, "max"),
+           "serial_fraction": (0.05, "max"), "serial_amdahl_efficiency_8": (0.6, "min")}
 #: The first run of a time-resolved scenario (the motion kernels: the slowest to compile).
 COLD_MOTION_SCENARIO = "floating_lidar_waves"
 #: Imports of ``uq run`` that a new process pays before any work.
@@ -189,7 +197,6 @@ def _clean(folder):
 def sweep_monte_carlo(draws=MC_DRAWS):
     """(seconds per scene of a Monte Carlo sweep of ``rubio2022_misalignment`` at `draws`
     per scene, the floor per scene: drawing that scene's normals)."""
-    from uq.bench import sweep
     seconds, scenes = sweep.monte_carlo(draws=draws)
     return seconds / scenes, sweep.draw_floor(draws=draws)
 
@@ -197,7 +204,6 @@ def sweep_monte_carlo(draws=MC_DRAWS):
 def gum_grid(repeats=1):
     """(seconds of the Fig. 2 GUM grid, seconds of the same with the numpy model's
     complex step, the previous implementation), and the number of scenes."""
-    from uq.bench import sweep
     new_s, scenes = sweep.gum_grid()
     old_s, _ = sweep.gum_grid(model="numpy")          # uq run --model numpy
     return new_s, old_s, scenes
@@ -351,6 +357,14 @@ def measure(quick=False, progress=None, scale=1):
                    sweep_mc_over_draw_floor=per_scene / floor)
     say(f"Monte Carlo sweep: {1e3 * per_scene:.3f} ms per scene, its draws "
         f"{1e3 * floor:.3f} ms")
+    figures.update(sweep.serial_fraction(quick=quick, draws=trials(sweep.SERIAL_DRAWS)))
+    say(f"distributed sweep, {figures['serial_chunks']} chunks on "
+        f"{figures['serial_workers']} workers: serial fraction "
+        f"{figures['serial_fraction']:.3f} (all the driver's CPU "
+        f"{figures['serial_driver_cpu_over_single']:.3f}), Amdahl speed-up with 8 workers "
+        f"{figures['serial_amdahl_speedup_8']:.1f}; wall "
+        f"{figures['serial_single_wall_s']:.1f} s in one process, "
+        f"{figures['serial_distributed_wall_s']:.1f} s distributed")
     if quick:
         return figures
     figures.update(cold_start())

@@ -148,7 +148,7 @@ def dask_client(args):
     # as the exception it raised, through the client.
     os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "critical")
     try:
-        from dask.distributed import Client, LocalCluster
+        from dask.distributed import Client
     except ImportError:
         raise ScenarioError("--workers/--scheduler", "dask", "dask.distributed is not "
                             "installed; allowed: pip install 'floating-lidar-uq[dask]' (or pip install -e '.[dask]' in a checkout)") from None
@@ -156,11 +156,10 @@ def dask_client(args):
         with Client(args.scheduler, set_as_default=False) as client:
             yield client
         return
+    from uq.pipeline.cluster import local_cluster
     logging.getLogger("distributed").setLevel(logging.ERROR)
-    with _ignoring_sigint():          # the workers inherit it: Ctrl-C reaches uq alone
-        cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                               dashboard_address=":0")
-    with cluster, Client(cluster, set_as_default=False) as client:
+    # SIGINT ignored while the workers start: they inherit it, so Ctrl-C reaches uq alone
+    with local_cluster(args.workers, starting=_ignoring_sigint) as client:
         yield client
 
 

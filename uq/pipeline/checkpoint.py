@@ -30,7 +30,8 @@ from pathlib import Path
 
 from uq._version import __version__
 from uq.errors import CheckpointError, DataFileError, OutputError
-from uq.files import MARKER, write_marker, write_netcdf, write_text, written_by_uq
+from uq.files import (MARKER, netcdf_bytes, write_bytes, write_marker, write_netcdf, write_text,
+                      written_by_uq)
 
 MANIFEST = "manifest.json"
 LOCK = "lock"
@@ -204,16 +205,21 @@ class Checkpoint:
             return "no checksum"
         return "" if _sha256(path) == recorded else "checksum mismatch"
 
-    def save(self, index, dataset):
+    def save(self, index, dataset, encoded=None):
         """Keep a finished chunk (after checking that no file the scenario reads has
-        changed since the run started: DataFileError naming it)."""
+        changed since the run started: DataFileError naming it). `encoded`: its file
+        as :func:`encode_chunk` made it with this run's digest (on a dask worker),
+        written as it is; else the chunk's file is written here."""
         for item in self.inputs:
             item.verify()
-        dataset = dataset.copy(deep=False)
-        dataset.attrs[DIGEST_ATTRIBUTE] = self.digest
         path = self.directory / f"chunk-{index:06d}.nc"
-        write_netcdf(dataset, path)
-        write_text(path.with_name(path.name + ".sha256"), _sha256(path) + "\n")
+        if encoded is None:
+            write_netcdf(_with_digest(dataset, self.digest), path)
+            digest = _sha256(path)
+        else:
+            write_bytes(path, encoded)
+            digest = hashlib.sha256(encoded).hexdigest()
+        write_text(path.with_name(path.name + ".sha256"), digest + "\n")
 
     def is_empty(self):
         """No chunk on disk (nothing a --resume could reuse)?"""
@@ -243,6 +249,20 @@ class Checkpoint:
             path.unlink()
         except FileNotFoundError:
             pass
+
+
+def encode_chunk(dataset, digest):
+    """The checkpoint file of a finished chunk, as bytes: its netCDF4 file
+    (:func:`uq.files.netcdf_bytes`) carrying the run's `digest`. Pure: a dask worker
+    makes it beside the chunk, so the run's own process only writes it to disk."""
+    return netcdf_bytes(_with_digest(dataset, digest))
+
+
+def _with_digest(dataset, digest):
+    """A shallow copy of a chunk's `dataset` carrying the run's `digest`."""
+    dataset = dataset.copy(deep=False)
+    dataset.attrs[DIGEST_ATTRIBUTE] = digest
+    return dataset
 
 
 class InputFile:

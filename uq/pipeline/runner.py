@@ -19,6 +19,7 @@ from uq._version import __version__
 from uq.pipeline.distributions import error_distribution
 from uq.engine.inputs import Input
 from uq.pipeline import probesection, records
+from uq.pipeline.checkpoint import encode_chunk
 from uq.pipeline.modelsetup import (MOTION_INPUTS, error_inputs, input_label, scene_from_settings,
                                     skipped_work)
 from uq.physics.correction import describe_corrections
@@ -85,27 +86,44 @@ def _compute(scenario, plan, seed, progress, client, checkpoint, compiled):
     """Results of every chunk, by index: from the checkpoint, else computed."""
     results = checkpoint.load() if checkpoint else {}
     todo = [chunk for chunk in plan.chunks if chunk.index not in results]
-    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed, compiled))
+    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed, compiled), None)
                 for chunk in todo) if client is None else \
-        _distributed(client, scenario, plan, todo, seed, compiled)
+        _distributed(client, scenario, plan, todo, seed, compiled,
+                     checkpoint.digest if checkpoint else None)
     if progress and results:
         progress(len(results), len(plan.chunks))
-    for index, dataset in finished:
+    for index, dataset, encoded in finished:
         results[index] = dataset
         if checkpoint:
-            checkpoint.save(index, dataset)
+            checkpoint.save(index, dataset, encoded)
         if progress:
             progress(len(results), len(plan.chunks))
     return results
 
 
-def _distributed(client, scenario, plan, chunks, seed, compiled):
-    """Chunks on a dask cluster, yielded as they finish."""
+def _distributed(client, scenario, plan, chunks, seed, compiled, digest):
+    """Chunks on a dask cluster, yielded as ``(index, dataset, encoded)`` as they finish.
+
+    What this process does per chunk is kept to receiving it and writing its checkpoint
+    file (the serial share of a distributed sweep, ``uq.bench.sweep.serial_fraction``):
+    the scenario and the plan are sent to the workers once (scattered), each task carries
+    only its chunk, and the worker evaluates the chunk (its Monte Carlo, GUM and paper
+    model) and encodes its checkpoint file (:func:`chunk_task`)."""
     from dask.distributed import as_completed
-    futures = {client.submit(run_chunk, scenario, plan, chunk, seed, compiled, pure=False): chunk.index
-               for chunk in chunks}
+    shared = client.scatter([scenario, plan], broadcast=True, hash=False)
+    futures = {client.submit(chunk_task, *shared, chunk, seed, compiled, digest,
+                             pure=False): chunk.index for chunk in chunks}
     for future in as_completed(futures, loop=client.loop):
-        yield futures[future], future.result()
+        dataset, encoded = future.result()
+        yield futures.pop(future), dataset, encoded   # the cluster may forget it now
+
+
+def chunk_task(scenario, plan, chunk, seed, compiled=True, digest=None):
+    """One chunk on a dask worker: ``(dataset, encoded)``, its results
+    (:func:`run_chunk`) and, with the checkpoint's `digest`, its checkpoint file
+    (:func:`uq.pipeline.checkpoint.encode_chunk`), else None."""
+    dataset = run_chunk(scenario, plan, chunk, seed, compiled)
+    return dataset, None if digest is None else encode_chunk(dataset, digest)
 
 
 def run_chunk(scenario, plan, chunk, seed, compiled=True):
