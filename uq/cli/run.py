@@ -162,7 +162,16 @@ def dask_client(args):
         cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
                                dashboard_address=":0")
     with cluster, Client(cluster, set_as_default=False) as client:
-        yield client
+        try:
+            yield client
+        except BaseException:
+            # stopped (Ctrl-C, SIGTERM) or failed: closing the client forgets the chunks
+            # still pending, and the scheduler, in this process, logs a gather of one of
+            # them then in flight as an error ("Couldn't gather keys ... 'forgotten'",
+            # seen on a loaded machine); the user gets the stop's one message, or the
+            # exception itself
+            logging.getLogger("distributed").setLevel(logging.CRITICAL)
+            raise
 
 
 @contextlib.contextmanager
