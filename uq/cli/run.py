@@ -160,7 +160,16 @@ def dask_client(args):
     logging.getLogger("distributed").setLevel(logging.ERROR)
     # SIGINT ignored while the workers start: they inherit it, so Ctrl-C reaches uq alone
     with local_cluster(args.workers, starting=_ignoring_sigint) as client:
-        yield client
+        try:
+            yield client
+        except BaseException:
+            # stopped (Ctrl-C, SIGTERM) or failed: closing the client forgets the chunks
+            # still pending, and the scheduler, in this process, logs a gather of one of
+            # them then in flight as an error ("Couldn't gather keys ... 'forgotten'",
+            # seen on a loaded machine); the user gets the stop's one message, or the
+            # exception itself
+            logging.getLogger("distributed").setLevel(logging.CRITICAL)
+            raise
 
 
 @contextlib.contextmanager

@@ -29,10 +29,18 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from uq.constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG, STORED_VALUES
-from uq.engine import statkernels
 from uq.engine.orderstats import order_statistics
 
 INTERVALS = ("symmetric", "shortest")
+
+
+def _kernels():
+    """:mod:`uq.engine.statkernels`, imported when a statistic is first computed, not
+    with this module: its kernels have explicit signatures, so numba compiles them
+    (first run after an install, ~5 s) or loads them on import, which a command that
+    only reads a scenario (``uq fit``, ``uq check``) must not pay."""
+    from uq.engine import statkernels
+    return statkernels
 
 
 def unwrap(values, reference):
@@ -173,7 +181,7 @@ class CoMoments:
         rows = values.reshape(len(values), -1, g)
         count = np.empty(rows.shape[1], dtype=np.int64)
         mean, comoment = np.empty(rows.shape[1:]), np.empty(rows.shape[1:] + (g,))
-        statkernels.comoments(rows, count, mean, comoment)
+        _kernels().comoments(rows, count, mean, comoment)
         count = count.reshape(self.count.shape)
         mean = mean.reshape(self.shape)
         comoment = comoment.reshape(self.comoment.shape)
@@ -293,18 +301,18 @@ class StreamingStatistics:
         if not circular and flat.strides[0] == flat.itemsize:  # element-major (the
             columns[:, offset:offset + m] = flat.T      # compiled models'): row copies
         else:
-            statkernels.transpose(flat, self.reference if circular else _NO_REFERENCE,
+            _kernels().transpose(flat, self.reference if circular else _NO_REFERENCE,
                                   circular, columns, offset)
         summaries = []
         count, mean, m2 = (np.empty(self.size, dtype=np.int64), np.empty(self.size),
                            np.empty(self.size))
         for start in range(0, m, batch_size):
             stop = min(m, start + batch_size)
-            statkernels.moments(columns, offset + start, offset + stop, count, mean, m2)
+            _kernels().moments(columns, offset + start, offset + stop, count, mean, m2)
             self.moments.merge(count.reshape(self.shape), mean.reshape(self.shape),
                                m2.reshape(self.shape))
             if circular:
-                statkernels.resultant(columns, offset + start, offset + stop,
+                _kernels().resultant(columns, offset + start, offset + stop,
                                       self.reference, self._cos, self._sin)
             if summarize:
                 summaries.extend(self._summaries(columns, offset, start, stop, (count, mean, m2),
@@ -327,7 +335,7 @@ class StreamingStatistics:
         count, mean, m2 = (np.empty_like(m) for m in moments)
         out = []
         for first in range(start, stop - size + 1, size):
-            statkernels.moments(columns, offset + first, offset + first + size, count, mean,
+            _kernels().moments(columns, offset + first, offset + first + size, count, mean,
                                 m2)
             out.append((first, self._summary(columns, offset + first, offset + first + size,
                                              count, mean, m2, kind)))
@@ -362,12 +370,12 @@ class StreamingStatistics:
         if kind == "symmetric":
             ranks = _rank_pairs(count, probability)
             parts = element_parts(self.size)
-            length = statkernels.scratch_length(stop - start)
+            length = _kernels().scratch_length(stop - start)
             if len(self._scratch) != len(parts) or self._scratch[0].shape[1] < length:
                 self._scratch = [np.empty((2, length)) for _ in parts]
             count = np.ascontiguousarray(count, dtype=np.int64)
             low_rank, high_rank = ranks[:, 0].copy(), ranks[:, 1].copy()
-            in_parallel([(statkernels.select_pairs, columns[part], start, stop, count[part],
+            in_parallel([(_kernels().select_pairs, columns[part], start, stop, count[part],
                           low_rank[part], high_rank[part], low[part], high[part], scratch)
                          for part, scratch in zip(parts, self._scratch)])
             return low, high

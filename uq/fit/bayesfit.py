@@ -14,7 +14,9 @@ with covariance
 Priors are uniform within bounds (:data:`DEFAULT_PRIORS`, documented there),
 log-uniform where marked, or normal ``(mean, u, "normal")`` when configured. The posterior is sampled by emcee's affine-invariant ensemble
 (Foreman-Mackey et al. 2013) in several independent ensembles, each started in a small
-ball about the maximum a posteriori and seeded through emcee's State random_state.
+ball about the maximum a posteriori, advanced side by side by one emcee sampler (the
+stretch move per ensemble, :mod:`uq.fit.ensembles`) seeded through emcee's State
+random_state.
 Convergence is decided, and failure raised, from the integrated autocorrelation time
 (each chain longer than 50 tau; burn-in 2 tau and thinning tau/2 derived from it) and
 the rank-normalised split R-hat across ensembles (Vehtari et al. 2021, < 1.01).
@@ -49,6 +51,7 @@ from scipy.stats import beta as beta_distribution
 from scipy.stats import norm, rankdata
 
 from uq.constants import COMPLEX_STEP, MIN_WALKERS, VON_KARMAN
+from uq.fit.ensembles import IndependentStretchMove, integrated_times, split_ensembles
 from uq.fit.profilefit import least_squares_profile
 from uq.physics.profiles import PROFILES
 
@@ -315,15 +318,15 @@ def sample_posterior(posterior, seed, walkers=MIN_WALKERS, ensembles=4, steps=50
     centre = maximum_a_posteriori(posterior)
     space = SamplingSpace(posterior)
     ball = np.random.default_rng(streams[-1])
-    samplers, states = [], []
-    for stream in streams[:-1]:
-        start = _starting_ball(space, space.to_sampled(centre), ball, walkers)
-        states.append(emcee.State(start, random_state=np.random.RandomState(
-            np.random.MT19937(stream)).get_state()))
-        target = space.log_probability if space.transformed else \
-            posterior.log_probability                   # nothing to transform: no wrapper
-        samplers.append(emcee.EnsembleSampler(walkers, centre.size, target, vectorize=True))
-    chains, taus = _run_until_converged(samplers, states, steps, max_steps, space)
+    start = np.concatenate([_starting_ball(space, space.to_sampled(centre), ball, walkers)
+                            for _ in range(ensembles)])
+    state = emcee.State(start, random_state=np.random.RandomState(
+        np.random.MT19937(streams[0])).get_state())
+    target = space.log_probability if space.transformed else \
+        posterior.log_probability                       # nothing to transform: no wrapper
+    sampler = emcee.EnsembleSampler(walkers * ensembles, centre.size, target, vectorize=True,
+                                    moves=IndependentStretchMove(ensembles))
+    chains, taus = _run_until_converged(sampler, state, ensembles, steps, max_steps, space)
     tau = np.max(taus, axis=0)
     burn, thin = int(np.ceil(2 * tau.max())), max(1, int(tau.min() / 2))
     chains = space.to_natural(np.array(chains))         # (ensembles, steps, walkers, k)
@@ -504,25 +507,26 @@ def _starting_ball(space, centre, rng, walkers):
     return centre + offsets
 
 
-def _run_until_converged(samplers, states, steps, max_steps, space):
-    """Run every ensemble in rounds of `steps`, all to the same length, until that length
-    is above TAU_FACTOR x the largest tau of any ensemble (or `max_steps`).
+def _run_until_converged(sampler, state, ensembles, steps, max_steps, space):
+    """Run the ensembles (one sampler, :mod:`uq.fit.ensembles`) in rounds of `steps`
+    until their length is above TAU_FACTOR x the largest tau of any ensemble (or
+    `max_steps`); returns the chains (E, steps, W, k) and tau (E, k).
 
     tau is per parameter the larger of the walkers' own coordinates and the parameters
     as reported (ln z0 for a log-uniform one, :meth:`SamplingSpace.to_reported`): a
     function of a well-mixed chain may still be autocorrelated longer (z0 from u* and
     U_c), and the criterion must hold for what the user reads."""
     while True:
-        states = [sampler.run_mcmc(state, steps, progress=False)
-                  for sampler, state in zip(samplers, states)]
-        taus = [sampler.get_autocorr_time(tol=0) for sampler in samplers]
-        iteration = samplers[0].iteration
+        state = sampler.run_mcmc(state, steps, progress=False)
+        chains = split_ensembles(sampler.get_chain(), ensembles)
+        taus = integrated_times(chains, AUTOCORRELATION_WINDOW)
+        iteration = sampler.iteration
         if iteration > TAU_FACTOR * np.max(taus) or iteration >= max_steps:
             if space.transformed:                       # only then: the check costs FFTs
-                taus = [np.maximum(tau, emcee.autocorr.integrated_time(space.to_reported(
-                    sampler.get_chain()), tol=0)) for tau, sampler in zip(taus, samplers)]
+                taus = np.maximum(taus, integrated_times(space.to_reported(chains),
+                                                         AUTOCORRELATION_WINDOW))
             if iteration > TAU_FACTOR * np.max(taus) or iteration >= max_steps:
-                return [sampler.get_chain() for sampler in samplers], taus
+                return chains, taus
 
 
 def posterior_summary(samples, names):

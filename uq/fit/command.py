@@ -52,7 +52,7 @@ def run_fit(input_path, config_path=None, output=None, overrides=None, quiet=Fal
     from uq.fit.plots import plot_corner, plot_profile_fit
     figures = [output.with_name(f"{output.stem}_profile.png"),
                output.with_name(f"{output.stem}_corner.png")]
-    save_figure(plot_profile_fit(dataset), figures[0], dpi=120)
+    save_figure(plot_profile_fit(dataset), figures[0], dpi=120, bbox_inches="tight")
     save_figure(plot_corner(dataset), figures[1], dpi=100, bbox_inches="tight")
     if not quiet:
         print(fit_table(dataset))
