@@ -679,14 +679,13 @@ MOUNTED_STRUCTURE = STRUCTURE + ("want_shear", "level_first", "level_second", "u
 
 
 @_helper
-def _solve2(a00, a01, a10, a11, r0, r1):
-    """Solution of the 2 x 2 system ``[[a00, a01], [a10, a11]] x = (r0, r1)`` (Gaussian
-    elimination with partial pivoting on the real parts, as LAPACK's gesv)."""
-    if abs(a10.real) > abs(a00.real):
-        a00, a01, r0, a10, a11, r1 = a10, a11, r1, a00, a01, r0
-    factor = a10 / a00
-    second = (r1 - factor * r0) / (a11 - factor * a01)
-    return (r0 - a01 * second) / a00, second
+def _inverse2(a00, a01, a10, a11):
+    """The inverse of the 2 x 2 matrix ``[[a00, a01], [a10, a11]]`` (Cramer's rule: one
+    division; the systems solved here, the level beams' horizontal parts and the 2-beam
+    normal equations, have condition numbers of ~cot(half-cone) and its square, so the
+    solution is within ~1e-14 relative of LAPACK's pivoted elimination)."""
+    scale = 1.0 / (a00 * a11 - a01 * a10)
+    return a11 * scale, -a01 * scale, -a10 * scale, a00 * scale
 
 
 @_helper
@@ -736,6 +735,9 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
     mean_rot = rot
     mean_ship = (zero, zero)
     ship = (zero, zero, zero)
+    inverse = (zero, zero, zero, zero)
+    lidar_frame = n_beams > 2 and not pointwise        # the scan's A^+ v: its rows needed
+    lidar_horizontal = lidar_frame and (model == FULL or level_a < 0)
     for s in range(s0, s1):
         speed_ref, w = table[s, _SPEED], table[s, _VERTICAL]
         to_north = -table[s, _COS + _T_DIRECTION]       # wind "from": it blows to -e
@@ -783,11 +785,15 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
                 for g in range(n_gates):
                     gate_height[s, g, i] = heights[g]
             # the believed beams and the velocity removed along them (each beam's own
-            # reading; a scan's reading is the same for every beam: k = 1)
+            # reading; a scan's reading is the same for every beam: k = 1, computed for
+            # the first beam; none's: the configured heading, the scene's first trial's)
             for b in range(n_beams):
-                if model == NONE:
+                if (model == NONE and i > t0) or (b > 0 and not pointwise):
+                    pass                        # the same rotation and ship velocity
+                elif model == NONE:
                     rot = _rotation(NONE, one, zero, one, zero, one, zero, cos_nominal,
                                     sin_nominal)
+                    ship = (zero, zero, zero)
                 else:
                     kh = b if heading_error.shape[2] > 1 else 0
                     kp = b if pitch_error.shape[2] > 1 else 0
@@ -795,18 +801,26 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
                     rot = _rotation(model, cos_read[0, kh, j], sin_read[0, kh, j],
                                     cos_read[1, kp, j], sin_read[1, kp, j], cos_read[2, kr, j],
                                     sin_read[2, kr, j], cos_nominal, sin_nominal)
-                for k in range(3):
-                    normal[b, k] = rot[3 * k] * units[b, 0] + rot[3 * k + 1] * units[b, 1] \
-                        + rot[3 * k + 2] * units[b, 2]
-                if model == NONE:
-                    ship = (zero, zero, zero)
-                else:
                     kc = b if cog_error.shape[2] > 1 else 0
                     sog = sog0 + _pick(sog_error, i, s, b)
                     ship = (sog * cos_read[3, kc, j], sog * sin_read[3, kc, j],
                             heave0 + _pick(heave_error, i, s, b) if model == FULL else zero)
+                if model == NONE and i > t0:
+                    continue                    # none's believed beams: the scene's
+                for k in range(3):
+                    normal[b, k] = rot[3 * k] * units[b, 0] + rot[3 * k + 1] * units[b, 1] \
+                        + rot[3 * k + 2] * units[b, 2]
                 along[b] = normal[b, 0] * ship[0] + normal[b, 1] * ship[1] + \
                     normal[b, 2] * ship[2]
+            if not (model == NONE and i > t0):  # the 2 x 2 inverses of the believed beams
+                if n_beams == 2:                # the horizontal normal equations
+                    h00 = normal[0, 0] * normal[0, 0] + normal[1, 0] * normal[1, 0]
+                    h01 = normal[0, 0] * normal[0, 1] + normal[1, 0] * normal[1, 1]
+                    h11 = normal[0, 1] * normal[0, 1] + normal[1, 1] * normal[1, 1]
+                    inverse = _inverse2(h00, h01, h01, h11)
+                elif level_a >= 0:              # the level pair's horizontal parts
+                    inverse = _inverse2(normal[level_a, 0], normal[level_a, 1],
+                                        normal[level_b, 0], normal[level_b, 1])
             if pointwise and model == TILT2D and n_beams > 2:   # the mean reading, Eq. 13 [1]
                 mean[0] = _mean_reading(heading_error, base[0], i, s, zero)
                 mean[1] = _mean_reading(pitch_error, base[1], i, s, zero)
@@ -828,26 +842,27 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
                     corrected[b] = measured + along[b]
                     if want_radial:
                         radial[s, b, g, i] = corrected[b]
-                    x += operator[0, b] * measured        # A^+ v (3 or more beams)
-                    y += operator[1, b] * measured
-                    z += operator[2, b] * measured
+                    if lidar_frame:                       # A^+ v (Eq. 13 [1])
+                        z += operator[2, b] * measured
+                        if lidar_horizontal:
+                            x += operator[0, b] * measured
+                            y += operator[1, b] * measured
                 if n_beams == 2:                # w = 0: the horizontal least squares
-                    h00 = normal[0, 0] * normal[0, 0] + normal[1, 0] * normal[1, 0]
-                    h01 = normal[0, 0] * normal[0, 1] + normal[1, 0] * normal[1, 1]
-                    h11 = normal[0, 1] * normal[0, 1] + normal[1, 1] * normal[1, 1]
-                    north, east = _solve2(
-                        h00, h01, h01, h11,
-                        normal[0, 0] * corrected[0] + normal[1, 0] * corrected[1],
-                        normal[0, 1] * corrected[0] + normal[1, 1] * corrected[1])
+                    r0 = normal[0, 0] * corrected[0] + normal[1, 0] * corrected[1]
+                    r1 = normal[0, 1] * corrected[0] + normal[1, 1] * corrected[1]
+                    north = inverse[0] * r0 + inverse[1] * r1
+                    east = inverse[2] * r0 + inverse[3] * r1
                     up = zero
                 elif not pointwise:             # Eq. 13 [1] with the scan's reading
-                    north = rot[0] * x + rot[1] * y + ship[0]
-                    east = rot[3] * x + rot[4] * y + ship[1]
-                    up = z
-                    if model == FULL:
-                        north += rot[2] * z
-                        east += rot[5] * z
-                        up = rot[6] * x + rot[7] * y + rot[8] * z + ship[2]
+                    up = rot[6] * x + rot[7] * y + rot[8] * z + ship[2] if model == FULL \
+                        else z
+                    north = east = zero
+                    if level_a < 0:             # (else the level pair's, below)
+                        north = rot[0] * x + rot[1] * y + ship[0]
+                        east = rot[3] * x + rot[4] * y + ship[1]
+                        if model == FULL:
+                            north += rot[2] * z
+                            east += rot[5] * z
                 else:                           # point-wise least squares [2]
                     for k in range(3):
                         total = zero
@@ -869,10 +884,10 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
                         north = mean_rot[0] * x + mean_rot[1] * y + mean_ship[0]
                         east = mean_rot[3] * x + mean_rot[4] * y + mean_ship[1]
                 if level_a >= 0:                # the hub-height wind of the level beams
-                    north, east = _solve2(
-                        normal[level_a, 0], normal[level_a, 1], normal[level_b, 0],
-                        normal[level_b, 1], corrected[level_a] - normal[level_a, 2] * up,
-                        corrected[level_b] - normal[level_b, 2] * up)
+                    r0 = corrected[level_a] - normal[level_a, 2] * up
+                    r1 = corrected[level_b] - normal[level_b, 2] * up
+                    north = inverse[0] * r0 + inverse[1] * r1
+                    east = inverse[2] * r0 + inverse[3] * r1
                 if want_speed:
                     speed[s, g, i] = _hypot(north, east)
                 if want_vertical:
