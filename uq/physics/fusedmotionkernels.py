@@ -42,6 +42,7 @@ References
 .. [3] Matavar, A. (2024). Wind field reconstruction from floating lidars. MSc thesis,
    TU Delft, Sec. 3.2 (point-wise correction).
 """
+import functools
 import math
 
 import numpy as np
@@ -71,12 +72,13 @@ HEAD = ("n_beams", "n_gates", "n_nodes", "n_slanted", "model", "ins_mode", "rate
         "heading", "pitch", "roll", "lidar_height", "wind_speed", "reference_height", "shear",
         "to_north", "to_east", "vertical_wind", "ship_north", "ship_east", "ship_up",
         "level_cos", "level_sin", "course_cos", "course_sin", "arm_bow", "arm_starboard",
-        "arm_up", "static_arm_up", "half_cone", "misalignment", "moves_yaw", "has_arm", "probe")
+        "arm_up", "static_arm_up", "half_cone", "misalignment", "moves_yaw", "has_arm", "probe",
+        "mounted", "tilt_cos", "tilt_sin")
 (_N_BEAMS, _N_GATES, _N_NODES, _N_SLANTED, _MODEL, _INS_MODE, _RATE, _HEADING, _PITCH, _ROLL,
  _LIDAR_HEIGHT, _WIND_SPEED, _REFERENCE_HEIGHT, _SHEAR, _TO_NORTH, _TO_EAST, _VERTICAL_WIND,
  _SHIP_NORTH, _SHIP_EAST, _SHIP_UP, _LEVEL_COS, _LEVEL_SIN, _COURSE_COS, _COURSE_SIN,
  _ARM_BOW, _ARM_STARBOARD, _ARM_UP, _STATIC_ARM_UP, _HALF_CONE, _MISALIGNMENT, _MOVES_YAW,
- _HAS_ARM, _PROBE) = range(len(HEAD))
+ _HAS_ARM, _PROBE, _MOUNTED, _TILT_COS, _TILT_SIN) = range(len(HEAD))
 
 #: Correction models: the codes NONE ... POINTWISE of
 #: :class:`uq.physics.modelinputs.Correction` (:mod:`uq.physics.kernelbase`); INS modes.
@@ -132,7 +134,7 @@ def _kernel(signature):
 def _head(consts):
     """The scalars of :data:`HEAD` as a tuple: values, not memory, so that loops reading
     them need no alias checks against the arrays they write."""
-    return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31], consts[32])
+    return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31], consts[32], consts[33], consts[34], consts[35])
 
 
 @_called
@@ -288,7 +290,9 @@ def _geometry(consts, azimuths, beams, cone_error, misalignment_error, height_er
         _geometry_angle(consts[_HALF_CONE], cone_error, start, count, work, _CONE)
         _geometry_angle(consts[_MISALIGNMENT], misalignment_error, start, count, work, _MIS)
         for b in range(n_beams):
-            if b < n_slanted:
+            if consts[_MOUNTED] > 0:         # clock positions about a tilted boresight
+                _mounted_beams(consts, azimuths, b, count, work, ship_beams)
+            elif b < n_slanted:
                 cos_a, sin_a = azimuths[b, 0], azimuths[b, 1]
                 for j in range(count):
                     sin_cone, cos_m, sin_m = work[_CONE + 1, j], work[_MIS, j], work[_MIS + 1, j]
@@ -302,6 +306,24 @@ def _geometry(consts, azimuths, beams, cone_error, misalignment_error, height_er
     height = consts[_LIDAR_HEIGHT]
     for j in range(count):
         work[_LIDAR_Z, j] = height + height_error[start + j if height_error.shape[0] > 1 else 0]
+
+
+@_helper
+def _mounted_beams(consts, azimuths, b, count, work, ship_beams):
+    """Beam b of a tilted mount in the ship frame, ship_beams[b] (3, trials), from the
+    cone's and misalignment's rows (:func:`uq.physics.beams.mounted_unit_vectors`):
+    ``Rz(m) [cos(a) d + sin(a) (cos(phi) e_up + sin(phi) e_starboard)]``, d = (sin tau, 0,
+    cos tau), e_up = (-cos tau, 0, sin tau)."""
+    cos_phi, sin_phi = azimuths[b, 0], azimuths[b, 1]
+    cos_t, sin_t = consts[_TILT_COS], consts[_TILT_SIN]
+    for j in range(count):
+        cos_a, sin_a = work[_CONE, j], work[_CONE + 1, j]
+        cos_m, sin_m = work[_MIS, j], work[_MIS + 1, j]
+        bow = cos_a * sin_t - sin_a * cos_phi * cos_t
+        starboard = sin_a * sin_phi
+        ship_beams[b, 0, j] = cos_m * bow - sin_m * starboard
+        ship_beams[b, 1, j] = sin_m * bow + cos_m * starboard
+        ship_beams[b, 2, j] = cos_a * cos_t + sin_a * cos_phi * sin_t
 
 
 @_helper
@@ -694,6 +716,21 @@ def _pointwise_at(head, state, work, nx, ny, nz, j, exact, heading_varies, sourc
 def _pointwise(consts, state, work, normal, nx, ny, nz, count, heading_varies, source):
     """:func:`_pointwise_at` for the block's trials (one SIMD loop per case, then libm
     where an angle is beyond the reduction), and ``B^T B`` accumulated."""
+    _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, source)
+    for j in range(count):
+        bx, by, bz = work[_BEAM, j], work[_BEAM + 1, j], work[_BEAM + 2, j]
+        normal[0, j] += bx * bx
+        normal[1, j] += bx * by
+        normal[2, j] += bx * bz
+        normal[3, j] += by * by
+        normal[4, j] += by * bz
+        normal[5, j] += bz * bz
+
+
+@_helper
+def _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, source):
+    """:func:`_pointwise_at` for the block's trials: the read rotation of (nx, ny, nz)
+    into rows _BEAM, the lidar velocity along it into _ALONG."""
     head = _head(consts)
     if source == FROM_ROWS:
         for j in range(count):
@@ -712,14 +749,26 @@ def _pointwise(consts, state, work, normal, nx, ny, nz, count, heading_varies, s
             if not work[_BIG, j] <= SINCOS_REDUCTION_LIMIT:
                 _pointwise_at(head, state, work, nx, ny, nz, j, True, heading_varies,
                               FROM_ANGLES)
-    for j in range(count):
-        bx, by, bz = work[_BEAM, j], work[_BEAM + 1, j], work[_BEAM + 2, j]
-        normal[0, j] += bx * bx
-        normal[1, j] += bx * by
-        normal[2, j] += bx * bz
-        normal[3, j] += by * by
-        normal[4, j] += by * bz
-        normal[5, j] += bz * bz
+
+
+@_helper
+def _store_reading(consts, state, work, normal, row, count, heading_varies, source):
+    """A point-wise reading of a tilted mount into normal[row ..]: the believed beam
+    (rows _BEAM), the velocity along it (_ALONG) and, for the shear exponent's believed
+    heights, the lidar's lift ``[(R_read - R_static) r]_up`` through the lever arm r
+    (:func:`uq.physics.timeresolved._lever_arm_lift`; 0 without one)."""
+    for i in range(3):
+        normal[row + i, :count] = work[_BEAM + i, :count]
+    normal[row + 3, :count] = work[_ALONG, :count]
+    normal[row + 4, :count] = 0.0
+    if consts[_HAS_ARM] > 0 and consts[_MOUNTED] > 1:   # (HEAD mounted 2: the shear's)
+        _pointwise_rows(consts, state, work, consts[_ARM_BOW], consts[_ARM_STARBOARD],
+                        consts[_ARM_UP], count, heading_varies, source)
+        for j in range(count):              # the reading's rotation of the arm
+            normal[row + 4, j] = work[_BEAM + 2, j] - consts[_STATIC_ARM_UP]
+        for i in range(3):                  # the beam's rows back for the least squares
+            work[_BEAM + i, :count] = normal[row + i, :count]
+        work[_ALONG, :count] = normal[row + 3, :count]
 
 
 @_helper
@@ -815,6 +864,10 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                  errors, has, start, count, states[0], work, True)
     normal[:, :count] = 0.0
     heading_varies = consts[_MOVES_YAW] > 0 or has[0]
+    # a tilted mount (rows of `normal` beyond the least squares'): its reconstruction
+    # (:func:`mounted_wind`) keeps each beam's measured radial velocity and, point-wise,
+    # its believed beam, the velocity along it and the lidar's believed lift
+    stored = 6 + 3 * n_gates if normal.shape[0] > 6 + 3 * n_gates else 0
     for b in range(n_beams):
         if model == POINTWISE:          # this beam's own reading: the beam and velocity it implies
             state = states[b if at_nodes else 0]
@@ -828,6 +881,9 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                 source = FROM_ROWS if written else FROM_ANGLES
             _pointwise(consts, state, work, normal, beams[b, 0], beams[b, 1], beams[b, 2],
                        count, heading_varies, source)
+            if stored:                  # a tilted mount's: the believed beam, the along
+                _store_reading(consts, state, work, normal, stored + 5 * b, count,
+                               heading_varies, source)
         beam = b if noise.shape[1] > 1 else 0
         for g in range(n_gates):
             work[_MEASURED, :count] = 0.0                # the dwell mean of the truth
@@ -843,6 +899,9 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
             else:
                 for j in range(count):
                     work[_MEASURED, j] += noise[0, beam, gate]
+            if stored:                  # a tilted mount's: the measured radial velocity
+                normal[stored + 5 * n_beams + b * n_gates + g, :count] = \
+                    work[_MEASURED, :count]
             if model == POINTWISE:
                 for j in range(count):
                     corrected = work[_MEASURED, j] + work[_ALONG, j]
@@ -874,3 +933,109 @@ def wind_speed(out, count, speed, vertical):
             radius = speed[g, j]
             if not HYPOT_SAFE_MIN < radius < HYPOT_SAFE_MAX:
                 speed[g, j] = math.hypot(out[0, g, j], out[1, g, j])
+
+
+#: The layout vector of :func:`mounted_wind` (int64): the level pair (clock 90 and 270),
+#: the upper and lower beams (-1: none; :mod:`uq.physics.nacelle`) and whether the
+#: shear exponent is wanted.
+MOUNTED_LAYOUT = ("level_first", "level_second", "upper", "lower", "want_shear")
+
+
+def mounted_wind(consts, layout, beams, slant, work, normal, count, out, shear):
+    """A tilted (nacelle) mount's wind of trials [0, count), after :func:`reconstruct`
+    (whose `normal` then holds the measured radial velocities and, point-wise, each
+    beam's believed beam, velocity along it and lift; its `work` the scan's reading).
+
+    Each beam's believed earth-frame beam ``b_k`` (the point-wise reading's, or the
+    scan's rotation of the configured beam as the correction model believes it) and
+    its corrected radial velocity ``c_k = v_k + b_k . s`` (s: the velocity the model
+    removes). 2 beams: the horizontal least squares ``b_k,h . u_h = c_k``, w = 0
+    assumed; with the level pair: the hub-height horizontal wind ``b_k,h . u_h = c_k -
+    b_k,up w`` with the w of `out` (:mod:`uq.physics.nacelle`); other layouts keep
+    `out`. Writes out[:, g, j] and, wanted, ``shear[g, j] = ln(U_up / U_down) / ln(z_up /
+    z_down)``, ``U_k = c_k / (b_k,h . e)`` at the believed heights ``z_k = lidar height +
+    lift_k + slant b_k,up`` (NaN where a ratio is not positive).
+    """
+    n_beams, n_gates, model = int(consts[_N_BEAMS]), int(consts[_N_GATES]), int(consts[_MODEL])
+    level_a, level_b, upper, lower = layout[0], layout[1], layout[2], layout[3]
+    want_shear = layout[4] > 0
+    stored = 6 + 3 * n_gates
+    measured = stored + 5 * n_beams
+    believed = np.empty((n_beams, 3))
+    along, lift, corrected = np.empty(n_beams), np.zeros(n_beams), np.empty(n_beams)
+    height = consts[_LIDAR_HEIGHT]
+    i00 = i01 = i10 = i11 = 0.0
+    for j in range(count):
+        if model == POINTWISE:
+            for b in range(n_beams):
+                for i in range(3):
+                    believed[b, i] = normal[stored + 5 * b + i, j]
+                along[b] = normal[stored + 5 * b + 3, j]
+                lift[b] = normal[stored + 5 * b + 4, j]
+        else:                                   # the scan's reading (_scan_correction)
+            ch, sh = work[_READ_TRIG, j], work[_READ_TRIG + 1, j]
+            cp, sp = work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j]
+            cr, sr = work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j]
+            vn, ve = work[_READ_VELOCITY, j], work[_READ_VELOCITY + 1, j]
+            vu = work[_READ_VELOCITY + 2, j] if model == FULL else 0.0
+            for b in range(n_beams):
+                bx, by, bz = rotate(ch, sh, cp, sp, cr, sr, beams[b, 0], beams[b, 1],
+                                    beams[b, 2])
+                believed[b, 0], believed[b, 1], believed[b, 2] = bx, by, bz
+                along[b] = bx * vn + by * ve + bz * vu
+        if n_beams == 2:                        # the horizontal normal equations
+            h00 = believed[0, 0] * believed[0, 0] + believed[1, 0] * believed[1, 0]
+            h01 = believed[0, 0] * believed[0, 1] + believed[1, 0] * believed[1, 1]
+            h11 = believed[0, 1] * believed[0, 1] + believed[1, 1] * believed[1, 1]
+            i00, i01, i10, i11 = _inverse2(h00, h01, h01, h11)
+        elif level_a >= 0:                      # the level pair's horizontal parts
+            i00, i01, i10, i11 = _inverse2(believed[level_a, 0], believed[level_a, 1],
+                                           believed[level_b, 0], believed[level_b, 1])
+        for g in range(n_gates):
+            for b in range(n_beams):
+                corrected[b] = normal[measured + b * n_gates + g, j] + along[b]
+            if n_beams == 2:
+                r0 = believed[0, 0] * corrected[0] + believed[1, 0] * corrected[1]
+                r1 = believed[0, 1] * corrected[0] + believed[1, 1] * corrected[1]
+                out[0, g, j], out[1, g, j], out[2, g, j] = \
+                    i00 * r0 + i01 * r1, i10 * r0 + i11 * r1, 0.0
+            elif level_a >= 0:
+                up = out[2, g, j]
+                r0 = corrected[level_a] - believed[level_a, 2] * up
+                r1 = corrected[level_b] - believed[level_b, 2] * up
+                out[0, g, j], out[1, g, j] = i00 * r0 + i01 * r1, i10 * r0 + i11 * r1
+            if want_shear:
+                shear[g, j] = _shear_exponent(out[0, g, j], out[1, g, j], believed, corrected,
+                                              height + lift[upper] + slant[upper, g] *
+                                              believed[upper, 2],
+                                              height + lift[lower] + slant[lower, g] *
+                                              believed[lower, 2], upper, lower)
+
+
+@_called
+def _inverse2(a00, a01, a10, a11):
+    """The inverse of ``[[a00, a01], [a10, a11]]`` by Cramer's rule (the systems here are
+    well conditioned: ~cot(half-cone), :func:`uq.physics.fusedkernels._inverse2`)."""
+    scale = 1.0 / (a00 * a11 - a01 * a10)
+    return a11 * scale, -a01 * scale, -a10 * scale, a00 * scale
+
+
+@_called
+def _shear_exponent(north, east, believed, corrected, z_upper, z_lower, upper, lower):
+    """``ln(U_up / U_down) / ln(z_up / z_down)``, ``U_k = c_k / (b_k,h . e)``; NaN where a
+    ratio is not positive (:func:`uq.physics.nacelle.shear_exponent`)."""
+    speed = math.sqrt(north * north + east * east)
+    along_upper = (believed[upper, 0] * north + believed[upper, 1] * east) / speed
+    along_lower = (believed[lower, 0] * north + believed[lower, 1] * east) / speed
+    ratio_speed = (corrected[upper] / along_upper) / (corrected[lower] / along_lower)
+    ratio_height = z_upper / z_lower
+    if ratio_speed > 0 and ratio_height > 0:
+        return math.log(ratio_speed) / math.log(ratio_height)
+    return math.nan
+
+
+@functools.cache
+def compiled_mounted_wind():
+    """:func:`mounted_wind` compiled on first use (a tilted mount's run alone pays it)."""
+    return _kernel(f"void({_CV}, int64[::1], {_CM}, {_CM}, {_CM}, {_CM}, int64, {_CT}, "
+                   f"{_CM})")(mounted_wind)
