@@ -954,62 +954,81 @@ def mounted_wind(consts, layout, beams, slant, work, normal, count, out, shear):
     b_k,up w`` with the w of `out` (:mod:`uq.physics.nacelle`); other layouts keep
     `out`. Writes out[:, g, j] and, wanted, ``shear[g, j] = ln(U_up / U_down) / ln(z_up /
     z_down)``, ``U_k = c_k / (b_k,h . e)`` at the believed heights ``z_k = lidar height +
-    lift_k + slant b_k,up`` (NaN where a ratio is not positive).
+    lift_k + slant b_k,up`` (NaN where a ratio is not positive). Loops over the trials
+    innermost (SIMD); the 2 x 2 inverses in work's rows _MATRIX1 (free after
+    :func:`reconstruct`).
     """
     n_beams, n_gates, model = int(consts[_N_BEAMS]), int(consts[_N_GATES]), int(consts[_MODEL])
     level_a, level_b, upper, lower = layout[0], layout[1], layout[2], layout[3]
-    want_shear = layout[4] > 0
     stored = 6 + 3 * n_gates
     measured = stored + 5 * n_beams
-    believed = np.empty((n_beams, 3))
-    along, lift, corrected = np.empty(n_beams), np.zeros(n_beams), np.empty(n_beams)
-    height = consts[_LIDAR_HEIGHT]
-    i00 = i01 = i10 = i11 = 0.0
-    for j in range(count):
-        if model == POINTWISE:
-            for b in range(n_beams):
-                for i in range(3):
-                    believed[b, i] = normal[stored + 5 * b + i, j]
-                along[b] = normal[stored + 5 * b + 3, j]
-                lift[b] = normal[stored + 5 * b + 4, j]
-        else:                                   # the scan's reading (_scan_correction)
-            ch, sh = work[_READ_TRIG, j], work[_READ_TRIG + 1, j]
-            cp, sp = work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j]
-            cr, sr = work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j]
-            vn, ve = work[_READ_VELOCITY, j], work[_READ_VELOCITY + 1, j]
-            vu = work[_READ_VELOCITY + 2, j] if model == FULL else 0.0
-            for b in range(n_beams):
-                bx, by, bz = rotate(ch, sh, cp, sp, cr, sr, beams[b, 0], beams[b, 1],
-                                    beams[b, 2])
-                believed[b, 0], believed[b, 1], believed[b, 2] = bx, by, bz
-                along[b] = bx * vn + by * ve + bz * vu
-        if n_beams == 2:                        # the horizontal normal equations
-            h00 = believed[0, 0] * believed[0, 0] + believed[1, 0] * believed[1, 0]
-            h01 = believed[0, 0] * believed[0, 1] + believed[1, 0] * believed[1, 1]
-            h11 = believed[0, 1] * believed[0, 1] + believed[1, 1] * believed[1, 1]
-            i00, i01, i10, i11 = _inverse2(h00, h01, h01, h11)
-        elif level_a >= 0:                      # the level pair's horizontal parts
-            i00, i01, i10, i11 = _inverse2(believed[level_a, 0], believed[level_a, 1],
-                                           believed[level_b, 0], believed[level_b, 1])
-        for g in range(n_gates):
-            for b in range(n_beams):
-                corrected[b] = normal[measured + b * n_gates + g, j] + along[b]
-            if n_beams == 2:
-                r0 = believed[0, 0] * corrected[0] + believed[1, 0] * corrected[1]
-                r1 = believed[0, 1] * corrected[0] + believed[1, 1] * corrected[1]
-                out[0, g, j], out[1, g, j], out[2, g, j] = \
-                    i00 * r0 + i01 * r1, i10 * r0 + i11 * r1, 0.0
-            elif level_a >= 0:
+    if model != POINTWISE:                  # the scan's reading (_scan_correction's rows)
+        full = model == FULL
+        for b in range(n_beams):
+            nx, ny, nz = beams[b, 0], beams[b, 1], beams[b, 2]
+            row = stored + 5 * b
+            for j in range(count):
+                bx, by, bz = rotate(work[_READ_TRIG, j], work[_READ_TRIG + 1, j],
+                                    work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j],
+                                    work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j],
+                                    nx, ny, nz)
+                vu = work[_READ_VELOCITY + 2, j] if full else 0.0
+                normal[row, j], normal[row + 1, j], normal[row + 2, j] = bx, by, bz
+                normal[row + 3, j] = bx * work[_READ_VELOCITY, j] + \
+                    by * work[_READ_VELOCITY + 1, j] + bz * vu
+                normal[row + 4, j] = 0.0
+    first = stored + 5 * (0 if n_beams == 2 else level_a)
+    second = stored + 5 * (1 if n_beams == 2 else level_b)
+    inverse = _MATRIX1
+    if n_beams == 2 or level_a >= 0:
+        for j in range(count):
+            n00, n01 = normal[first, j], normal[first + 1, j]
+            n10, n11 = normal[second, j], normal[second + 1, j]
+            if n_beams == 2:                # the horizontal normal equations
+                n00, n01, n10, n11 = (n00 * n00 + n10 * n10, n00 * n01 + n10 * n11,
+                                      n00 * n01 + n10 * n11, n01 * n01 + n11 * n11)
+            i00, i01, i10, i11 = _inverse2(n00, n01, n10, n11)
+            work[inverse, j], work[inverse + 1, j] = i00, i01
+            work[inverse + 2, j], work[inverse + 3, j] = i10, i11
+    m_first = measured + (0 if n_beams == 2 else level_a) * n_gates
+    m_second = measured + (1 if n_beams == 2 else level_b) * n_gates
+    for g in range(n_gates):
+        if n_beams == 2:
+            for j in range(count):
+                c0 = normal[m_first + g, j] + normal[first + 3, j]
+                c1 = normal[m_second + g, j] + normal[second + 3, j]
+                r0 = normal[first, j] * c0 + normal[second, j] * c1
+                r1 = normal[first + 1, j] * c0 + normal[second + 1, j] * c1
+                out[0, g, j] = work[inverse, j] * r0 + work[inverse + 1, j] * r1
+                out[1, g, j] = work[inverse + 2, j] * r0 + work[inverse + 3, j] * r1
+                out[2, g, j] = 0.0
+        elif level_a >= 0:
+            for j in range(count):
                 up = out[2, g, j]
-                r0 = corrected[level_a] - believed[level_a, 2] * up
-                r1 = corrected[level_b] - believed[level_b, 2] * up
-                out[0, g, j], out[1, g, j] = i00 * r0 + i01 * r1, i10 * r0 + i11 * r1
-            if want_shear:
-                shear[g, j] = _shear_exponent(out[0, g, j], out[1, g, j], believed, corrected,
-                                              height + lift[upper] + slant[upper, g] *
-                                              believed[upper, 2],
-                                              height + lift[lower] + slant[lower, g] *
-                                              believed[lower, 2], upper, lower)
+                r0 = (normal[m_first + g, j] + normal[first + 3, j]) - normal[first + 2, j] * up
+                r1 = (normal[m_second + g, j] + normal[second + 3, j]) - \
+                    normal[second + 2, j] * up
+                out[0, g, j] = work[inverse, j] * r0 + work[inverse + 1, j] * r1
+                out[1, g, j] = work[inverse + 2, j] * r0 + work[inverse + 3, j] * r1
+        if layout[4] > 0:
+            _shear_rows(consts, normal, stored, measured + upper * n_gates + g,
+                        measured + lower * n_gates + g, stored + 5 * upper,
+                        stored + 5 * lower, slant[upper, g], slant[lower, g], out, g, count,
+                        shear)
+
+
+@_helper
+def _shear_rows(consts, normal, stored, m_upper, m_lower, upper, lower, slant_upper,
+                slant_lower, out, g, count, shear):
+    """shear[g, :count] from the upper and lower beams' rows (:func:`mounted_wind`)."""
+    height = consts[_LIDAR_HEIGHT]
+    for j in range(count):
+        shear[g, j] = _shear_exponent(
+            out[0, g, j], out[1, g, j], normal[upper, j], normal[upper + 1, j],
+            normal[lower, j], normal[lower + 1, j],
+            normal[m_upper, j] + normal[upper + 3, j], normal[m_lower, j] + normal[lower + 3, j],
+            (height + normal[upper + 4, j]) + slant_upper * normal[upper + 2, j],
+            (height + normal[lower + 4, j]) + slant_lower * normal[lower + 2, j])
 
 
 @_called
@@ -1021,13 +1040,14 @@ def _inverse2(a00, a01, a10, a11):
 
 
 @_called
-def _shear_exponent(north, east, believed, corrected, z_upper, z_lower, upper, lower):
+def _shear_exponent(north, east, upper_north, upper_east, lower_north, lower_east,
+                    c_upper, c_lower, z_upper, z_lower):
     """``ln(U_up / U_down) / ln(z_up / z_down)``, ``U_k = c_k / (b_k,h . e)``; NaN where a
     ratio is not positive (:func:`uq.physics.nacelle.shear_exponent`)."""
     speed = math.sqrt(north * north + east * east)
-    along_upper = (believed[upper, 0] * north + believed[upper, 1] * east) / speed
-    along_lower = (believed[lower, 0] * north + believed[lower, 1] * east) / speed
-    ratio_speed = (corrected[upper] / along_upper) / (corrected[lower] / along_lower)
+    along_upper = (upper_north * north + upper_east * east) / speed
+    along_lower = (lower_north * north + lower_east * east) / speed
+    ratio_speed = (c_upper / along_upper) / (c_lower / along_lower)
     ratio_height = z_upper / z_lower
     if ratio_speed > 0 and ratio_height > 0:
         return math.log(ratio_speed) / math.log(ratio_height)
