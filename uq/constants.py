@@ -79,6 +79,17 @@ SWEEP_CHUNK_ELEMENTS_COMPILED = 2**22
 #: (:mod:`uq.physics.fused`), so this bounds the chunk's outputs and statistics instead.
 FUSED_MAX_SCENES = 64
 
+#: Fewest scenes of a complex-step call (the GUM's Jacobian) that the compiled static
+#: model takes [1] (:func:`uq.physics.fused.declined`); smaller calls run the numpy
+#: model's complex step. Measured (numba 0.68, 2 cores): the numpy complex step costs
+#: ~12 us per scene, the compiled one ~2.4 us once compiled, and compiling its complex
+#: kernels ~11 s of a cold start (of 27 s for ``uq run rubio2022_case_i``). Below 2^14
+#: scenes the compiled kernels save under 0.2 s a run: a one-scene case, or a Monte Carlo
+#: sweep's chunk (at most :data:`FUSED_MAX_SCENES` scenes) never compiles them, a GUM
+#: grid (Rubio & Gottschall's Fig. 2: 518,400 scenes) does. The two complex steps agree
+#: to 1e-12 (tests/physics/test_fused.py).
+COMPLEX_STEP_COMPILED_MIN_SCENES = 2**14
+
 #: von Karman constant [1]: 0.40, the value of Hogstrom (1996), Boundary-Layer
 #: Meteorol. 78, 215-246 (0.40 +- 0.01 from his review of surface-layer experiments).
 VON_KARMAN = 0.40

@@ -135,7 +135,7 @@ def test_only_requested_outputs():
     assert set(out) == {"wind_speed"} and out["wind_speed"].shape == (3, 1)
 
 
-def test_applicable_to_every_static_scene_and_output():
+def test_applicable_to_every_static_scene_and_output(complex_kernels):
     scene = make_scene()
     n = 3
     assert fused.applicable(scene, EVERY, {})
@@ -200,9 +200,17 @@ def test_independent_draws_per_scene_agree_with_numpy(model, sources, rng):
             np.testing.assert_array_equal(alone[name], compiled[name][:, 1, 1], err_msg=name)
 
 
+@pytest.fixture
+def complex_kernels(monkeypatch):
+    """The compiled model takes complex steps of any number of scenes (by default it
+    leaves those of fewer than COMPLEX_STEP_COMPILED_MIN_SCENES to the numpy model)."""
+    monkeypatch.setattr(fused, "COMPLEX_STEP_COMPILED_MIN_SCENES", 1)
+
+
 def _jacobians(scene, inputs):
     """Complex-step Jacobians of every output by the compiled and by the numpy model."""
     laid = input_set(inputs)
+    assert fused.declined(scene, EVERY, {"ins_heading": np.zeros(1, complex)}) == ""
     return [complex_step_jacobian(
         lambda **e: measurement_model(scene, EVERY, compiled=compiled, **e), laid)
         for compiled in (True, False)]
@@ -210,7 +218,7 @@ def _jacobians(scene, inputs):
 
 @pytest.mark.parametrize("model", ["none", "yaw", "tilt2d", "full"])
 @pytest.mark.parametrize("correlation", ["scan", "beam"])
-def test_complex_step_jacobian_agrees_with_numpy(model, correlation):
+def test_complex_step_jacobian_agrees_with_numpy(model, correlation, complex_kernels):
     """The GUM: complex errors run the compiled loop in complex arithmetic. Its value
     and Jacobian equal the numpy model's (every output, every error source, a batch of
     three scenes, geometry errors so the truth varies per perturbation). Tolerance
@@ -239,7 +247,7 @@ def test_complex_step_jacobian_agrees_with_numpy(model, correlation):
     assert_same(value_c, value_n)
 
 
-def test_complex_step_of_a_large_grid_without_geometry_errors():
+def test_complex_step_of_a_large_grid_without_geometry_errors(complex_kernels):
     """A GUM grid (the truth per scene, INS errors only, the paper's Table B1): the
     compiled Jacobian of 500 scenes equals the numpy one."""
     from scipy import stats
@@ -253,6 +261,21 @@ def test_complex_step_of_a_large_grid_without_geometry_errors():
     for name in EVERY:
         np.testing.assert_allclose(jac_c[name], jac_n[name], rtol=0, atol=ATOL, err_msg=name)
     assert_same(value_c, value_n)
+
+
+def test_a_small_complex_step_runs_the_numpy_model():
+    """The GUM's complex step of a few scenes is the numpy model's (cheaper than compiling
+    the complex kernels, see COMPLEX_STEP_COMPILED_MIN_SCENES); of a large grid, the
+    compiled loop's; real draws always the compiled loop's."""
+    from uq.constants import COMPLEX_STEP_COMPILED_MIN_SCENES as least
+    one = make_scene(**{"correction": "yaw"})
+    grid = dataclasses.replace(one, wind_direction=np.linspace(0.0, 6.0, least))
+    just_below = dataclasses.replace(one, wind_direction=np.linspace(0.0, 6.0, least - 1))
+    step, draws = {"ins_heading": np.full(2, 0.1 + 1e-20j)}, {"ins_heading": np.full(2, 0.1)}
+    assert "complex step (the GUM) of fewer than" in fused.declined(one, EVERY, step)
+    assert "fewer than" in fused.declined(just_below, EVERY, step)
+    assert fused.declined(grid, EVERY, step) == ""
+    assert fused.declined(one, EVERY, draws) == ""
 
 
 @pytest.mark.parametrize("model", ["yaw", "full"])

@@ -111,9 +111,9 @@ def command(args):
 
 def load_kernels(args, scenario):
     """Load the compiled kernels the run surely uses before its progress bar starts: the
-    statistics', and the static model's geometry in real and complex arithmetic or the
-    time-resolved model's. The wind kernel (scan-wise or point-wise) loads when first
-    called. The first run after an install compiles them into numba's cache; the
+    statistics', and the static model's geometry (real arithmetic; the complex kernels
+    load when a GUM grid of many scenes first calls them) or the time-resolved model's.
+    The wind kernel (scan-wise or point-wise) loads when first called. The first run after an install compiles them into numba's cache; the
     command's :class:`~uq.cli.compiling.CompileNotice` says so, kernel by kernel."""
     from uq.pipeline import motionsection
     import uq.engine.statkernels  # noqa: F401  (numba compiles or loads on import)
@@ -123,9 +123,8 @@ def load_kernels(args, scenario):
         import uq.physics.fusedmotionkernels  # noqa: F401
         return
     from uq.physics import fusedkernels
-    for number in (float, complex):               # complex: the GUM's complex steps
-        for name in ("ins_trig", "geometry"):
-            fusedkernels.compiled(number)[name]
+    for name in ("ins_trig", "geometry"):         # the complex kernels: a large GUM grid's
+        fusedkernels.compiled(float)[name]
 
 
 def check_scale_out(args):

@@ -48,7 +48,7 @@ import numpy as np
 from uq.physics import fusedkernels as kernels
 from uq.physics import wind as wind_formulas
 from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
-from uq.constants import FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS
+from uq.constants import COMPLEX_STEP_COMPILED_MIN_SCENES, FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS
 from uq.physics import modelinputs
 from uq.physics.modelinputs import STATIC_COMPILED, Correction
 from uq.physics import nacelle
@@ -89,8 +89,12 @@ def declined(scene, outputs, errors, scene_draws=False):
     allowed = _outputs_of(scene)
     if not set(outputs) <= allowed:
         return f"output(s) {', '.join(sorted(set(outputs) - allowed))}"
-    if scene.probe is not None and any(np.iscomplexobj(v) for v in errors.values()):
-        return "a probe volume's complex step (the GUM)"
+    if any(np.iscomplexobj(v) for v in errors.values()):
+        if scene.probe is not None:
+            return "a probe volume's complex step (the GUM)"
+        if math.prod(scene.shape) < COMPLEX_STEP_COMPILED_MIN_SCENES:
+            return (f"a complex step (the GUM) of fewer than "
+                    f"{COMPLEX_STEP_COMPILED_MIN_SCENES} scenes")
     lacked = modelinputs.lacks(STATIC_COMPILED, errors)
     if lacked:
         return f"input(s) {', '.join(lacked)}"
@@ -380,8 +384,9 @@ def _prepared(scene, outputs, errors, scene_draws):
     s_axis = shape if scene_draws else ()
     values = {name: np.asarray(value) for name, value in errors.items() if value is not None}
     dtype = complex if any(v.dtype.kind == "c" for v in values.values()) else float
-    if scene.probe is not None and dtype is complex:
-        return None                 # a probe's complex step (the GUM): the numpy model
+    if dtype is complex and (scene.probe is not None or
+                             scenes < COMPLEX_STEP_COMPILED_MIN_SCENES):
+        return None                 # a probe's or a small complex step: the numpy model
     beams, gates = scene.n_beams, len(scene.ranges)
     n = max([v.shape[0] for v in values.values() if v.ndim], default=1)
     laid = {}
