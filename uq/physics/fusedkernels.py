@@ -944,6 +944,9 @@ _KERNELS = {"ins_trig": (ins_trig, "trig"), "geometry": (geometry, "geometry"),
             "wind_mounted_pointwise": (wind_mounted_pointwise, "wind_mounted")}
 #: The kernels' names (each compiled for float64 and complex128 by :func:`compiled`).
 KERNEL_NAMES = tuple(_KERNELS)
+#: Those of a tilted mount, which runs them in float64 alone (its complex step, the
+#: GUM, is the numpy model's: :func:`uq.physics.fused.declined`).
+MOUNTED_KERNEL_NAMES = ("geometry_mounted", "wind_mounted_scan", "wind_mounted_pointwise")
 
 
 @functools.cache
