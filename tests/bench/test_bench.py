@@ -108,3 +108,19 @@ def test_the_scale_run_reports_its_own_peak_memory_not_its_parents():
     parent = np.ones(80_000_000)                       # 640 MB, touched
     _, megabytes = bench.scale(2000)
     assert parent[-1] == 1.0 and megabytes < 500, megabytes
+
+
+def test_the_nacelle_figure_compares_like_with_like(caplog):
+    """``nacelle_scans``: the nacelle lidar and the DBS of each pair differ in the mount
+    alone (same beams' count for 4, the 4-beam DBS for 2), and both run the compiled
+    models (no fall-back to numpy said at INFO, apart from the GUM's complex step)."""
+    import logging
+    from uq.bench import targets
+    from uq.physics import modelinputs
+    modelinputs._LOGGED.clear()
+    with caplog.at_level(logging.INFO, logger="uq.physics.modelinputs"):
+        times = targets.nacelle_scans(2**10, repeats=1)
+    assert set(times) == {(4, "static"), (4, "motion"), (2, "static"), (2, "motion")}
+    assert all(nacelle > 0 and dbs > 0 for nacelle, dbs in times.values())
+    declined = [r.getMessage() for r in caplog.records if "does not take" in r.getMessage()]
+    assert declined and all("complex" in message for message in declined)

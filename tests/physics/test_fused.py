@@ -360,3 +360,91 @@ def test_no_output_depends_on_uninitialised_memory(sources, monkeypatch, rng):
     dirty = measurement_model(batch, EVERY, **err)
     for name in EVERY:
         np.testing.assert_array_equal(dirty[name], clean[name], err_msg=name)
+
+
+# ---- a tilted (nacelle) mount: lidar.mount.tilt > 0 (uq.physics.nacelle)
+
+from uq.physics.scene import NACELLE_OUTPUTS          # noqa: E402
+
+FOUR, TWO = [0, 90, 180, 270], [90, 270]
+
+
+def nacelle_scene(azimuths, model, tilt=90.0, **changes):
+    """A nacelle lidar (clock positions `azimuths`, half-cone 15 deg) at 150 m on a pitched,
+    rolled, yawed, moving platform, power-law shear, the wind 20 deg off the bow."""
+    return make_scene(**{"correction": model, "lidar.mount": {"tilt": tilt},
+                         "lidar.half_cone": 15.0, "lidar.azimuths": azimuths,
+                         "lidar.height": 150.0, "lidar.ranges": [50, 100, 300],
+                         "lidar.misalignment": 2.0, "wind.shear": 0.14,
+                         "wind.reference_height": 150.0, "wind.direction": 20.0,
+                         "ship.heading": 30.0, "ship.pitch": 2.0, "ship.roll": -1.0,
+                         "ship.sog": 1.0, "ship.cog": 60.0, "ship.heave": 0.2, **changes})
+
+
+def nacelle_outputs(azimuths):
+    """Every output a layout has (the shear exponent needs beams above and below)."""
+    return EVERY + (NACELLE_OUTPUTS if 0 in azimuths else ("yaw_misalignment",))
+
+
+def assert_nacelle_same(compiled, plain):
+    """As :func:`assert_same`, the yaw misalignment compared on the circle like the
+    direction (-180 vs 179.999... is a match), NaN shear exponents in the same trials."""
+    for name in ("yaw_misalignment", "shear_exponent"):
+        if name in plain:
+            assert np.array_equal(np.isnan(compiled[name]), np.isnan(plain[name])), name
+    rest = {name: value for name, value in plain.items() if name not in NACELLE_OUTPUTS}
+    assert_same({name: compiled[name] for name in rest}, rest)
+    if "yaw_misalignment" in plain:
+        difference = np.mod(compiled["yaw_misalignment"] - plain["yaw_misalignment"] + 180.0,
+                            360.0) - 180.0
+        np.testing.assert_allclose(difference, 0.0, atol=ATOL)   # deg: as the direction's
+    if "shear_exponent" in plain:    # [1]: ln ratios of ~0.3 from speeds and heights that
+        # agree to 1e-12 relative: the quotient to ~1e-12 / 0.3 of itself (~0.14)
+        np.testing.assert_allclose(compiled["shear_exponent"], plain["shear_exponent"],
+                                   rtol=0, atol=ATOL, equal_nan=True)
+
+
+@pytest.mark.parametrize("azimuths, model", [
+    (azimuths, model) for azimuths in (FOUR, TWO, [0, 120, 240])
+    for model in ("none", "yaw", "tilt2d", "full")
+    if not (model == "tilt2d" and len(azimuths) == 2)])   # (refused: a 3-D correction)
+@pytest.mark.parametrize("per_beam", [(), ("ins_heading", "ins_pitch", "ins_roll", "ins_sog",
+                                           "ins_cog", "ins_heave"), ("ins_pitch",)])
+def test_a_nacelle_lidar_agrees_with_numpy(azimuths, model, per_beam, rng):
+    """The compiled model takes a tilted mount: clock-position beams, the 2-beam
+    horizontal least squares (w = 0), the 4-beam hub-height wind of the level pair after
+    the 3-D solve (a 3-beam layout without a level pair keeps the 3-D solve), the yaw
+    misalignment and the shear exponent at the believed heights; one reading per scan or
+    per beam, every error source on. Its outputs equal the numpy model's."""
+    scene = nacelle_scene(azimuths, model)
+    err = errors(rng, 300, scene, ALL_SOURCES, per_beam=per_beam)
+    outputs = nacelle_outputs(azimuths)
+    assert fused.declined(scene, outputs, err) == ""
+    compiled, plain = both(scene, outputs, **err)
+    assert_nacelle_same(compiled, plain)
+    assert np.isfinite(compiled["wind_speed"]).all()               # the check can fail
+
+
+@pytest.mark.parametrize("tilt", [90.0, 60.0])
+def test_a_batch_of_nacelle_scenes_with_their_own_draws_agrees_with_numpy(tilt, rng):
+    """A batch (2 x 3: wind speed, direction, shear) with independent draws per scene and
+    a probe-free truth per trial (geometry errors), at a tilt between the two lidars."""
+    base = nacelle_scene(FOUR, "full", tilt)
+    grid = np.ones((2, 3))
+    batch = dataclasses.replace(base, wind_speed=np.array([[4.0], [8.0]]) * grid,
+                                wind_direction=np.deg2rad([0.0, 90.0, 359.0]) * grid,
+                                shear=np.array([0.0, 0.1, 0.2]) * grid)
+    err = errors(rng, 40, base, ALL_SOURCES, scenes=(2, 3))
+    outputs = nacelle_outputs(FOUR)
+    assert fused.applicable(batch, outputs, err, scene_draws=True)
+    assert_nacelle_same(*both(batch, outputs, scene_draws=True, **err))
+
+
+def test_a_nacelle_lidar_declines_what_it_does_not_compute():
+    """The GUM's complex step of a tilted mount and the shear exponent of beams with no
+    upper and lower one stay with the numpy model, and say so."""
+    scene = nacelle_scene(FOUR, "full")
+    assert "complex step" in fused.declined(scene, WIND, {"ins_pitch": np.ones(3) * 1j})
+    two = nacelle_scene(TWO, "full")
+    assert "upper and a lower" in fused.declined(two, ("shear_exponent",), {})
+    assert "yaw_misalignment" in fused.declined(make_scene(), ("yaw_misalignment",), {})

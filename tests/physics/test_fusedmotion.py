@@ -159,3 +159,69 @@ def test_a_measured_record(tmp_path):
                                              "columns": {"roll": "r", "heave": "h"},
                                              "components": 20},
                                   "pitch": {"amplitude": 2.0, "period": 5.0}}}))
+
+
+# ---- a tilted (nacelle) mount: lidar.mount.tilt > 0 (uq.physics.nacelle)
+
+#: The nacelle lidar of nacelle_floating: boresight along the bow at 150 m, half-cone 15
+#: deg, 0.25 s per line of sight, the INS 150 m below (lever arm), preview 50-300 m.
+NACELLE = {"lidar.mount": {"tilt": 90.0}, "lidar.half_cone": 15.0,
+           "lidar.vertical_beam": False, "lidar.height": 150.0,
+           "wind.reference_height": 150.0, "lidar.lever_arm": [0.0, 0.0, 150.0],
+           "lidar.scan.beam_duration": 0.25, "lidar.ranges": [50.0, 100.0, 300.0],
+           "motion.surge": {"amplitude": 1.0, "period": 8.0, "phase": "random"}}
+NACELLE_OUTPUTS = OUTPUTS + ("yaw_misalignment", "shear_exponent")
+#: The cases of CASES that a nacelle lidar meets too (a VAD is not one), each with 4
+#: beams (up, starboard, down, port) and with 2 (starboard, port; tilt2d, a 3-D
+#: correction, is refused on two beams).
+NACELLE_CASES = {f"{name}, {len(azimuths)} beams": (changes, azimuths)
+                 for name, changes in CASES.items() if "VAD" not in name
+                 for azimuths in ([0, 90, 180, 270], [90, 270])
+                 if not (len(azimuths) == 2 and changes.get("correction") == "tilt2d")}
+
+
+def both_nacelle(changes, azimuths, n=200):
+    """(compiled, numpy) outputs of the nacelle lidar: every output its layout has."""
+    settings = load_scenario({"name": "t", **merged(BASE, {
+        **NACELLE, "lidar.azimuths": azimuths, **changes})}).settings
+    scene = scene_from_settings(settings)
+    inputs = error_inputs(settings, scene.n_beams, len(scene.ranges))
+    constant = {k: v for k, v in inputs.items() if isinstance(v, float)}
+    random = input_set({k: v for k, v in inputs.items() if not isinstance(v, float)})
+    errors = random.values(np.random.default_rng(3).standard_normal((n, random.dimension)))
+    errors.update(constant)
+    outputs = NACELLE_OUTPUTS if 0 in azimuths else NACELLE_OUTPUTS[:-1]
+    assert fusedmotion.declined(scene, outputs, errors) == ""
+    return (measurement_model(scene, outputs, **errors),
+            measurement_model(scene, outputs, compiled=False, **errors))
+
+
+@pytest.mark.parametrize("changes, azimuths", NACELLE_CASES.values(), ids=NACELLE_CASES.keys())
+def test_a_nacelle_lidar_compiled_equals_numpy(changes, azimuths):
+    """The compiled model takes a tilted mount: the clock-position beams (and their
+    geometry errors), the 2-beam horizontal least squares (w = 0), the 4-beam hub-height
+    wind of the level pair after the 3-D solve, the yaw misalignment, and the shear
+    exponent at the believed heights (point-wise: lifted by the lever arm at the attitude
+    read). Yaw misalignment as the direction (an arc length at the speed); the shear
+    exponent [1] to 1e-12: ln ratios of ~0.3 from speeds and heights that agree to
+    ~1e-13 relative."""
+    fast, slow = both_nacelle(changes, azimuths)
+    assert_same(fast, slow)
+    turn = (fast["yaw_misalignment"] - slow["yaw_misalignment"] + 180.0) % 360.0 - 180.0
+    assert np.max(np.abs(np.deg2rad(turn)) * slow["wind_speed"]) < TOLERANCE
+    if "shear_exponent" in slow:
+        assert np.array_equal(np.isnan(fast["shear_exponent"]), np.isnan(slow["shear_exponent"]))
+        np.testing.assert_allclose(fast["shear_exponent"], slow["shear_exponent"], rtol=0,
+                                   atol=TOLERANCE, equal_nan=True)
+
+
+def test_a_nacelle_lidar_declines_what_it_does_not_compute():
+    """tilt2d on two beams (numpy refuses it too) and a shear exponent without upper and
+    lower beams stay with the numpy model, and say why."""
+    settings = load_scenario({"name": "t", **merged(BASE, {
+        **NACELLE, "lidar.azimuths": [90, 270]})}).settings
+    scene = scene_from_settings(settings)
+    assert "upper and a lower" in fusedmotion.declined(scene, NACELLE_OUTPUTS, {})
+    two = dataclasses.replace(scene, correction="tilt2d")
+    assert "tilt2d" in fusedmotion.declined(two, OUTPUTS, {})
+    assert fusedmotion.declined(scene, NACELLE_OUTPUTS[:-1], {}) == ""

@@ -14,6 +14,8 @@ Fig. 2 GUM grid, 518,400 scenes         the numpy model's complex step (before) 
 10^6 point-wise scans in motion         10^6 static scans                           <= 4x
 conical scan, 50 lines of sight         a 4-beam scan in motion, per trial          <= 15x
 pulsed probe, ``floating_lidar_full``   the compiled point model, ``uq.run``        <= 3x
+nacelle lidar (tilt 90), 4 beams,       a 4-beam DBS scan, the same run otherwise   <= 1x
+static and point-wise in motion         (CPU time per scan)
 ``uq run rubio2022_case_i``, numba's    CPU time [s] (and peak memory [MB]) in a     <= 20 s
 cache empty (a fresh cache folder)      new process; the same run with it filled     600 MB
 ``uq run floating_lidar_waves`` (the    the same                                    <= 30 s
@@ -61,6 +63,7 @@ TARGETS = {"floating_lidar_full_mc_over_draw_floor": (3.0, "max"),
            "pointwise_motion_over_static": (4.0, "max"),
            "conical_over_four_beam": (15.0, "max"),
            "pulsed_probe_over_point": (3.0, "max"),
+           "nacelle_static_over_dbs": (1.0, "max"), "nacelle_motion_over_dbs": (1.0, "max"),
            "cold_start_cpu_s": (20.0, "max"), "cold_start_peak_rss_mb": (600.0, "max"),
            "cold_start_motion_cpu_s": (30.0, "max"),
            "cold_start_motion_peak_rss_mb": (600.0, "max"),
@@ -258,6 +261,50 @@ def conical_scans(n=2**17, repeats=5):
             median_time(lambda: run(four), repeats))
 
 
+def median_cpu_time(function, repeats):
+    """Median CPU time [s] of this process (``time.process_time``) over `repeats` calls
+    after one warm call: a figure a busy machine does not move (the runs here are
+    single-threaded)."""
+    function()
+    times = []
+    for _ in range(repeats):
+        started = time.process_time()
+        function()
+        times.append(time.process_time() - started)
+    return float(np.median(times))
+
+
+#: The nacelle lidar of the issue's held-out check: 4 beams at clock positions up,
+#: starboard, down, port, half-cone 15 deg, the boresight along the bow at 150 m, 100 m
+#: preview; in motion pitch 3 deg at 25 s of random phase, the INS 150 m below.
+NACELLE = {"lidar.mount": {"tilt": 90.0}, "lidar.half_cone": 15.0, "lidar.height": 150.0,
+           "lidar.ranges": [100.0], "lidar.vertical_beam": False,
+           "outputs": ["wind_speed", "wind_direction"]}
+NACELLE_MOTION = {"correction": "pointwise", "lidar.scan.beam_duration": 0.25,
+                  "lidar.lever_arm": [0.0, 0.0, 150.0],
+                  "motion.pitch": {"amplitude": 3.0, "period": 25.0}}
+
+
+def nacelle_scans(n=2**17, repeats=3):
+    """CPU time [s] of ``uq.run`` of n nacelle scans and of n DBS scans of the same beam
+    count (the DBS: the same lidar upward, half-cone 15 deg, azimuths 0/90/180/270), the
+    same outputs, radial noise, correction and motion: {(beams, kind): (nacelle, dbs)}
+    for 4 beams static (``ship.pitch`` 2 deg) and in motion (point-wise), and the 2-beam
+    nacelle lidar (clock 90/270) against the 4-beam DBS (a DBS needs 3 beams or more)."""
+    static = {"ship.pitch": 2.0}
+    cases = {(4, "static"): static, (4, "motion"): NACELLE_MOTION,
+             (2, "static"): static, (2, "motion"): NACELLE_MOTION}
+    times = {}
+    for (beams, kind), changes in cases.items():
+        azimuths = [0.0, 90.0, 180.0, 270.0] if beams == 4 else [90.0, 270.0]
+        nacelle = _scans(n, **NACELLE, **changes, **{"lidar.azimuths": azimuths})
+        dbs = _scans(n, **{**NACELLE, "lidar.mount": {"tilt": 0.0}}, **changes,
+                     **{"lidar.azimuths": [0.0, 90.0, 180.0, 270.0]})
+        times[beams, kind] = (median_cpu_time(lambda: run(nacelle), repeats),
+                              median_cpu_time(lambda: run(dbs), repeats))
+    return times
+
+
 def probe_against_point(n=2**16, repeats=5):
     """(seconds of ``uq.run`` of ``floating_lidar_full`` with a pulsed probe, of the same
     at a point; seconds of its measurement model alone with the probe, at a point) at n
@@ -352,6 +399,13 @@ def measure(quick=False, progress=None, scale=1):
                    pulsed_probe_model_over_point=probe_model_s / point_model_s)
     say(f"floating_lidar_full, pulsed probe, n = {n}: {probe_s:.3f} s, at a point "
         f"{point_s:.3f} s (the model alone {probe_model_s:.3f} s, {point_model_s:.3f} s)")
+    n = trials(2**17)
+    for (beams, kind), (nacelle_s, dbs_s) in nacelle_scans(n).items():
+        name = f"nacelle_{kind}" + ("" if beams == 4 else "_2_beams")
+        figures.update({f"{name}_cpu_s": nacelle_s, f"dbs_{kind}_cpu_s": dbs_s,
+                        f"{name}_over_dbs": nacelle_s / dbs_s})
+        say(f"{n} nacelle scans, {beams} beams, {kind}: {nacelle_s:.3f} s of CPU, a 4-beam "
+            f"DBS {dbs_s:.3f} s")
     per_scene, floor = sweep_monte_carlo(trials(MC_DRAWS))
     figures.update(sweep_mc_s_per_scene=per_scene, sweep_draw_floor_s_per_scene=floor,
                    sweep_mc_over_draw_floor=per_scene / floor)

@@ -19,11 +19,13 @@ def command(args):
     started = time.perf_counter()
     import numba
     import uq.engine.statkernels  # noqa: F401  (explicit signatures: compiled on import)
-    import uq.physics.fusedmotionkernels  # noqa: F401  (the same)
+    from uq.physics import fusedmotionkernels  # (the same)
     from uq.physics import fusedkernels
     for number in (float, complex):
         for name in fusedkernels.KERNEL_NAMES:
-            fusedkernels.compiled(number)[name]
+            if number is float or name not in fusedkernels.MOUNTED_KERNEL_NAMES:
+                fusedkernels.compiled(number)[name]
+    fusedmotionkernels.compiled_mounted_wind()        # a tilted mount's, on first use
     compiling = getattr(args, "compile_notice", None)
     compiled = compiling.kernels if compiling else 0
     say(args, f"uq warmup: {compiled} kernel(s) compiled, the others loaded from the cache "

@@ -51,9 +51,11 @@ from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_di
 from uq.constants import COMPLEX_STEP_COMPILED_MIN_SCENES, FULL_CIRCLE_DEG, FUSED_BLOCK_TRIALS
 from uq.physics import modelinputs
 from uq.physics.modelinputs import STATIC_COMPILED, Correction
-from uq.physics.scene import OUTPUTS
+from uq.physics import nacelle
+from uq.physics.scene import NACELLE_OUTPUTS, OUTPUTS
 
-#: Outputs the fused loop computes: all of them.
+#: Outputs the fused loop computes: all of them (a tilted mount's also
+#: :data:`~uq.physics.scene.NACELLE_OUTPUTS`).
 FUSED_OUTPUTS = OUTPUTS
 _INS = tuple(f"ins_{key}" for key in kernels.INS_ORDER)
 _GEOMETRY = tuple(f"lidar_{key}" for key in kernels.GEO_ORDER)
@@ -81,10 +83,12 @@ def declined(scene, outputs, errors, scene_draws=False):
     step, which the numpy model differentiates)."""
     if scene.time_resolved is not None:
         return "a time-resolved scene"
-    if scene.tilt != 0:
-        return "a tilted mount (lidar.mount.tilt): the numpy model's clock-position beams"
-    if not set(outputs) <= _OUTPUT_SET:
-        return f"output(s) {', '.join(sorted(set(outputs) - _OUTPUT_SET))}"
+    mounted = _mounted_decline(scene, outputs, errors)
+    if mounted:
+        return mounted
+    allowed = _outputs_of(scene)
+    if not set(outputs) <= allowed:
+        return f"output(s) {', '.join(sorted(set(outputs) - allowed))}"
     if any(np.iscomplexobj(v) for v in errors.values()):
         if scene.probe is not None:
             return "a probe volume's complex step (the GUM)"
@@ -97,6 +101,34 @@ def declined(scene, outputs, errors, scene_draws=False):
     if _prepared(scene, outputs, errors, scene_draws) is None:
         return "an input of a shape it does not take"
     return ""
+
+
+def _mounted_decline(scene, outputs, errors):
+    """Why the compiled model does not take a tilted mount's call ('' where it does, or
+    for an upward lidar)."""
+    if scene.tilt == 0:
+        return ""
+    if any(np.iscomplexobj(value) for value in errors.values()):
+        return "a tilted mount's complex step (the GUM)"
+    if scene.vertical_beam or (scene.horizontal_only and scene.correction == "tilt2d"):
+        return "a tilted mount with a vertical beam, or tilt2d on two beams"
+    if "shear_exponent" in outputs and nacelle.upper_lower(scene.azimuths) is None:
+        return "shear_exponent without an upper and a lower beam"
+    return ""
+
+
+def _outputs_of(scene):
+    """The outputs the compiled model computes for `scene`."""
+    return _OUTPUT_SET | set(NACELLE_OUTPUTS) if scene.tilt != 0 else _OUTPUT_SET
+
+
+def _mounted_structure(scene, outputs):
+    """The tail of a tilted mount's structure vector (:data:`~uq.physics.fusedkernels.
+    MOUNTED_STRUCTURE`): the shear exponent wanted, the level pair, the upper and lower
+    beams (-1 where there are none)."""
+    pair = None if scene.horizontal_only else nacelle.level_pair(scene.azimuths)
+    upper_lower = nacelle.upper_lower(scene.azimuths) if "shear_exponent" in outputs else None
+    return [int("shear_exponent" in outputs), *(pair or (-1, -1)), *(upper_lower or (-1, -1))]
 
 
 def measurement_model(scene, outputs, scene_draws=False, **errors):
@@ -113,7 +145,7 @@ def measurement_model(scene, outputs, scene_draws=False, **errors):
 def evaluate(scene, outputs, scene_draws, errors):
     """:func:`measurement_model` where :func:`applicable`, else None (one pass over the
     arguments for both: the model is called once per slice of ~2^13 trials)."""
-    if scene.tilt != 0:             # a tilted mount: the numpy model (declined)
+    if scene.tilt != 0 and _mounted_decline(scene, outputs, errors):
         return None
     if scene.probe is not None:             # its node count (the scene itself if chosen)
         from uq.physics import probe as probe_volume
@@ -126,12 +158,18 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype, probe_er
     n_gates, n_beams = len(scene.ranges), scene.n_beams
     scenes = math.prod(shape)
     (table, shapes), kept = scene_table(scene, shape)
+    mounted = scene.tilt != 0
+    directed = "wind_direction" in outputs or "yaw_misalignment" in outputs
     structure = np.array([len(scene.azimuths), int(scene.vertical_beam), n_gates,
                           Correction.of(scene.correction)]
-                         + [int(q in outputs) for q in OUTPUTS], dtype=np.int64)
+                         + [int(q in outputs or (q == "wind_direction" and directed))
+                            for q in OUTPUTS]
+                         + (_mounted_structure(scene, outputs) if mounted else []),
+                         dtype=np.int64)
     out = {q: np.empty((scenes,) + ((n_beams,) if q == "radial_velocity" else ())
-                       + (n_gates, n), dtype=dtype) if q in outputs else _UNUSED[dtype][q]
-           for q in OUTPUTS}             # element-major: each element's trials contiguous
+                       + (n_gates, n), dtype=dtype) if q in outputs or (
+                           q == "wind_direction" and directed) else _UNUSED[dtype][q]
+           for q in OUTPUTS + ("shear_exponent",)}   # element-major: trials contiguous
     from_east = np.empty_like(out["wind_direction"])
     per_trial = any(g.shape[0] > 1 for g in geo) or (     # geometry or probe errors:
         scene.probe is not None and _probe_varies(scene.probe, probe_errors))  # per trial
@@ -145,7 +183,9 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype, probe_er
     truth_rows = group * trials if per_trial else scenes
     compiled = kernels.compiled(dtype)
     pointwise = any(error.shape[2] > 1 for error in ins)   # a reading per beam
-    wind = compiled["wind_pointwise" if pointwise else "wind_scan"]
+    wind = compiled[("wind_mounted_" if mounted else "wind_") +
+                    ("pointwise" if pointwise else "scan")]
+    more = (out["shear_exponent"],) if mounted else ()
     exponent = np.empty(truth_rows)
     if per_trial:                           # geometry errors: the truth of each trial
         beams = np.empty((truth_rows, n_beams, 3), dtype=dtype)
@@ -168,9 +208,12 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype, probe_er
             wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile, geo[2],
                  s0, s1, t0, t1, scene_draws, per_trial, out["wind_speed"],
                  out["vertical_wind"], out["wind_direction"], from_east,
-                 out["radial_velocity"], out["gate_height"])
-    if "wind_direction" in outputs:
+                 out["radial_velocity"], out["gate_height"], *more)
+    if directed:
         _direction(out["wind_direction"], from_east, out["wind_direction"])
+    if "yaw_misalignment" in outputs:       # relative to the rotor axis, the heading
+        heading = table[:, kernels.TABLE.index("heading")].reshape(scenes, 1, 1)
+        out["yaw_misalignment"] = nacelle.yaw_misalignment(out["wind_direction"], heading)
     # (n, *S, ...) views of the element-major arrays
     return {q: np.moveaxis(out[q], -1, 0).reshape((n,) + shape + out[q].shape[1:-1])
             for q in outputs}
@@ -178,7 +221,7 @@ def _run(scene, outputs, scene_draws, shape, n, ins, geo, noise, dtype, probe_er
 
 #: Placeholders of the outputs not requested, per dtype (the kernels write nothing there).
 _UNUSED = {dtype: {q: np.empty((1, 1, 1) + ((1,) if q == "radial_velocity" else ()), dtype)
-                   for q in OUTPUTS} for dtype in (float, complex)}
+                   for q in OUTPUTS + ("shear_exponent",)} for dtype in (float, complex)}
 
 
 def _scene_truth(table, shapes, structure, geo, scenes, dtype, kept, probe=(None, {})):
@@ -218,8 +261,9 @@ def _truth(compiled, table, shapes, structure, geo, s0, s1, t0, t1, per_trial, b
     """True beams and the power-law profile U(z) / U_ref (z / z_ref)^alpha of the rows
     of a rectangle (:func:`uq.physics.fusedkernels.geometry`); numpy's SIMD log and exp,
     NaN stays NaN (1 where there is no shear: exp(0 log 1) is exactly 1)."""
-    compiled["geometry"](table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams,
-                         profile, exponent)
+    mounted = len(structure) == len(kernels.MOUNTED_STRUCTURE)   # a tilted mount's
+    compiled["geometry_mounted" if mounted else "geometry"](
+        table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams, profile, exponent)
     rows = (s1 - s0) * ((t1 - t0) if per_trial else 1)
     if probe[0] is not None:                # the weighted speed along the true beams
         _probe_truth(probe, table, shapes, structure, geo[2], s0, s1, t0, t1, per_trial,
@@ -332,7 +376,7 @@ def _prepared(scene, outputs, errors, scene_draws):
     axis of length 1 broadcasting: INS (k = 1 or beams), geometry (k = 1), noise
     (k = beams x gates); complex128 if any error is complex, else float64."""
     if scene.time_resolved is not None or \
-            not set(outputs) <= _OUTPUT_SET or \
+            not set(outputs) <= _outputs_of(scene) or \
             not set(errors) <= _ERROR_SET:
         return None
     shape = scene.shape
@@ -426,14 +470,20 @@ def make_scene_table(scene, shape=None):
     else:                    # complex numbers sort by real, then imaginary part
         distinct, index = np.unique(key, return_inverse=True)
     units = beam_unit_vectors(distinct.real, azimuths, distinct.imag,
-                              scene.vertical_beam)                             # (u, b, 3)
-    operator = least_squares_operator(units)                                  # (u, 3, b)
+                              scene.vertical_beam, scene.tilt)                 # (u, b, 3)
+    if scene.horizontal_only:           # two beams of a tilted mount: w = 0, no A^+
+        operator = np.zeros(units.shape[:-2] + (3, units.shape[-2]))
+    else:
+        operator = least_squares_operator(units)                              # (u, 3, b)
     slant = slant_distances(scene.ranges, distinct.real, n_slanted, scene.vertical_beam)
     u = len(distinct)
     geometry = np.concatenate([np.broadcast_to(np.cos(azimuths), (u, n_slanted)),
                                np.broadcast_to(np.sin(azimuths), (u, n_slanted)),
                                operator.reshape(u, -1), slant.reshape(u, -1),
-                               units.reshape(u, -1)], axis=1)
+                               units.reshape(u, -1)]
+                              + ([np.full((u, 1), np.cos(scene.tilt)),     # a tilted mount's
+                                  np.full((u, 1), np.sin(scene.tilt))] if scene.tilt != 0
+                                 else []), axis=1)
     table = np.empty((scenes, kernels.TABLE_WIDTH))
     kernels.fill_table(fields, np.ascontiguousarray(index.reshape(-1), dtype=np.intp), table)
     return table, geometry

@@ -101,8 +101,11 @@ def _signature(kind, dtype):
     if kind == "geometry":
         return types.void(table, table, ints, geo, i8, i8, i8, i8, b1, a3, a3,
                           types.Array(types.float64, 1, "C"))
-    return types.void(table, table, ints, ins, a3, c3, c3, a3, a3, a3, i8, i8, i8, i8, b1, b1,
-                      a3, a3, a3, a3, a4, a3)
+    wind = (table, table, ints, ins, a3, c3, c3, a3, a3, a3, i8, i8, i8, i8, b1, b1,
+            a3, a3, a3, a3, a4, a3)
+    if kind == "wind_mounted":              # and the shear exponent
+        return types.void(*wind, a3)
+    return types.void(*wind)
 
 
 @_helper
@@ -251,15 +254,44 @@ def _angle_block(error, s, t0, count, base, cos_base, sin_base, out, row):
 
 
 def geometry(table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams, ratio, shear):
+    """:func:`_geometry` of an upward lidar (beams on the cone about the deck's vertical)."""
+    _geometry(table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams, ratio, shear,
+              False)
+
+
+def geometry_mounted(table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams, ratio,
+                     shear):
+    """:func:`_geometry` of a tilted mount (beams at clock positions about the boresight)."""
+    _geometry(table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams, ratio, shear,
+              True)
+
+
+@_helper
+def _mounted_beam(cos_cone, sin_cone, cos_m, sin_m, cos_clock, sin_clock, cos_tilt,
+                  sin_tilt):
+    """Ship-frame beam of a tilted mount (:func:`uq.physics.beams.mounted_unit_vectors`):
+    ``Rz(m) [cos(a) d + sin(a) (cos(phi) e_up + sin(phi) e_starboard)]`` with the
+    boresight d = (sin tau, 0, cos tau) and e_up = (-cos tau, 0, sin tau)."""
+    bow = cos_cone * sin_tilt - sin_cone * cos_clock * cos_tilt
+    starboard = sin_cone * sin_clock
+    up = cos_cone * cos_tilt + sin_cone * cos_clock * sin_tilt
+    return cos_m * bow - sin_m * starboard, sin_m * bow + cos_m * starboard, up
+
+
+@_helper
+def _geometry(table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams, ratio, shear,
+              mounted):
     """True earth-frame beams into beams[row] (b, 3), z / z_ref of their gates into
     ratio[row] (b, g) and the scene's shear exponent into shear[row]; NaN at a height
     <= 0 (outside the power law). Rows: with `per_trial`, (s - s0) (t1 - t0) + (i - t0)
     for the trials of the rectangle; else one row per scene, s - s0, with the errors of
     trial t0 (constant over trials). Without shear the ratio is not needed: 1 (or NaN).
+    `mounted` (a constant of each kernel): the beams of a tilted mount, whose mount's
+    (cos, sin) of the tilt follow the geometry row (:func:`_geometry_offsets`).
     """
     n_slanted, n_gates = structure[0], structure[2]
     n_beams = n_slanted + structure[1]
-    _, slant, _, _ = _geometry_offsets(n_slanted, n_beams, n_gates)
+    _, slant, _, row_end = _geometry_offsets(n_slanted, n_beams, n_gates)
     count = t1 - t0 if per_trial else 1
     zero = np.zeros(1, beams.dtype)[0]            # 0 of the number type (not 0 x data)
     trig = np.full((4, count), zero)              # cos, sin of half-cone, misalignment
@@ -278,7 +310,11 @@ def geometry(table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams, ra
             cos_t, sin_t, cos_m, sin_m = trig[0, j], trig[1, j], trig[2, j], trig[3, j]
             base = table[s, _LIDAR_HEIGHT] + _pick(height_error, t0 + j, s, 0)
             for b in range(n_beams):
-                if b < n_slanted:
+                if mounted:
+                    x, y, z = _mounted_beam(cos_t, sin_t, cos_m, sin_m, shapes[shape, b],
+                                            shapes[shape, n_slanted + b],
+                                            shapes[shape, row_end], shapes[shape, row_end + 1])
+                elif b < n_slanted:
                     cos_a, sin_a = shapes[shape, b], shapes[shape, n_slanted + b]
                     x = sin_t * (cos_m * cos_a - sin_m * sin_a)       # sin t cos(m + a)
                     y = sin_t * (sin_m * cos_a + cos_m * sin_a)       # sin t sin(m + a)
@@ -635,11 +671,282 @@ def wind_pointwise(table, shapes, structure, ins, noise, cos_trig, sin_trig, bea
           radial, gate_height, True)
 
 
+#: The structure vector of a tilted mount's kernels: STRUCTURE, then whether the shear
+#: exponent is wanted and the beam indices of the level pair (clock 90 and 270) and of
+#: the upper and lower beams (-1: none; :mod:`uq.physics.nacelle`).
+MOUNTED_STRUCTURE = STRUCTURE + ("want_shear", "level_first", "level_second", "upper",
+                                 "lower")
+
+
+@_helper
+def _inverse2(a00, a01, a10, a11):
+    """The inverse of the 2 x 2 matrix ``[[a00, a01], [a10, a11]]`` (Cramer's rule: one
+    division; the systems solved here, the level beams' horizontal parts and the 2-beam
+    normal equations, have condition numbers of ~cot(half-cone) and its square, so the
+    solution is within ~1e-14 relative of LAPACK's pivoted elimination)."""
+    scale = 1.0 / (a00 * a11 - a01 * a10)
+    return a11 * scale, -a01 * scale, -a10 * scale, a00 * scale
+
+
+@_helper
+def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile,
+                  height_error, s0, s1, t0, t1, per_scene, per_trial, speed, vertical,
+                  from_north, from_east, radial, gate_height, shear_out, pointwise):
+    """:func:`_wind` of a tilted (nacelle) mount (:mod:`uq.physics.nacelle`), with the
+    structure of :data:`MOUNTED_STRUCTURE` and the shear exponent into shear_out (S, g, n).
+
+    Each beam's believed earth-frame beam (the reading of the scan, or its own) and the
+    corrected radial velocity ``c_k = v_k + b_k . s`` (s: the ship velocity the model
+    removes). 2 beams: the horizontal least squares of ``b_k,h . u_h = c_k``, w = 0
+    assumed. 3 or more: the wind of :func:`_wind` (Eq. 13 of [1] on the configured beams'
+    A^+ v, or the point-wise least squares [2]), then with the level pair the hub-height
+    horizontal wind ``b_k,h . u_h = c_k - b_k,up w`` of those two beams. The shear
+    exponent ``ln(U_up / U_down) / ln(z_up / z_down)``, ``U_k = c_k / (b_k,h . e)`` at the
+    believed heights ``z_k = lidar height + slant b_k,up`` (NaN where a ratio is not
+    positive). A scan-wise reading is the point-wise code with one reading for all beams.
+    """
+    n_beams, n_gates, model = structure[0], structure[2], structure[3]
+    if model != NONE and model != YAW and model != TILT2D and model != FULL:
+        raise ValueError("unknown correction model code (see uq.physics.modelinputs)")
+    want_speed, want_direction, want_vertical = structure[4], structure[5], structure[6]
+    want_radial, want_height, want_shear = structure[7], structure[8], structure[9]
+    level_a, level_b, upper, lower = structure[10], structure[11], structure[12], structure[13]
+    at_operator, at_slant, at_units, _ = _geometry_offsets(n_beams, n_beams, n_gates)
+    heading_error, pitch_error, roll_error = ins[0], ins[1], ins[2]
+    sog_error, cog_error, heave_error = ins[3], ins[4], ins[5]
+    has_noise = noise.shape[2] > 1
+    zero = np.zeros(1, beams.dtype)[0]
+    truth = np.full((n_beams, n_gates), zero)
+    heights = np.full(n_gates, zero)
+    count = t1 - t0
+    cos_read = np.full((4, n_beams, count), zero)
+    sin_read = np.full((4, n_beams, count), zero)
+    base = np.empty(4)
+    operator = np.empty((3, n_beams))
+    units = np.empty((n_beams, 3))
+    normal = np.full((n_beams, 3), zero)             # believed earth-frame beams
+    along = np.full(n_beams, zero)                   # ... the removed velocity along them
+    corrected = np.full(n_beams, zero)               # c_k of one gate
+    mean = np.full(6, zero)
+    matrix = np.full((3, 3), zero)
+    rhs = np.full(3, zero)
+    one = zero + 1.0
+    rot = _rotation(FULL, one, zero, one, zero, one, zero, 1.0, 0.0)
+    mean_rot = rot
+    mean_ship = (zero, zero)
+    ship = (zero, zero, zero)
+    inverse = (zero, zero, zero, zero)
+    lidar_frame = n_beams > 2 and not pointwise        # the scan's A^+ v: its rows needed
+    lidar_horizontal = lidar_frame and (model == FULL or level_a < 0)
+    for s in range(s0, s1):
+        speed_ref, w = table[s, _SPEED], table[s, _VERTICAL]
+        to_north = -table[s, _COS + _T_DIRECTION]       # wind "from": it blows to -e
+        to_east = -table[s, _SIN + _T_DIRECTION]
+        sog0, cog0, heave0 = table[s, _SOG], table[s, _COG], table[s, _HEAVE]
+        true_ship = (sog0 * table[s, _COS + _T_COG], sog0 * table[s, _SIN + _T_COG], heave0)
+        cos_nominal, sin_nominal = table[s, _COS + _T_HEADING], table[s, _SIN + _T_HEADING]
+        lidar_height = table[s, _LIDAR_HEIGHT]
+        shape = int(table[s, _GEOMETRY_ROW])
+        for b in range(n_beams):
+            for k in range(3):
+                operator[k, b] = shapes[shape, at_operator + k * n_beams + b]
+                units[b, k] = shapes[shape, at_units + 3 * b + k]
+        base[0], base[1], base[2], base[3] = table[s, _HEADING], table[s, _PITCH], \
+            table[s, _ROLL], cog0
+        tr0 = (s - s0) * count if per_scene else 0
+        _readings(heading_error, 0, base[0], cos_nominal, sin_nominal, s, t0, count, tr0,
+                  cos_trig, sin_trig, cos_read, sin_read)
+        _readings(pitch_error, 1, base[1], table[s, _COS + _T_PITCH],
+                  table[s, _SIN + _T_PITCH], s, t0, count, tr0, cos_trig, sin_trig,
+                  cos_read, sin_read)
+        _readings(roll_error, 2, base[2], table[s, _COS + _T_ROLL], table[s, _SIN + _T_ROLL],
+                  s, t0, count, tr0, cos_trig, sin_trig, cos_read, sin_read)
+        _readings(cog_error, 3, cog0, table[s, _COS + _T_COG], table[s, _SIN + _T_COG], s,
+                  t0, count, tr0, cos_trig, sin_trig, cos_read, sin_read)
+        if not per_trial:
+            _true_radials(beams, profile, s, speed_ref, w, to_north, to_east, true_ship,
+                          n_beams, n_gates, truth)
+            if want_height:
+                _gate_heights(table, s, shapes, shape, beams, s, _pick(height_error, t0, s, 0),
+                              n_beams, n_gates, at_slant, heights)
+        noise_s = s if noise.shape[1] > 1 else 0
+        for i in range(t0, t1):
+            j = i - t0
+            noise_i = i if noise.shape[0] > 1 else 0
+            if per_trial:
+                r = (s - s0) * count + j
+                _true_radials(beams, profile, r, speed_ref, w, to_north, to_east, true_ship,
+                              n_beams, n_gates, truth)
+                if want_height:
+                    _gate_heights(table, s, shapes, shape, beams, r,
+                                  _pick(height_error, i, s, 0), n_beams, n_gates, at_slant,
+                                  heights)
+            if want_height:
+                for g in range(n_gates):
+                    gate_height[s, g, i] = heights[g]
+            # the believed beams and the velocity removed along them (each beam's own
+            # reading; a scan's reading is the same for every beam: k = 1, computed for
+            # the first beam; none's: the configured heading, the scene's first trial's)
+            for b in range(n_beams):
+                if (model == NONE and i > t0) or (b > 0 and not pointwise):
+                    pass                        # the same rotation and ship velocity
+                elif model == NONE:
+                    rot = _rotation(NONE, one, zero, one, zero, one, zero, cos_nominal,
+                                    sin_nominal)
+                    ship = (zero, zero, zero)
+                else:
+                    kh = b if heading_error.shape[2] > 1 else 0
+                    kp = b if pitch_error.shape[2] > 1 else 0
+                    kr = b if roll_error.shape[2] > 1 else 0
+                    rot = _rotation(model, cos_read[0, kh, j], sin_read[0, kh, j],
+                                    cos_read[1, kp, j], sin_read[1, kp, j], cos_read[2, kr, j],
+                                    sin_read[2, kr, j], cos_nominal, sin_nominal)
+                    kc = b if cog_error.shape[2] > 1 else 0
+                    sog = sog0 + _pick(sog_error, i, s, b)
+                    ship = (sog * cos_read[3, kc, j], sog * sin_read[3, kc, j],
+                            heave0 + _pick(heave_error, i, s, b) if model == FULL else zero)
+                if model == NONE and i > t0:
+                    continue                    # none's believed beams: the scene's
+                for k in range(3):
+                    normal[b, k] = rot[3 * k] * units[b, 0] + rot[3 * k + 1] * units[b, 1] \
+                        + rot[3 * k + 2] * units[b, 2]
+                along[b] = normal[b, 0] * ship[0] + normal[b, 1] * ship[1] + \
+                    normal[b, 2] * ship[2]
+            if not (model == NONE and i > t0):  # the 2 x 2 inverses of the believed beams
+                if n_beams == 2:                # the horizontal normal equations
+                    h00 = normal[0, 0] * normal[0, 0] + normal[1, 0] * normal[1, 0]
+                    h01 = normal[0, 0] * normal[0, 1] + normal[1, 0] * normal[1, 1]
+                    h11 = normal[0, 1] * normal[0, 1] + normal[1, 1] * normal[1, 1]
+                    inverse = _inverse2(h00, h01, h01, h11)
+                elif level_a >= 0:              # the level pair's horizontal parts
+                    inverse = _inverse2(normal[level_a, 0], normal[level_a, 1],
+                                        normal[level_b, 0], normal[level_b, 1])
+            if pointwise and model == TILT2D and n_beams > 2:   # the mean reading, Eq. 13 [1]
+                mean[0] = _mean_reading(heading_error, base[0], i, s, zero)
+                mean[1] = _mean_reading(pitch_error, base[1], i, s, zero)
+                mean[2] = _mean_reading(roll_error, base[2], i, s, zero)
+                mean[3] = _mean_reading(cog_error, base[3], i, s, zero)
+                total = zero
+                for k in range(sog_error.shape[2]):
+                    total += sog0 + _pick(sog_error, i, s, k)
+                mean[4] = total / sog_error.shape[2]
+                mean_rot = _rotation(FULL, np.cos(mean[0]), np.sin(mean[0]), np.cos(mean[1]),
+                                     np.sin(mean[1]), np.cos(mean[2]), np.sin(mean[2]),
+                                     cos_nominal, sin_nominal)
+                mean_ship = (mean[4] * np.cos(mean[3]), mean[4] * np.sin(mean[3]))
+            for g in range(n_gates):
+                x = y = z = zero
+                for b in range(n_beams):
+                    measured = truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] \
+                        if has_noise else truth[b, g]
+                    corrected[b] = measured + along[b]
+                    if want_radial:
+                        radial[s, b, g, i] = corrected[b]
+                    if lidar_frame:                       # A^+ v (Eq. 13 [1])
+                        z += operator[2, b] * measured
+                        if lidar_horizontal:
+                            x += operator[0, b] * measured
+                            y += operator[1, b] * measured
+                if n_beams == 2:                # w = 0: the horizontal least squares
+                    r0 = normal[0, 0] * corrected[0] + normal[1, 0] * corrected[1]
+                    r1 = normal[0, 1] * corrected[0] + normal[1, 1] * corrected[1]
+                    north = inverse[0] * r0 + inverse[1] * r1
+                    east = inverse[2] * r0 + inverse[3] * r1
+                    up = zero
+                elif not pointwise:             # Eq. 13 [1] with the scan's reading
+                    up = rot[6] * x + rot[7] * y + rot[8] * z + ship[2] if model == FULL \
+                        else z
+                    north = east = zero
+                    if level_a < 0:             # (else the level pair's, below)
+                        north = rot[0] * x + rot[1] * y + ship[0]
+                        east = rot[3] * x + rot[4] * y + ship[1]
+                        if model == FULL:
+                            north += rot[2] * z
+                            east += rot[5] * z
+                else:                           # point-wise least squares [2]
+                    for k in range(3):
+                        total = zero
+                        for b in range(n_beams):
+                            total += normal[b, k] * corrected[b]
+                        rhs[k] = total
+                        for m in range(3):
+                            total = zero
+                            for b in range(n_beams):
+                                total += normal[b, k] * normal[b, m]
+                            matrix[k, m] = total
+                    _solve3(matrix, rhs)
+                    north, east, up = rhs[0], rhs[1], rhs[2]
+                    if model == TILT2D:
+                        d0, d1, d2 = north - mean_ship[0], east - mean_ship[1], up
+                        x = mean_rot[0] * d0 + mean_rot[3] * d1 + mean_rot[6] * d2
+                        y = mean_rot[1] * d0 + mean_rot[4] * d1 + mean_rot[7] * d2
+                        up = mean_rot[2] * d0 + mean_rot[5] * d1 + mean_rot[8] * d2
+                        north = mean_rot[0] * x + mean_rot[1] * y + mean_ship[0]
+                        east = mean_rot[3] * x + mean_rot[4] * y + mean_ship[1]
+                if level_a >= 0:                # the hub-height wind of the level beams
+                    r0 = corrected[level_a] - normal[level_a, 2] * up
+                    r1 = corrected[level_b] - normal[level_b, 2] * up
+                    north = inverse[0] * r0 + inverse[1] * r1
+                    east = inverse[2] * r0 + inverse[3] * r1
+                if want_speed:
+                    speed[s, g, i] = _hypot(north, east)
+                if want_vertical:
+                    vertical[s, g, i] = up
+                if want_direction:
+                    from_north[s, g, i], from_east[s, g, i] = -north, -east
+                if want_shear:
+                    shear_out[s, g, i] = _shear_exponent(
+                        north, east, normal, corrected, lidar_height,
+                        shapes[shape, at_slant + upper * n_gates + g],
+                        shapes[shape, at_slant + lower * n_gates + g], upper, lower)
+
+
+@_helper
+def _shear_exponent(north, east, normal, corrected, lidar_height, slant_upper, slant_lower,
+                    upper, lower):
+    """``ln(U_up / U_down) / ln(z_up / z_down)`` with ``U_k = c_k / (b_k,h . e)`` and the
+    believed heights ``z_k`` (:func:`uq.physics.nacelle.shear_exponent`); NaN where a
+    ratio is not positive."""
+    speed = np.sqrt(north * north + east * east)
+    along_upper = (normal[upper, 0] * north + normal[upper, 1] * east) / speed
+    along_lower = (normal[lower, 0] * north + normal[lower, 1] * east) / speed
+    ratio_speed = (corrected[upper] / along_upper) / (corrected[lower] / along_lower)
+    ratio_height = (lidar_height + slant_upper * normal[upper, 2]) / \
+        (lidar_height + slant_lower * normal[lower, 2])
+    if ratio_speed.real > 0 and ratio_height.real > 0:
+        return np.log(ratio_speed) / np.log(ratio_height)
+    return np.nan + 0 * ratio_speed
+
+
+def wind_mounted_scan(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams,
+                      profile, height_error, s0, s1, t0, t1, per_scene, per_trial, speed,
+                      vertical, from_north, from_east, radial, gate_height, shear_out):
+    """:func:`_wind_mounted` with one INS reading per scan."""
+    _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile,
+                  height_error, s0, s1, t0, t1, per_scene, per_trial, speed, vertical,
+                  from_north, from_east, radial, gate_height, shear_out, False)
+
+
+def wind_mounted_pointwise(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams,
+                           profile, height_error, s0, s1, t0, t1, per_scene, per_trial, speed,
+                           vertical, from_north, from_east, radial, gate_height, shear_out):
+    """:func:`_wind_mounted` with a reading per beam (point-wise)."""
+    _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile,
+                  height_error, s0, s1, t0, t1, per_scene, per_trial, speed, vertical,
+                  from_north, from_east, radial, gate_height, shear_out, True)
+
+
 #: The kernels, each with its kind of signature.
 _KERNELS = {"ins_trig": (ins_trig, "trig"), "geometry": (geometry, "geometry"),
-            "wind_scan": (wind_scan, "wind"), "wind_pointwise": (wind_pointwise, "wind")}
+            "wind_scan": (wind_scan, "wind"), "wind_pointwise": (wind_pointwise, "wind"),
+            "geometry_mounted": (geometry_mounted, "geometry"),
+            "wind_mounted_scan": (wind_mounted_scan, "wind_mounted"),
+            "wind_mounted_pointwise": (wind_mounted_pointwise, "wind_mounted")}
 #: The kernels' names (each compiled for float64 and complex128 by :func:`compiled`).
 KERNEL_NAMES = tuple(_KERNELS)
+#: Those of a tilted mount, which runs them in float64 alone (its complex step, the
+#: GUM, is the numpy model's: :func:`uq.physics.fused.declined`).
+MOUNTED_KERNEL_NAMES = ("geometry_mounted", "wind_mounted_scan", "wind_mounted_pointwise")
 
 
 @functools.cache

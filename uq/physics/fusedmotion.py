@@ -42,9 +42,10 @@ from uq.physics import probe as probe_volume
 from uq.physics.beams import least_squares_operator, slant_distances
 from uq.physics import modelinputs
 from uq.physics.modelinputs import MOTION_COMPILED, Correction
+from uq.physics import nacelle
 from uq.physics.motion import DEGREES_OF_FREEDOM
 from uq.physics.rotation import rotation_about_vertical, rotation_pitch, rotation_roll
-from uq.physics.scene import SCENE_FIELDS, sample_count
+from uq.physics.scene import NACELLE_OUTPUTS, SCENE_FIELDS, sample_count
 from uq.physics.timing import dwell_frequency
 
 #: Outputs the compiled model computes; any other requested output uses the numpy model.
@@ -73,10 +74,13 @@ def declined(scene, outputs, errors, scene_draws=False):
     """Why the compiled model does not take this call, in words ('' where it does)."""
     if scene.time_resolved is None:
         return "a static scene"
-    if scene.tilt != 0:
-        return "a tilted mount (lidar.mount.tilt): the numpy model's clock-position beams"
-    if not set(outputs) <= set(FUSED_OUTPUTS):
-        return f"output(s) {', '.join(sorted(set(outputs) - set(FUSED_OUTPUTS)))}"
+    allowed = set(FUSED_OUTPUTS) | (set(NACELLE_OUTPUTS) if scene.tilt != 0 else set())
+    if not set(outputs) <= allowed:
+        return f"output(s) {', '.join(sorted(set(outputs) - allowed))}"
+    if scene.horizontal_only and scene.correction == "tilt2d":
+        return "tilt2d on two beams of a tilted mount (a 3-D correction)"
+    if "shear_exponent" in outputs and nacelle.upper_lower(scene.azimuths) is None:
+        return "shear_exponent without an upper and a lower beam"
     lacked = modelinputs.lacks(MOTION_COMPILED, errors)
     if lacked:
         return f"input(s) {', '.join(lacked)}"
@@ -106,14 +110,27 @@ def measurement_model(scene, outputs, scene_draws=False, **errors):
         scene = probe_volume.resolve(scene)
     shape, gates = scene.shape, len(scene.ranges)
     n = sample_count(errors)
-    result = {q: np.empty((n,) + shape + (gates,)) for q in FUSED_OUTPUTS if q in outputs}
+    result = {q: np.empty((n,) + shape + (gates,)) for q in FUSED_OUTPUTS + NACELLE_OUTPUTS
+              if q in outputs}
     for index in np.ndindex(*shape):
         mine = errors if not scene_draws else {
             name: value[(slice(None),) + index] if np.ndim(value) > 1 else value
             for name, value in errors.items()}
         into = {q: result[q][(slice(None),) + index] for q in result}      # (n, gates) views
-        _evaluate(scene_plan(_scene_at(scene, index)), mine, n, into, scene.probe)
+        _evaluate(scene_plan(_scene_at(scene, index)), mine, n, into, scene.probe,
+                  _mounted_layout(scene, outputs))
     return result
+
+
+def _mounted_layout(scene, outputs):
+    """The layout vector of a tilted mount (:data:`~uq.physics.fusedmotionkernels.
+    MOUNTED_LAYOUT`), None for an upward lidar."""
+    if scene.tilt == 0:
+        return None
+    pair = None if scene.horizontal_only else nacelle.level_pair(scene.azimuths)
+    upper_lower = nacelle.upper_lower(scene.azimuths) if "shear_exponent" in outputs else None
+    return np.array([*(pair or (-1, -1)), *(upper_lower or (-1, -1)),
+                     int("shear_exponent" in outputs)], dtype=np.int64)
 
 
 def _scene_at(scene, index):
@@ -240,7 +257,9 @@ def _scene_plan(scene):
             "course_cos": math.cos(scene.cog), "course_sin": math.sin(scene.cog),
             "arm_bow": arm[0], "arm_starboard": arm[1], "arm_up": arm[2],
             "static_arm_up": static[2], "moves_yaw": moves[2],
-            "has_arm": bool(np.any(arm != 0)), "probe": scene.probe is not None}
+            "has_arm": bool(np.any(arm != 0)), "probe": scene.probe is not None,
+            "mounted": scene.tilt != 0, "tilt_cos": math.cos(scene.tilt),
+            "tilt_sin": math.sin(scene.tilt)}
     consts = np.array([head[name] if name in head else getattr(scene, name)
                        for name in kernels.HEAD], dtype=float)
     return Plan(consts=consts, pairs=np.array(pairs, dtype=np.int64).reshape(-1, 2),
@@ -250,7 +269,8 @@ def _scene_plan(scene):
                 azimuths=np.ascontiguousarray(np.stack([np.cos(azimuths), np.sin(azimuths)],
                                                        axis=-1).reshape(-1, 2)),
                 beams=np.ascontiguousarray(beams),
-                operator=np.ascontiguousarray(least_squares_operator(beams)),
+                operator=np.zeros((3, n_beams)) if scene.horizontal_only   # (w = 0)
+                else np.ascontiguousarray(least_squares_operator(beams)),
                 slant=np.ascontiguousarray(slant_distances(
                     scene.ranges, scene.half_cone, len(azimuths), scene.vertical_beam)),
                 n_phases=n_phases, n_window=n_window,
@@ -268,16 +288,23 @@ def block_trials(plan, probe_nodes=0):
     nodes = plan.node_table.shape[2]
     per_trial = (kernels.WORK_ROWS + beams * (kernels.STATE_ROWS + 3)
                  + nodes * (gates * (1 + 2 * probe_nodes) + 2) + 6 + 8 * gates
-                 + 4 * max(1, len(plan.components)))
+                 + 4 * max(1, len(plan.components))
+                 + (5 * beams + beams * gates if plan.consts[kernels.HEAD.index("mounted")]
+                    else 0))                # a tilted mount's kept readings
     low, high = MOTION_BLOCK_TRIALS
     size = 2 ** int(math.floor(math.log2(max(1, MOTION_BLOCK_VALUES // per_trial))))
     return int(np.clip(size, low, high))
 
 
-def _evaluate(plan, errors, n, into, probe=None):
+def _evaluate(plan, errors, n, into, probe=None, layout=None):
     """The outputs of one scene into `into` (name -> (n, gates) view), block by block
-    (with a `probe` volume: its weighted speed, :mod:`uq.physics.fusedprobe`)."""
+    (with a `probe` volume: its weighted speed, :mod:`uq.physics.fusedprobe`; a tilted
+    mount's `layout`: its reconstruction, :func:`~uq.physics.fusedmotionkernels.
+    mounted_wind`)."""
     consts = plan.consts
+    if layout is not None and layout[-1]:   # the shear exponent: the believed lift too
+        consts = consts.copy()
+        consts[kernels.HEAD.index("mounted")] = 2.0
     n_beams, n_gates = plan.slant.shape
     n_nodes = len(plan.weights)
     ins = tuple(_ins_input(errors.get(name), n) for name in kernels.INPUTS)
@@ -299,7 +326,9 @@ def _evaluate(plan, errors, n, into, probe=None):
     ship_beams = np.empty((n_beams, 3, m))
     parts = np.empty((2, n_beams * n_nodes, m))
     ratio = np.empty((n_beams * n_nodes, n_gates, m))
-    normal = np.empty((6 + 3 * n_gates, m))
+    normal = np.empty((6 + 3 * n_gates + (0 if layout is None else
+                                          5 * n_beams + n_beams * n_gates), m))
+    shear_out = np.empty((n_gates, m)) if layout is not None and layout[-1] else None
     out = np.empty((3, n_gates, m))
     speed, vertical = np.empty((n_gates, m)), np.empty((n_gates, m))
     shear = consts[kernels.HEAD.index("shear")]
@@ -326,15 +355,25 @@ def _evaluate(plan, errors, n, into, probe=None):
                             plan.read_table, plan.stamps, plan.beams, plan.operator,
                             plan.weights, ins, has, noise, start, count, work, c, turned,
                             states, parts, ratio, normal, out)
+        if layout is not None:                      # a tilted mount's reconstruction
+            kernels.compiled_mounted_wind()(consts, layout, plan.beams, plan.slant, work,
+                                            normal, count, out,
+                                            shear_out if shear_out is not None else speed)
         kernels.wind_speed(out, count, speed, vertical)
         stop = start + count
         if "wind_speed" in into:
             into["wind_speed"][start:stop] = speed[:, :count].T
         if "vertical_wind" in into:
             into["vertical_wind"][start:stop] = vertical[:, :count].T
-        if "wind_direction" in into:
-            into["wind_direction"][start:stop] = _direction(out[0, :, :count],
-                                                            out[1, :, :count]).T
+        if "wind_direction" in into or "yaw_misalignment" in into:
+            direction = _direction(out[0, :, :count], out[1, :, :count]).T
+            if "wind_direction" in into:
+                into["wind_direction"][start:stop] = direction
+            if "yaw_misalignment" in into:          # from the rotor axis, the heading
+                into["yaw_misalignment"][start:stop] = nacelle.yaw_misalignment(
+                    direction, consts[kernels.HEAD.index("heading")])
+        if shear_out is not None and "shear_exponent" in into:
+            into["shear_exponent"][start:stop] = shear_out[:, :count].T
 
 
 def _probe_profile(probe, errors, start, count, ratio, beam_up, focus, item_focus,

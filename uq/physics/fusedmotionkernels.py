@@ -42,6 +42,7 @@ References
 .. [3] Matavar, A. (2024). Wind field reconstruction from floating lidars. MSc thesis,
    TU Delft, Sec. 3.2 (point-wise correction).
 """
+import functools
 import math
 
 import numpy as np
@@ -71,12 +72,13 @@ HEAD = ("n_beams", "n_gates", "n_nodes", "n_slanted", "model", "ins_mode", "rate
         "heading", "pitch", "roll", "lidar_height", "wind_speed", "reference_height", "shear",
         "to_north", "to_east", "vertical_wind", "ship_north", "ship_east", "ship_up",
         "level_cos", "level_sin", "course_cos", "course_sin", "arm_bow", "arm_starboard",
-        "arm_up", "static_arm_up", "half_cone", "misalignment", "moves_yaw", "has_arm", "probe")
+        "arm_up", "static_arm_up", "half_cone", "misalignment", "moves_yaw", "has_arm", "probe",
+        "mounted", "tilt_cos", "tilt_sin")
 (_N_BEAMS, _N_GATES, _N_NODES, _N_SLANTED, _MODEL, _INS_MODE, _RATE, _HEADING, _PITCH, _ROLL,
  _LIDAR_HEIGHT, _WIND_SPEED, _REFERENCE_HEIGHT, _SHEAR, _TO_NORTH, _TO_EAST, _VERTICAL_WIND,
  _SHIP_NORTH, _SHIP_EAST, _SHIP_UP, _LEVEL_COS, _LEVEL_SIN, _COURSE_COS, _COURSE_SIN,
  _ARM_BOW, _ARM_STARBOARD, _ARM_UP, _STATIC_ARM_UP, _HALF_CONE, _MISALIGNMENT, _MOVES_YAW,
- _HAS_ARM, _PROBE) = range(len(HEAD))
+ _HAS_ARM, _PROBE, _MOUNTED, _TILT_COS, _TILT_SIN) = range(len(HEAD))
 
 #: Correction models: the codes NONE ... POINTWISE of
 #: :class:`uq.physics.modelinputs.Correction` (:mod:`uq.physics.kernelbase`); INS modes.
@@ -132,7 +134,7 @@ def _kernel(signature):
 def _head(consts):
     """The scalars of :data:`HEAD` as a tuple: values, not memory, so that loops reading
     them need no alias checks against the arrays they write."""
-    return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31], consts[32])
+    return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31], consts[32], consts[33], consts[34], consts[35])
 
 
 @_called
@@ -288,7 +290,9 @@ def _geometry(consts, azimuths, beams, cone_error, misalignment_error, height_er
         _geometry_angle(consts[_HALF_CONE], cone_error, start, count, work, _CONE)
         _geometry_angle(consts[_MISALIGNMENT], misalignment_error, start, count, work, _MIS)
         for b in range(n_beams):
-            if b < n_slanted:
+            if consts[_MOUNTED] > 0:         # clock positions about a tilted boresight
+                _mounted_beams(consts, azimuths, b, count, work, ship_beams)
+            elif b < n_slanted:
                 cos_a, sin_a = azimuths[b, 0], azimuths[b, 1]
                 for j in range(count):
                     sin_cone, cos_m, sin_m = work[_CONE + 1, j], work[_MIS, j], work[_MIS + 1, j]
@@ -302,6 +306,24 @@ def _geometry(consts, azimuths, beams, cone_error, misalignment_error, height_er
     height = consts[_LIDAR_HEIGHT]
     for j in range(count):
         work[_LIDAR_Z, j] = height + height_error[start + j if height_error.shape[0] > 1 else 0]
+
+
+@_helper
+def _mounted_beams(consts, azimuths, b, count, work, ship_beams):
+    """Beam b of a tilted mount in the ship frame, ship_beams[b] (3, trials), from the
+    cone's and misalignment's rows (:func:`uq.physics.beams.mounted_unit_vectors`):
+    ``Rz(m) [cos(a) d + sin(a) (cos(phi) e_up + sin(phi) e_starboard)]``, d = (sin tau, 0,
+    cos tau), e_up = (-cos tau, 0, sin tau)."""
+    cos_phi, sin_phi = azimuths[b, 0], azimuths[b, 1]
+    cos_t, sin_t = consts[_TILT_COS], consts[_TILT_SIN]
+    for j in range(count):
+        cos_a, sin_a = work[_CONE, j], work[_CONE + 1, j]
+        cos_m, sin_m = work[_MIS, j], work[_MIS + 1, j]
+        bow = cos_a * sin_t - sin_a * cos_phi * cos_t
+        starboard = sin_a * sin_phi
+        ship_beams[b, 0, j] = cos_m * bow - sin_m * starboard
+        ship_beams[b, 1, j] = sin_m * bow + cos_m * starboard
+        ship_beams[b, 2, j] = cos_a * cos_t + sin_a * cos_phi * sin_t
 
 
 @_helper
@@ -699,6 +721,21 @@ def _pointwise_at(head, state, work, nx, ny, nz, j, exact, heading_varies, sourc
 def _pointwise(consts, state, work, normal, nx, ny, nz, count, heading_varies, source):
     """:func:`_pointwise_at` for the block's trials (one SIMD loop per case, then libm
     where an angle is beyond the reduction), and ``B^T B`` accumulated."""
+    _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, source)
+    for j in range(count):
+        bx, by, bz = work[_BEAM, j], work[_BEAM + 1, j], work[_BEAM + 2, j]
+        normal[0, j] += bx * bx
+        normal[1, j] += bx * by
+        normal[2, j] += bx * bz
+        normal[3, j] += by * by
+        normal[4, j] += by * bz
+        normal[5, j] += bz * bz
+
+
+@_helper
+def _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, source):
+    """:func:`_pointwise_at` for the block's trials: the read rotation of (nx, ny, nz)
+    into rows _BEAM, the lidar velocity along it into _ALONG."""
     head = _head(consts)
     if source == FROM_ROWS:
         for j in range(count):
@@ -717,14 +754,26 @@ def _pointwise(consts, state, work, normal, nx, ny, nz, count, heading_varies, s
             if not work[_BIG, j] <= SINCOS_REDUCTION_LIMIT:
                 _pointwise_at(head, state, work, nx, ny, nz, j, True, heading_varies,
                               FROM_ANGLES)
-    for j in range(count):
-        bx, by, bz = work[_BEAM, j], work[_BEAM + 1, j], work[_BEAM + 2, j]
-        normal[0, j] += bx * bx
-        normal[1, j] += bx * by
-        normal[2, j] += bx * bz
-        normal[3, j] += by * by
-        normal[4, j] += by * bz
-        normal[5, j] += bz * bz
+
+
+@_helper
+def _store_reading(consts, state, work, normal, row, count, heading_varies, source):
+    """A point-wise reading of a tilted mount into normal[row ..]: the believed beam
+    (rows _BEAM), the velocity along it (_ALONG) and, for the shear exponent's believed
+    heights, the lidar's lift ``[(R_read - R_static) r]_up`` through the lever arm r
+    (:func:`uq.physics.timeresolved._lever_arm_lift`; 0 without one)."""
+    for i in range(3):
+        normal[row + i, :count] = work[_BEAM + i, :count]
+    normal[row + 3, :count] = work[_ALONG, :count]
+    normal[row + 4, :count] = 0.0
+    if consts[_HAS_ARM] > 0 and consts[_MOUNTED] > 1:   # (HEAD mounted 2: the shear's)
+        _pointwise_rows(consts, state, work, consts[_ARM_BOW], consts[_ARM_STARBOARD],
+                        consts[_ARM_UP], count, heading_varies, source)
+        for j in range(count):              # the reading's rotation of the arm
+            normal[row + 4, j] = work[_BEAM + 2, j] - consts[_STATIC_ARM_UP]
+        for i in range(3):                  # the beam's rows back for the least squares
+            work[_BEAM + i, :count] = normal[row + i, :count]
+        work[_ALONG, :count] = normal[row + 3, :count]
 
 
 @_helper
@@ -822,6 +871,10 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
             _read_rows(consts, states[0], work, count)
     normal[:, :count] = 0.0
     heading_varies = consts[_MOVES_YAW] > 0 or has[0]
+    # a tilted mount (rows of `normal` beyond the least squares'): its reconstruction
+    # (:func:`mounted_wind`) keeps each beam's measured radial velocity and, point-wise,
+    # its believed beam, the velocity along it and the lidar's believed lift
+    stored = 6 + 3 * n_gates if normal.shape[0] > 6 + 3 * n_gates else 0
     for b in range(n_beams):
         if model == POINTWISE:          # this beam's own reading: the beam and velocity it implies
             state = states[b if at_nodes else 0]
@@ -834,6 +887,9 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                 source = FROM_ROWS if written else FROM_ANGLES
             _pointwise(consts, state, work, normal, beams[b, 0], beams[b, 1], beams[b, 2],
                        count, heading_varies, source)
+            if stored:                  # a tilted mount's: the believed beam, the along
+                _store_reading(consts, state, work, normal, stored + 5 * b, count,
+                               heading_varies, source)
         beam = b if noise.shape[1] > 1 else 0
         for g in range(n_gates):
             work[_MEASURED, :count] = 0.0                # the dwell mean of the truth
@@ -849,6 +905,9 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
             else:
                 for j in range(count):
                     work[_MEASURED, j] += noise[0, beam, gate]
+            if stored:                  # a tilted mount's: the measured radial velocity
+                normal[stored + 5 * n_beams + b * n_gates + g, :count] = \
+                    work[_MEASURED, :count]
             if model == POINTWISE:
                 for j in range(count):
                     corrected = work[_MEASURED, j] + work[_ALONG, j]
@@ -880,3 +939,129 @@ def wind_speed(out, count, speed, vertical):
             radius = speed[g, j]
             if not HYPOT_SAFE_MIN < radius < HYPOT_SAFE_MAX:
                 speed[g, j] = math.hypot(out[0, g, j], out[1, g, j])
+
+
+#: The layout vector of :func:`mounted_wind` (int64): the level pair (clock 90 and 270),
+#: the upper and lower beams (-1: none; :mod:`uq.physics.nacelle`) and whether the
+#: shear exponent is wanted.
+MOUNTED_LAYOUT = ("level_first", "level_second", "upper", "lower", "want_shear")
+
+
+def mounted_wind(consts, layout, beams, slant, work, normal, count, out, shear):
+    """A tilted (nacelle) mount's wind of trials [0, count), after :func:`reconstruct`
+    (whose `normal` then holds the measured radial velocities and, point-wise, each
+    beam's believed beam, velocity along it and lift; its `work` the scan's reading).
+
+    Each beam's believed earth-frame beam ``b_k`` (the point-wise reading's, or the
+    scan's rotation of the configured beam as the correction model believes it) and
+    its corrected radial velocity ``c_k = v_k + b_k . s`` (s: the velocity the model
+    removes). 2 beams: the horizontal least squares ``b_k,h . u_h = c_k``, w = 0
+    assumed; with the level pair: the hub-height horizontal wind ``b_k,h . u_h = c_k -
+    b_k,up w`` with the w of `out` (:mod:`uq.physics.nacelle`); other layouts keep
+    `out`. Writes out[:, g, j] and, wanted, ``shear[g, j] = ln(U_up / U_down) / ln(z_up /
+    z_down)``, ``U_k = c_k / (b_k,h . e)`` at the believed heights ``z_k = lidar height +
+    lift_k + slant b_k,up`` (NaN where a ratio is not positive). Loops over the trials
+    innermost (SIMD); the 2 x 2 inverses in work's rows _MATRIX1 (free after
+    :func:`reconstruct`).
+    """
+    n_beams, n_gates, model = int(consts[_N_BEAMS]), int(consts[_N_GATES]), int(consts[_MODEL])
+    level_a, level_b, upper, lower = layout[0], layout[1], layout[2], layout[3]
+    stored = 6 + 3 * n_gates
+    measured = stored + 5 * n_beams
+    if model != POINTWISE:                  # the scan's reading (_scan_correction's rows)
+        full = model == FULL
+        for b in range(n_beams):
+            nx, ny, nz = beams[b, 0], beams[b, 1], beams[b, 2]
+            row = stored + 5 * b
+            for j in range(count):
+                bx, by, bz = rotate(work[_READ_TRIG, j], work[_READ_TRIG + 1, j],
+                                    work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j],
+                                    work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j],
+                                    nx, ny, nz)
+                vu = work[_READ_VELOCITY + 2, j] if full else 0.0
+                normal[row, j], normal[row + 1, j], normal[row + 2, j] = bx, by, bz
+                normal[row + 3, j] = bx * work[_READ_VELOCITY, j] + \
+                    by * work[_READ_VELOCITY + 1, j] + bz * vu
+                normal[row + 4, j] = 0.0
+    first = stored + 5 * (0 if n_beams == 2 else level_a)
+    second = stored + 5 * (1 if n_beams == 2 else level_b)
+    inverse = _MATRIX1
+    if n_beams == 2 or level_a >= 0:
+        for j in range(count):
+            n00, n01 = normal[first, j], normal[first + 1, j]
+            n10, n11 = normal[second, j], normal[second + 1, j]
+            if n_beams == 2:                # the horizontal normal equations
+                n00, n01, n10, n11 = (n00 * n00 + n10 * n10, n00 * n01 + n10 * n11,
+                                      n00 * n01 + n10 * n11, n01 * n01 + n11 * n11)
+            i00, i01, i10, i11 = _inverse2(n00, n01, n10, n11)
+            work[inverse, j], work[inverse + 1, j] = i00, i01
+            work[inverse + 2, j], work[inverse + 3, j] = i10, i11
+    m_first = measured + (0 if n_beams == 2 else level_a) * n_gates
+    m_second = measured + (1 if n_beams == 2 else level_b) * n_gates
+    for g in range(n_gates):
+        if n_beams == 2:
+            for j in range(count):
+                c0 = normal[m_first + g, j] + normal[first + 3, j]
+                c1 = normal[m_second + g, j] + normal[second + 3, j]
+                r0 = normal[first, j] * c0 + normal[second, j] * c1
+                r1 = normal[first + 1, j] * c0 + normal[second + 1, j] * c1
+                out[0, g, j] = work[inverse, j] * r0 + work[inverse + 1, j] * r1
+                out[1, g, j] = work[inverse + 2, j] * r0 + work[inverse + 3, j] * r1
+                out[2, g, j] = 0.0
+        elif level_a >= 0:
+            for j in range(count):
+                up = out[2, g, j]
+                r0 = (normal[m_first + g, j] + normal[first + 3, j]) - normal[first + 2, j] * up
+                r1 = (normal[m_second + g, j] + normal[second + 3, j]) - \
+                    normal[second + 2, j] * up
+                out[0, g, j] = work[inverse, j] * r0 + work[inverse + 1, j] * r1
+                out[1, g, j] = work[inverse + 2, j] * r0 + work[inverse + 3, j] * r1
+        if layout[4] > 0:
+            _shear_rows(consts, normal, stored, measured + upper * n_gates + g,
+                        measured + lower * n_gates + g, stored + 5 * upper,
+                        stored + 5 * lower, slant[upper, g], slant[lower, g], out, g, count,
+                        shear)
+
+
+@_helper
+def _shear_rows(consts, normal, stored, m_upper, m_lower, upper, lower, slant_upper,
+                slant_lower, out, g, count, shear):
+    """shear[g, :count] from the upper and lower beams' rows (:func:`mounted_wind`)."""
+    height = consts[_LIDAR_HEIGHT]
+    for j in range(count):
+        shear[g, j] = _shear_exponent(
+            out[0, g, j], out[1, g, j], normal[upper, j], normal[upper + 1, j],
+            normal[lower, j], normal[lower + 1, j],
+            normal[m_upper, j] + normal[upper + 3, j], normal[m_lower, j] + normal[lower + 3, j],
+            (height + normal[upper + 4, j]) + slant_upper * normal[upper + 2, j],
+            (height + normal[lower + 4, j]) + slant_lower * normal[lower + 2, j])
+
+
+@_called
+def _inverse2(a00, a01, a10, a11):
+    """The inverse of ``[[a00, a01], [a10, a11]]`` by Cramer's rule (the systems here are
+    well conditioned: ~cot(half-cone), :func:`uq.physics.fusedkernels._inverse2`)."""
+    scale = 1.0 / (a00 * a11 - a01 * a10)
+    return a11 * scale, -a01 * scale, -a10 * scale, a00 * scale
+
+
+@_called
+def _shear_exponent(north, east, upper_north, upper_east, lower_north, lower_east,
+                    c_upper, c_lower, z_upper, z_lower):
+    """``ln(U_up / U_down) / ln(z_up / z_down)``, ``U_k = c_k / (b_k,h . e)``; NaN where a
+    ratio is not positive (:func:`uq.physics.nacelle.shear_exponent`)."""
+    speed = math.sqrt(north * north + east * east)
+    along_upper = (upper_north * north + upper_east * east) / speed
+    along_lower = (lower_north * north + lower_east * east) / speed
+    ratio_speed = (c_upper / along_upper) / (c_lower / along_lower)
+    ratio_height = z_upper / z_lower
+    if ratio_speed > 0 and ratio_height > 0:
+        return math.log(ratio_speed) / math.log(ratio_height)
+    return math.nan
+
+
+@functools.cache
+def compiled_mounted_wind():
+    """:func:`mounted_wind` compiled on first use (a tilted mount's run alone pays it)."""
+    return _kernel(f"void({_CV}, int64[::1], {_CM}, {_CM}, {_CM}, {_CM}, int64, {_CT}, "
+                   f"{_CM})")(mounted_wind)
