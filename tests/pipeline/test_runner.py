@@ -367,8 +367,7 @@ def test_motion_ti_gum_is_nan_where_the_gum_is():
         "wind_speed_budget": (("scene", "range", "input"), [[[0.01, np.nan]], [[0.01, 0.04]]])},
         coords={"input": ["ins.heading", "motion (phases)"]})
     inputs = {"ins_heading": 0.0, "motion_phases": Input(UniformCircle(1.0), (1, 2))}
-    out = _motion_ti(None, {"sampling": {"method": "none"}}, inputs, None, dataset,
-                     compiled=True)
+    out = _motion_ti({"sampling": {"method": "none"}}, inputs, None, dataset)
     gum = out["wind_speed_motion_ti_gum"][1]
     assert np.isnan(gum[0, 0]) and gum[1, 0] == pytest.approx(0.2 / 8.0, rel=1e-15)
 

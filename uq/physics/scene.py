@@ -26,6 +26,10 @@ OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity", "
 NACELLE_OUTPUTS = ("yaw_misalignment", "shear_exponent")
 #: Every per-trial output a scenario may request.
 ALL_OUTPUTS = OUTPUTS + NACELLE_OUTPUTS
+#: The wind speed of a second evaluation with some inputs held (``held`` of
+#: :func:`uq.physics.measurement.measurement_model`): the same trials' speed with those
+#: inputs replaced, e.g. the motion alone (``wind_speed_motion_ti``) [m s-1].
+HELD_WIND_SPEED = "wind_speed_held"
 #: The outputs the compiled model (:mod:`uq.physics.fused`) computes: those of OUTPUTS.
 COMPILED_OUTPUTS = OUTPUTS
 #: What the INS reports with an error, and the angles among them (:mod:`uq.physics.modelinputs`).
