@@ -81,10 +81,19 @@ class UniformCircle:
         """Points from normal scores, shape (..., 2) -> (..., 2) (into `out`, which may
         be `scores`). ``|z|^2 = z1 z1 + z2 z2`` (one addition: what a sum over the last
         axis gives, without its strided reduction)."""
-        first, second = scores[..., 0], scores[..., 1]
-        norm = np.sqrt(first * first + second * second)
-        out = np.multiply(scores, self.radius, out=out)
-        out /= norm[..., None]
+        out = np.empty(scores.shape) if out is None else out
+        shape = (scores.shape[0] if scores.ndim > 1 else 1,
+                 int(np.prod(scores.shape[1:-1])), 2)       # (n, points, 2): views of both
+        points, into = scores.reshape(shape), out.reshape(shape)
+        if into.size and not np.shares_memory(into, out):
+            raise ValueError("out must take the shape (n, points, 2) without a copy")
+        for k in range(points.shape[1]):    # 1-D columns: numpy's fast strided loops
+            first, second = points[:, k, 0], points[:, k, 1]
+            norm = np.sqrt(first * first + second * second)
+            np.multiply(first, self.radius, out=into[:, k, 0])
+            into[:, k, 0] /= norm
+            np.multiply(second, self.radius, out=into[:, k, 1])
+            into[:, k, 1] /= norm
         return out
 
     def __repr__(self):
