@@ -342,21 +342,12 @@ def _evaluate(plan, errors, n, into, probe=None, held=None):
         focus, item_focus = fusedprobe.distinct_focus(np.repeat(plan.slant, n_nodes,
                                                                 axis=0).ravel())
         reference = np.array([consts[kernels.HEAD.index("reference_height")]])
-    # the kernels' arguments, gathered once (the loop's Python work is per block)
-    truth = (consts, plan.pairs, plan.amplitudes, plan.components, plan.sources, phases,
-             window, plan.node_table, plan.azimuths, plan.beams, plan.slant, *geometry)
-    truth_scratch = (work, c, states, ship_beams, parts, ratio, beam_up)
-    reading = (consts, plan.pairs, plan.amplitudes, plan.components, plan.read_table,
-               plan.stamps, plan.beams, plan.operator, plan.weights)
-    reading_scratch = (work, c, turned, states, parts, ratio, normal, out)
-    kinematics, reconstruct, wind_speed = kernels.kinematics, kernels.reconstruct, \
-        kernels.wind_speed
-    into_speed, into_vertical = into.get("wind_speed"), into.get("vertical_wind")
-    into_direction, into_held = into.get("wind_direction"), into.get(HELD_WIND_SPEED)
     for start in range(0, n, m):
         count = min(m, n - start)
-        stop = start + count
-        kinematics(*truth, start, count, *truth_scratch)
+        kernels.kinematics(consts, plan.pairs, plan.amplitudes, plan.components, plan.sources,
+                           phases, window, plan.node_table, plan.azimuths, plan.beams,
+                           plan.slant, *geometry, start, count, work, c, states, ship_beams,
+                           parts, ratio, beam_up)
         if probe is not None:                       # the weighted U / U_ref at each node
             _probe_profile(probe, errors, start, count, ratio, beam_up, focus, item_focus,
                            reference, shear)
@@ -365,18 +356,26 @@ def _evaluate(plan, errors, n, into, probe=None, held=None):
             np.log(block, out=block)
             block *= shear
             np.exp(block, out=block)
-        reconstruct(*reading, ins, has, noise, start, count, *reading_scratch)
-        wind_speed(out, count, speed, vertical)
-        if into_speed is not None:
-            into_speed[start:stop] = speed[:, :count].T
-        if into_vertical is not None:
-            into_vertical[start:stop] = vertical[:, :count].T
-        if into_direction is not None:
-            into_direction[start:stop] = _direction(out[0, :, :count], out[1, :, :count]).T
+        kernels.reconstruct(consts, plan.pairs, plan.amplitudes, plan.components,
+                            plan.read_table, plan.stamps, plan.beams, plan.operator,
+                            plan.weights, ins, has, noise, start, count, work, c, turned,
+                            states, parts, ratio, normal, out)
+        kernels.wind_speed(out, count, speed, vertical)
+        stop = start + count
+        if "wind_speed" in into:
+            into["wind_speed"][start:stop] = speed[:, :count].T
+        if "vertical_wind" in into:
+            into["vertical_wind"][start:stop] = vertical[:, :count].T
+        if "wind_direction" in into:
+            into["wind_direction"][start:stop] = _direction(out[0, :, :count],
+                                                            out[1, :, :count]).T
         if second is not None:             # the same truth, the held inputs' reading
-            reconstruct(*reading, *second, start, count, *reading_scratch)
-            wind_speed(out, count, speed, vertical)
-            into_held[start:stop] = speed[:, :count].T
+            kernels.reconstruct(consts, plan.pairs, plan.amplitudes, plan.components,
+                                plan.read_table, plan.stamps, plan.beams, plan.operator,
+                                plan.weights, *second, start, count, work, c, turned,
+                                states, parts, ratio, normal, out)
+            kernels.wind_speed(out, count, speed, vertical)
+            into[HELD_WIND_SPEED][start:stop] = speed[:, :count].T
 
 
 def _probe_profile(probe, errors, start, count, ratio, beam_up, focus, item_focus,
