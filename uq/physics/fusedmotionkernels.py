@@ -586,14 +586,14 @@ def _error_rows(errors, has, start, count, k, work):
 
 @_helper
 def _reading(consts, pairs, amplitudes, components, read_table, stamps, k, c, turned,
-             errors, has, start, count, state, work, trig_rows):
+             errors, has, start, count, state, work):
     """The INS reading of read point k (the beam k for ``pointwise``, else the scan's mid
     time) for trials [start, start + count), as :func:`uq.physics.timeresolved.ins_state`
     and its reading errors: the motion's values and rates there in `state` (rates
-    interpolated for ``linear``) and the errors in work's rows; the (cos, sin) of the read
-    attitude with its errors (rows _READ_TRIG) and the read velocity with its errors
-    (_READ_VELOCITY) where the point-wise loop does not compute them (`trig_rows`, and
-    always for ``linear``). Returns whether those rows were written."""
+    interpolated for ``linear``) and the errors in work's rows; for ``linear`` also the
+    (cos, sin) of the read attitude with its errors (rows _READ_TRIG) and the read velocity
+    with its errors (_READ_VELOCITY), which :func:`_read_rows` writes otherwise. Returns
+    whether those rows were written."""
     head = _head(consts)
     mode, rate, stamp = int(consts[_INS_MODE]), consts[_RATE], stamps[k]
     _error_rows(errors, has, start, count, k, work)
@@ -636,14 +636,19 @@ def _reading(consts, pairs, amplitudes, components, read_table, stamps, k, c, tu
                         ce, se = work[_COSINE, j], work[_SINE, j]
                         work[row, j], work[row + 1, j] = co * ce - si * se, si * ce + co * se
             return True
-    if not trig_rows:
-        return False
+    return False
+
+
+@_helper
+def _read_rows(consts, state, work, count):
+    """The (cos, sin) of a reading's attitude with its errors (rows _READ_TRIG) and its
+    velocity with its errors (_READ_VELOCITY), from the state :func:`_reading` left."""
+    head = _head(consts)
     _attitude_rows(consts, state, work, count, _READ_TRIG, True)
     for j in range(count):
         vn, ve, vu = _ins_velocity(head, state, j)
         work[_READ_VELOCITY, j], work[_READ_VELOCITY + 1, j], work[_READ_VELOCITY + 2, j] = \
             _velocity_errors(head, work, j, vn, ve, vu)
-    return True
 
 
 #: Where the point-wise loop takes a reading's attitude from: its angles (sines and
@@ -811,8 +816,10 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
     if not at_nodes:
         states[0, :_TRIG, :count] = 0.0
     if model != NONE and model != POINTWISE:          # one reading per scan
-        _reading(consts, pairs, amplitudes, components, read_table, stamps, 0, phases, turned,
-                 errors, has, start, count, states[0], work, True)
+        mid = np.int64(0)                               # (not a literal: one compile)
+        if not _reading(consts, pairs, amplitudes, components, read_table, stamps, mid, phases,
+                        turned, errors, has, start, count, states[0], work):
+            _read_rows(consts, states[0], work, count)
     normal[:, :count] = 0.0
     heading_varies = consts[_MOVES_YAW] > 0 or has[0]
     for b in range(n_beams):
@@ -823,8 +830,7 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                 source = FROM_ANGLES if has[0] or has[1] or has[2] else FROM_STATE
             else:
                 written = _reading(consts, pairs, amplitudes, components, read_table, stamps,
-                                   b, phases, turned, errors, has, start, count, state, work,
-                                   False)
+                                   b, phases, turned, errors, has, start, count, state, work)
                 source = FROM_ROWS if written else FROM_ANGLES
             _pointwise(consts, state, work, normal, beams[b, 0], beams[b, 1], beams[b, 2],
                        count, heading_varies, source)
