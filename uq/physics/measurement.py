@@ -55,8 +55,8 @@ from uq.physics.rotation import attitude_matrix, rotate_vectors
 from uq.physics import modelinputs
 from uq.physics.modelinputs import STATIC, STATIC_COMPILED
 from uq.physics import nacelle
-from uq.physics.scene import (ANGULAR_NAVIGATION, HELD_WIND_SPEED, NACELLE_OUTPUTS,
-                              NAVIGATION, OUTPUTS, sample_count)
+from uq.physics.scene import (ANGULAR_NAVIGATION, NACELLE_OUTPUTS, NAVIGATION, OUTPUTS,
+                              sample_count, with_held)
 
 def true_wind(scene, heights, trailing=1):
     """True wind (north, east, up) [m s-1] at `heights` [m] of shape (..., *S, *T) with
@@ -195,14 +195,6 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
     if "gate_height" in outputs:
         result["gate_height"] = _gate_height(scene, beams_earth, err["lidar_height"])
     return _full_shape(result, (n,) + scene.shape, scene.n_beams)
-
-
-def with_held(result, second):
-    """`result` with the wind speed of the `second` evaluation (its inputs held) as
-    :data:`~uq.physics.scene.HELD_WIND_SPEED`, as many trials as `result` has."""
-    speed = second["wind_speed"]
-    n = max(np.shape(v)[0] for v in result.values())
-    return {**result, HELD_WIND_SPEED: np.broadcast_to(speed, (n,) + np.shape(speed)[1:])}
 
 
 def _error_shape(value, name, scenes, scene_draws):

@@ -55,7 +55,7 @@ from uq.physics.rotation import (attitude_from_matrix_analytic, attitude_matrix,
                                  rotation_about_vertical)
 from uq.physics import modelinputs, nacelle
 from uq.physics.modelinputs import MOTION, MOTION_COMPILED
-from uq.physics.scene import NACELLE_OUTPUTS, sample_count
+from uq.physics.scene import NACELLE_OUTPUTS, sample_count, with_held
 from uq.physics.timing import dwell_frequency
 
 #: The inputs a scan in motion adds to the static model's (:mod:`uq.physics.modelinputs`).
@@ -87,7 +87,6 @@ def measurement_model(scene, outputs, scene_draws=False, compiled=True, held=Non
                                                  **errors)
         modelinputs.log_fallback(MOTION_COMPILED, reason)
     if held is not None:
-        from uq.physics.measurement import with_held
         return with_held(measurement_model(scene, outputs, scene_draws, False, **errors),
                          measurement_model(scene, ("wind_speed",), scene_draws, False,
                                            **{**errors, **held}))
