@@ -191,6 +191,7 @@ def test_covariance_is_the_same_whatever_the_chunk_size():
 @pytest.mark.parametrize("method", ["mc", "lhs", "sobol"])
 def test_scores_drawn_into_a_buffer_are_the_same_draws(method):
     from uq.engine.sampling import normal_scores
+    from uq.constants import RNG_BLOCK_SIZE
     plain = normal_scores(method, 11, 3, 5, block_size=256)
     buffer = np.full((2, 256, 5), np.nan)
     normal_scores(method, 11, 3, 5, block_size=256, out=buffer[1])
@@ -202,6 +203,7 @@ def test_scores_drawn_into_a_buffer_are_the_same_draws(method):
 def test_leading_rows_of_a_block_are_the_rows_of_the_whole_block(method, rows):
     """A short last block draws only what it needs, and the same values."""
     from uq.engine.sampling import normal_scores
+    from uq.constants import RNG_BLOCK_SIZE
     whole = normal_scores(method, 5, 2, 3, block_size=8192)
     assert np.array_equal(normal_scores(method, 5, 2, 3, block_size=8192, rows=rows),
                           whole[:rows])
@@ -250,3 +252,38 @@ def test_few_batches_widen_the_numerical_error_by_students_t():
     from uq.engine.stopping import coverage_factor
     assert coverage_factor(3) == pytest.approx(st.t.ppf(0.975, 2), rel=1e-12)
     assert coverage_factor(1000) == 2.0 and np.isnan(coverage_factor(1))
+
+
+def _with_auxiliary(a, b):
+    """y = a + b, and the auxiliary z = a alone: y with b held at its mean; z leaves the
+    GUM's complex-step call (as the pipeline's held speed does)."""
+    out = {"y": a + b}
+    if not np.iscomplexobj(a):
+        out["z"] = a + 0.0 * b
+    return out
+
+
+@pytest.mark.parametrize("sampling", [{"n": 50_000}, {"digits": 2}],
+                         ids=["fixed n", "adaptive"])
+def test_an_auxiliary_output_keeps_mean_and_u_alone_and_changes_nothing_else(sampling):
+    """An auxiliary output (``auxiliary``): its z_mc_mean and z_mc_u are the moments of
+    the same trials (z = a: the normal scores of a, drawn alongside b; mean and std of
+    those draws, recomputed here, to the rounding of the batch merges, 1e-12 relative);
+    nothing else of z is reported, and every variable of y, the GUM and the number of
+    trials (the adaptive stopping rule) are identical to a run without it."""
+    inputs = {"a": st.norm(1.0, 2.0), "b": st.norm(0.0, 1.0)}
+    plain = uq.propagate(lambda a, b: {"y": a + b}, inputs, seed=3, **sampling)
+    both = uq.propagate(_with_auxiliary, inputs, seed=3, auxiliary=("z",), **sampling)
+    assert sorted(v for v in both.data_vars if v.startswith("z_")) == ["z_mc_mean", "z_mc_u"]
+    assert both.attrs["n_samples"] == plain.attrs["n_samples"]
+    for name in plain.data_vars:
+        np.testing.assert_array_equal(both[name], plain[name], err_msg=name)
+    from uq.engine.inputs import input_set
+    from uq.engine.sampling import normal_scores
+    from uq.constants import RNG_BLOCK_SIZE
+    n, laid = both.attrs["n_samples"], input_set(inputs)
+    scores = np.concatenate([normal_scores("mc", 3, block, laid.dimension)
+                             for block in range(-(-n // RNG_BLOCK_SIZE))])[:n]
+    a = laid.values(scores)["a"]
+    assert float(both["z_mc_mean"]) == pytest.approx(np.mean(a), rel=1e-12)
+    assert float(both["z_mc_u"]) == pytest.approx(np.std(a, ddof=1), rel=1e-12)

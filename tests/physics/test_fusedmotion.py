@@ -126,6 +126,65 @@ def test_compiled_equals_numpy(changes):
     assert_same(*both(changes))
 
 
+#: Which inputs a held evaluation replaces: the reconstruction's alone (the compiled
+#: model shares the kinematics), or the truth's too (a second evaluation).
+HELD_CASES = {
+    "pointwise, INS and noise held": ({}, ("ins_heading", "ins_pitch", "ins_roll", "ins_sog",
+                                           "ins_cog", "lidar_radial_velocity")),
+    "linear INS, clock offset held": ({"ins.rate": 10.0, "ins.interpolation": "linear",
+                                       "ins.clock_offset": {"dist": "normal", "u": 0.02}},
+                                      ("ins_clock_offset", "ins_heading")),
+    "full, noise held": ({"correction": "full"}, ("lidar_radial_velocity",)),
+    "geometry held": (CASES["geometry errors"], ("lidar_half_cone", "lidar_height",
+                                                 "lidar_radial_velocity")),
+}
+
+
+@pytest.mark.parametrize("changes, names", HELD_CASES.values(), ids=HELD_CASES.keys())
+def test_the_held_speed_is_a_second_evaluation(changes, names):
+    """``held``: the wind speed of the same trials with some inputs at fixed values
+    (``wind_speed_held``) is, bit for bit, the compiled model's speed evaluated with
+    those inputs replaced (on the shared kinematics, or by a second evaluation where a
+    held input moves the truth), and the numpy model's to the rounding bound; the other
+    outputs are those of the call without `held`."""
+    settings = load_scenario({"name": "t", **merged(BASE, changes)}).settings
+    scene = scene_from_settings(settings)
+    inputs = error_inputs(settings, scene.n_beams, len(scene.ranges))
+    random = input_set({k: v for k, v in inputs.items() if not isinstance(v, float)})
+    errors = random.values(np.random.default_rng(5).standard_normal((300, random.dimension)))
+    held = {name: 0.01 * (k + 1) for k, name in enumerate(names)}   # not the means: any value
+    shared = fusedmotion.shares_kinematics(held, errors)
+    assert shared == ("lidar_half_cone" not in names)
+    fast = measurement_model(scene, OUTPUTS, held=held, **errors)
+    alone = measurement_model(scene, ("wind_speed",), **{**errors, **held})["wind_speed"]
+    np.testing.assert_array_equal(fast["wind_speed_held"], alone)
+    assert not np.allclose(fast["wind_speed_held"], fast["wind_speed"], rtol=0, atol=1e-6)
+    plain = measurement_model(scene, OUTPUTS, **errors)
+    for q in OUTPUTS:
+        np.testing.assert_array_equal(fast[q], plain[q])
+    slow = measurement_model(scene, OUTPUTS, compiled=False, held=held, **errors)
+    np.testing.assert_allclose(fast["wind_speed_held"], slow["wind_speed_held"], rtol=0,
+                               atol=TOLERANCE)
+
+
+def test_nothing_held_is_the_speed_itself():
+    """``held={}`` replaces nothing: the second reconstruction is the first, bit for bit."""
+    fast = measurement_model(*_case_scene(), ("wind_speed",), held={}, **_case_errors())
+    np.testing.assert_array_equal(fast["wind_speed_held"], fast["wind_speed"])
+
+
+def _case_scene():
+    settings = load_scenario({"name": "t", **BASE}).settings
+    return (scene_from_settings(settings),)
+
+
+def _case_errors():
+    settings = load_scenario({"name": "t", **BASE}).settings
+    scene = scene_from_settings(settings)
+    random = input_set(error_inputs(settings, scene.n_beams, len(scene.ranges)))
+    return random.values(np.random.default_rng(6).standard_normal((200, random.dimension)))
+
+
 _DIRECTION, _ROLL = np.meshgrid([0.0, 120.0, 250.0], [-5.0, 0.0, 3.0], indexing="ij")
 BATCH = {"wind_direction": np.deg2rad(_DIRECTION), "roll": np.deg2rad(_ROLL)}  # 3 x 3 [rad]
 

@@ -20,6 +20,7 @@ import xarray as xr
 
 import uq
 from uq.physics.rotation import attitude_matrix, rubio2022_angles_from_attitude, rubio2022_rotation
+from uq.pipeline.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[2]
 K = 4.5
@@ -367,8 +368,7 @@ def test_motion_ti_gum_is_nan_where_the_gum_is():
         "wind_speed_budget": (("scene", "range", "input"), [[[0.01, np.nan]], [[0.01, 0.04]]])},
         coords={"input": ["ins.heading", "motion (phases)"]})
     inputs = {"ins_heading": 0.0, "motion_phases": Input(UniformCircle(1.0), (1, 2))}
-    out = _motion_ti(None, {"sampling": {"method": "none"}}, inputs, None, dataset,
-                     compiled=True)
+    out = _motion_ti({"sampling": {"method": "none"}}, inputs, None, dataset)
     gum = out["wind_speed_motion_ti_gum"][1]
     assert np.isnan(gum[0, 0]) and gum[1, 0] == pytest.approx(0.2 / 8.0, rel=1e-15)
 
@@ -430,3 +430,50 @@ def test_every_results_file_has_gum_valid(correction):
         assert not ds[f"{q}_gum_validation_conclusive"].any()
         assert ds[f"{q}_gum_valid"].attrs["flag_meanings"] == "not_validated validated"
     assert "0/1" not in summary_table(ds)
+
+
+#: A DBS scan of 1 s per beam under harmonic roll and pitch of random phase, point-wise
+#: corrected by a continuous INS, with INS attitude errors and radial noise.
+MOTION_SCAN = {"wind": {"speed": 10.0, "direction": 40.0},
+               "motion": {"roll": {"amplitude": 5.0, "period": 6.0},
+                          "pitch": {"amplitude": 3.0, "period": 5.0}},
+               "lidar": {"scan": {"beam_duration": 1.0},
+                         "errors": {"radial_velocity": {"dist": "normal", "u": 0.3}}},
+               "ins": {"pitch": {"dist": "normal", "u": 1.0},
+                       "roll": {"dist": "normal", "u": 1.0}},
+               "correction": "none", "sampling": {"n": 2**15, "seed": 4},
+               "outputs": ["wind_speed", "wind_speed_motion_ti"]}
+
+
+def test_motion_ti_with_only_the_motion_random_is_the_speeds_u():
+    """With the motion the only random input, the held speed (every other input at its
+    mean) is the speed itself, trial by trial: wind_speed_motion_ti is wind_speed_mc_u
+    over the true speed (to the rounding of two ways of merging the same moments,
+    1e-12 relative)."""
+    ds = uq.run({**MOTION_SCAN, "lidar": {"scan": {"beam_duration": 1.0}}, "ins": {}})
+    expected = float(ds["wind_speed_mc_u"]) / float(ds["wind_speed_true"])
+    assert float(ds["wind_speed_motion_ti"]) == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("changes", [{"correction": "none"},
+                                     {"correction": "pointwise", "ins.rate": 10.0,
+                                      "ins.interpolation": "linear"}],
+                         ids=["none", "pointwise, 10 Hz INS"])
+def test_motion_ti_agrees_with_a_run_of_the_motion_alone(changes):
+    """wind_speed_motion_ti from the run's own trials (the held speed, common random
+    numbers with the other outputs) against the earlier estimate, a second run with the
+    motion alone random (here: the same scan without its other errors, another seed):
+    two independent estimates of the same u from N trials each, so they differ by
+    sqrt(2) s at most k = 5 times in all but ~6e-7 of runs, with s the standard error of
+    u at N trials, estimated by the second run from the spread of u over its batches
+    (wind_speed_mc_u_standard_error). The non-motion errors are large enough that the
+    speed's u is well above the motion's (ten such standard errors): holding them
+    matters."""
+    ds = uq.run(load_scenario(MOTION_SCAN, changes))
+    alone = uq.run(load_scenario({**MOTION_SCAN, "lidar": {"scan": {"beam_duration": 1.0}},
+                                  "ins": {}, "sampling": {"n": 2**15, "seed": 5}}, changes))
+    truth = float(ds["wind_speed_true"])
+    u_new, u_old = float(ds["wind_speed_motion_ti"]) * truth, float(alone["wind_speed_mc_u"])
+    standard_error = float(alone["wind_speed_mc_u_standard_error"])
+    assert float(ds["wind_speed_mc_u"]) - u_new > 10 * standard_error
+    assert abs(u_new - u_old) <= 5 * np.sqrt(2) * standard_error

@@ -65,6 +65,8 @@ class UniformCircle:
     """
 
     joint_size = 2
+    #: :meth:`transform` may write its points over the scores (``out``).
+    transforms_in_place = True
 
     def __init__(self, radius=1.0):
         self.radius = float(radius)
@@ -75,10 +77,24 @@ class UniformCircle:
     def std(self):
         return self.radius / np.sqrt(2.0)
 
-    def transform(self, scores):
-        """Points from normal scores, shape (..., 2) -> (..., 2)."""
-        norm = np.sqrt(np.sum(scores * scores, axis=-1, keepdims=True))
-        return self.radius * scores / norm
+    def transform(self, scores, out=None):
+        """Points from normal scores, shape (..., 2) -> (..., 2) (into `out`, which may
+        be `scores`). ``|z|^2 = z1 z1 + z2 z2`` (one addition: what a sum over the last
+        axis gives, without its strided reduction)."""
+        out = np.empty(scores.shape) if out is None else out
+        shape = (scores.shape[0] if scores.ndim > 1 else 1,
+                 int(np.prod(scores.shape[1:-1])), 2)       # (n, points, 2): views of both
+        points, into = scores.reshape(shape), out.reshape(shape)
+        if into.size and not np.shares_memory(into, out):
+            raise ValueError("out must take the shape (n, points, 2) without a copy")
+        for k in range(points.shape[1]):    # 1-D columns: numpy's fast strided loops
+            first, second = points[:, k, 0], points[:, k, 1]
+            norm = np.sqrt(first * first + second * second)
+            np.multiply(first, self.radius, out=into[:, k, 0])
+            into[:, k, 0] /= norm
+            np.multiply(second, self.radius, out=into[:, k, 1])
+            into[:, k, 1] /= norm
+        return out
 
     def __repr__(self):
         return f"UniformCircle(radius={self.radius:g})"
@@ -153,7 +169,12 @@ class InputSet:
             distribution = self.distributions[name]
             shape = (len(scores),) + tuple(self.shapes[name])
             if hasattr(distribution, "joint_size"):
-                arrays[name] = distribution.transform(correlated[:, columns].reshape(shape))
+                scores_of = correlated[:, columns].reshape(shape)    # (a view here)
+                if getattr(distribution, "transforms_in_place", False) and \
+                        (overwrite or correlated is not scores):
+                    arrays[name] = distribution.transform(scores_of, out=scores_of)
+                else:
+                    arrays[name] = distribution.transform(scores_of)
                 continue
             value = affine[:, columns] if _is_normal(distribution) \
                 else _inverse_cdf(distribution, correlated[:, columns])

@@ -37,7 +37,7 @@ log = logging.getLogger(__name__)
 def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
               correlation=None, circular=(), output_dims=None, interval="symmetric",
               chunk_size=None, control_variate=False, stopping="jcgm101", covariance=(),
-              stop_when_gum_valid=False):
+              stop_when_gum_valid=False, auxiliary=()):
     """Propagate input distributions through `model` by Monte Carlo and by the GUM.
 
     Parameters
@@ -90,6 +90,12 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         Outputs whose covariance along their last axis (e.g. between range gates) is
         kept: ``q_mc_covariance`` (complete trials; plain Monte Carlo, no control
         variate) and ``q_gum_covariance`` (J V J^T), last dimension ``<dim>_other``.
+    auxiliary : iterable of str
+        Outputs of the model of which only the Monte Carlo mean and u are kept
+        (``q_mc_mean``, ``q_mc_u``; plain Monte Carlo from the same trials, merged batch by
+        batch as the others): they take no part in the GUM, the stopping rule, the
+        coverage interval, the control variate or the validation. The model may leave
+        them out of a call with complex inputs (the GUM's).
 
     Returns
     -------
@@ -131,16 +137,18 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     inputs_laid = input_set(inputs, correlation)
     circular = set(circular)
     wrapped = _named_outputs(model)
+    auxiliary = tuple(auxiliary)
+    main = _without(wrapped, auxiliary)
     try:
-        gum_value, jacobian = gum.complex_step_jacobian(wrapped, inputs_laid)
+        gum_value, jacobian = gum.complex_step_jacobian(main, inputs_laid)
         gum_note = "exact Jacobian by complex-step differentiation"
     except gum.NotComplexStepSafe as error:
-        gum_value, jacobian = _no_gum(wrapped, inputs_laid)
+        gum_value, jacobian = _no_gum(main, inputs_laid)
         gum_note = f"no GUM: {error}"
     references = {q: _circular_reference(gum_value[q]) if q in circular else None
                   for q in gum_value}
     runner = _Runner(wrapped, inputs_laid, method, seed, references, interval, chunk_size,
-                     covariance)
+                     covariance, auxiliary)
     if set(covariance) & circular:
         raise ValueError(f"no covariance of circular outputs: {sorted(set(covariance) & circular)}")
     if control_variate:
@@ -162,6 +170,7 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     if runner.stats is not None:
         dataset = dataset.assign(_mc_variables(runner, dataset, circular, validation_digits))
         dataset = dataset.assign(_mc_covariances(runner, dataset))
+        dataset = dataset.assign(_auxiliary_variables(runner, output_dims or {}))
     else:
         dataset = dataset.assign(_not_validated(dataset))
     dataset.attrs.update(n_samples=runner.n_done, seed=seed, sampling_method=method,
@@ -181,6 +190,17 @@ def _no_gum(model, inputs):
     value = {q: np.full(np.shape(v)[1:], np.nan) for q, v in outputs.items()}
     return value, {q: np.full((inputs.dimension,) + np.shape(v)[1:], np.nan)
                    for q, v in outputs.items()}
+
+
+def _without(model, names):
+    """`model` without the outputs `names` (the GUM's model: no auxiliary outputs)."""
+    if not names:
+        return model
+
+    def main(**arrays):
+        return {q: v for q, v in model(**arrays).items() if q not in names}
+    main.whole_chunks = model.whole_chunks
+    return main
 
 
 def _circular_reference(value):
@@ -249,7 +269,7 @@ class _Runner:
     """Draws blocks, evaluates the model chunk by chunk, accumulates statistics."""
 
     def __init__(self, model, inputs, method, seed, references, interval, chunk_size,
-                 covariance=()):
+                 covariance=(), auxiliary=()):
         self.model, self.inputs, self.method, self.seed = model, inputs, method, seed
         self.references, self.interval = references, interval
         blocks = DEFAULT_BLOCKS_PER_CHUNK if chunk_size is None else -(-int(chunk_size) // RNG_BLOCK_SIZE)
@@ -263,8 +283,11 @@ class _Runner:
         self.stopped_by = "fixed n"
         self.control, self.linear = None, {}
         self.covariance, self.comoments = tuple(covariance), {}
+        self.auxiliary, self.moments = tuple(auxiliary), {}
 
     def _start(self, capacity, shapes, expected=None):
+        self.moments = {q: Moments(shapes[q]) for q in self.auxiliary}
+        shapes = {q: shape for q, shape in shapes.items() if q not in self.auxiliary}
         self.stats = {q: StreamingStatistics(shape, capacity, self.references[q],
                                              expected=expected)
                       for q, shape in shapes.items()}
@@ -288,7 +311,7 @@ class _Runner:
             if self.control:
                 columns = controlvariate.input_columns(values, self.inputs)
                 linear.append({q: controlvariate.linear_deviation(self.control[q][0], columns)
-                               for q in pieces[-1]})
+                               for q in pieces[-1] if q not in self.auxiliary})
             if whole:
                 yield pieces.pop(), (linear.pop() if self.control else None)
         if not whole:
@@ -323,6 +346,10 @@ class _Runner:
         """Statistics batch by batch; chunks start on block boundaries, so the sequence of
         floating-point merges, and the result, is the same for every chunk size."""
         for q, values in outputs.items():
+            if q in self.moments:                 # auxiliary: the moments alone
+                for start in range(0, len(values), self.batch_size):
+                    self.moments[q].update(values[start:start + self.batch_size])
+                continue
             summaries = self.stats[q].add(values, self.batch_size, summarize=True,
                                           kind=self.interval, summary_size=self.summary_size)
             if q in self.comoments or linear is not None:
@@ -496,6 +523,16 @@ def _mc_variables(runner, gum_results, circular, digits):
         })
         if q in circular:
             data[f"{q}_mc_circular_std"] = (dims, result["circular_std"])
+    return data
+
+
+def _auxiliary_variables(runner, output_dims):
+    """``q_mc_mean`` and ``q_mc_u`` of the auxiliary outputs (NaN below two values)."""
+    data = {}
+    for q, moments in runner.moments.items():
+        dims = tuple(output_dims.get(q, [f"{q}_dim{i}" for i in range(len(moments.shape))]))
+        data[f"{q}_mc_mean"] = (dims, np.where(moments.count > 0, moments.mean, np.nan))
+        data[f"{q}_mc_u"] = (dims, np.sqrt(moments.variance()))
     return data
 
 

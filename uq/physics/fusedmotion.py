@@ -45,7 +45,7 @@ from uq.physics.modelinputs import MOTION_COMPILED, Correction
 from uq.physics import nacelle
 from uq.physics.motion import DEGREES_OF_FREEDOM
 from uq.physics.rotation import rotation_about_vertical, rotation_pitch, rotation_roll
-from uq.physics.scene import NACELLE_OUTPUTS, SCENE_FIELDS, sample_count
+from uq.physics.scene import HELD_WIND_SPEED, NACELLE_OUTPUTS, SCENE_FIELDS, sample_count
 from uq.physics.timing import dwell_frequency
 
 #: Outputs the compiled model computes; any other requested output uses the numpy model.
@@ -102,23 +102,34 @@ _MOST_AXES = {"reading": 2, "scan": 1, "beam_gate": 3, "phase": 3}
 _LEAST_AXES = {"reading": 1, "scan": 1, "beam_gate": 3, "phase": 3}
 
 
-def measurement_model(scene, outputs, scene_draws=False, **errors):
+def measurement_model(scene, outputs, scene_draws=False, held=None, **errors):
     """The compiled :func:`uq.physics.timeresolved.measurement_model` (same inputs and
     outputs: each (n, *S, n_gates) for a batch of scenes of shape S, evaluated one scene
-    after the other; with `scene_draws` each scene takes its own slice of the inputs)."""
+    after the other; with `scene_draws` each scene takes its own slice of the inputs).
+    `held` (inputs -> scalar): the wind speed of the same trials with these inputs
+    replaced, ``wind_speed_held``; where no input of the truth is held
+    (:func:`shares_kinematics`), a second reconstruction per block on the same
+    kinematics, else a second evaluation."""
     if scene.probe is not None:             # its node count (the scene itself if chosen)
         scene = probe_volume.resolve(scene)
     shape, gates = scene.shape, len(scene.ranges)
     n = sample_count(errors)
     result = {q: np.empty((n,) + shape + (gates,)) for q in FUSED_OUTPUTS + NACELLE_OUTPUTS
               if q in outputs}
+    if held is not None:
+        result[HELD_WIND_SPEED] = np.empty((n,) + shape + (gates,))
     for index in np.ndindex(*shape):
         mine = errors if not scene_draws else {
             name: value[(slice(None),) + index] if np.ndim(value) > 1 else value
             for name, value in errors.items()}
         into = {q: result[q][(slice(None),) + index] for q in result}      # (n, gates) views
-        _evaluate(scene_plan(_scene_at(scene, index)), mine, n, into, scene.probe,
-                  _mounted_layout(scene, outputs))
+        plan, layout = scene_plan(_scene_at(scene, index)), _mounted_layout(scene, outputs)
+        if held is None or shares_kinematics(held, mine):
+            _evaluate(plan, mine, n, into, scene.probe, layout, held)
+        else:
+            second = {"wind_speed": into.pop(HELD_WIND_SPEED)}
+            _evaluate(plan, mine, n, into, scene.probe, layout)
+            _evaluate(plan, {**mine, **held}, n, second, scene.probe, layout)
     return result
 
 
@@ -131,6 +142,19 @@ def _mounted_layout(scene, outputs):
     upper_lower = nacelle.upper_lower(scene.azimuths) if "shear_exponent" in outputs else None
     return np.array([*(pair or (-1, -1)), *(upper_lower or (-1, -1)),
                      int("shear_exponent" in outputs)], dtype=np.int64)
+
+
+#: Inputs of the truth (:func:`uq.physics.fusedmotionkernels.kinematics` and a probe's
+#: profile); the others enter the reconstruction alone.
+KINEMATIC_INPUTS = _GEOMETRY + PROBE_INPUTS + ("motion_phases", "motion_window")
+
+
+def shares_kinematics(held, errors):
+    """Can the evaluation with `held` replacing inputs of `errors` reuse the truth of
+    `errors`: is every held input of the truth given as that same scalar?"""
+    return all(name not in KINEMATIC_INPUTS or
+               (np.ndim(errors.get(name)) == 0 and errors.get(name) == value)
+               for name, value in held.items())
 
 
 def _scene_at(scene, index):
@@ -296,27 +320,36 @@ def block_trials(plan, probe_nodes=0):
     return int(np.clip(size, low, high))
 
 
-def _evaluate(plan, errors, n, into, probe=None, layout=None):
+def _reconstruction_inputs(errors, n):
+    """(INS inputs, which are given, radial noise) of :func:`kernels.reconstruct`."""
+    ins = tuple(_ins_input(errors.get(name), n) for name in kernels.INPUTS)
+    has = np.array([name in errors and not (np.ndim(errors[name]) == 0 and errors[name] == 0)
+                    for name in kernels.INPUTS], dtype=np.int64)
+    noise = errors.get("lidar_radial_velocity")
+    noise = np.zeros((1, 1, 1)) if noise is None else \
+        np.require(np.reshape(noise, (1, 1, 1)) if np.ndim(noise) == 0 else noise,
+                   dtype=float, requirements="W")
+    return ins, has, noise
+
+
+def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     """The outputs of one scene into `into` (name -> (n, gates) view), block by block
     (with a `probe` volume: its weighted speed, :mod:`uq.physics.fusedprobe`; a tilted
     mount's `layout`: its reconstruction, :func:`~uq.physics.fusedmotionkernels.
-    mounted_wind`)."""
+    mounted_wind`); with `held` (inputs of the reconstruction alone -> scalar) the
+    speed reconstructed from the same truth with those inputs replaced, into
+    ``into["wind_speed_held"]``."""
     consts = plan.consts
     if layout is not None and layout[-1]:   # the shear exponent: the believed lift too
         consts = consts.copy()
         consts[kernels.HEAD.index("mounted")] = 2.0
     n_beams, n_gates = plan.slant.shape
     n_nodes = len(plan.weights)
-    ins = tuple(_ins_input(errors.get(name), n) for name in kernels.INPUTS)
-    has = np.array([name in errors and not (np.ndim(errors[name]) == 0 and errors[name] == 0)
-                    for name in kernels.INPUTS], dtype=np.int64)
+    ins, has, noise = _reconstruction_inputs(errors, n)
+    second = None if held is None else _reconstruction_inputs({**errors, **held}, n)
     phases = _phase_input(errors.get("motion_phases"), plan.n_phases)
     window = _phase_input(errors.get("motion_window"), plan.n_window)
     geometry = [_column(errors.get(name)) for name in _GEOMETRY]
-    noise = errors.get("lidar_radial_velocity")
-    noise = np.zeros((1, 1, 1)) if noise is None else \
-        np.require(np.reshape(noise, (1, 1, 1)) if np.ndim(noise) == 0 else noise,
-                   dtype=float, requirements="W")
     m = min(block_trials(plan, probe.nodes if probe is not None else 0), max(n, 1))
     n_components = max(1, len(plan.components))
     work = np.empty((kernels.WORK_ROWS, m))
@@ -374,6 +407,17 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None):
                     direction, consts[kernels.HEAD.index("heading")])
         if shear_out is not None and "shear_exponent" in into:
             into["shear_exponent"][start:stop] = shear_out[:, :count].T
+        if second is not None:             # the same truth, the held inputs' reading
+            kernels.reconstruct(consts, plan.pairs, plan.amplitudes, plan.components,
+                                plan.read_table, plan.stamps, plan.beams, plan.operator,
+                                plan.weights, *second, start, count, work, c, turned,
+                                states, parts, ratio, normal, out)
+            if layout is not None:                  # (the shear row is stored already)
+                kernels.compiled_mounted_wind()(consts, layout, plan.beams, plan.slant, work,
+                                                normal, count, out,
+                                                shear_out if shear_out is not None else speed)
+            kernels.wind_speed(out, count, speed, vertical)
+            into[HELD_WIND_SPEED][start:stop] = speed[:, :count].T
 
 
 def _probe_profile(probe, errors, start, count, ratio, beam_up, focus, item_focus,

@@ -56,7 +56,7 @@ from uq.physics import modelinputs
 from uq.physics.modelinputs import STATIC, STATIC_COMPILED
 from uq.physics import nacelle
 from uq.physics.scene import (ANGULAR_NAVIGATION, NACELLE_OUTPUTS, NAVIGATION, OUTPUTS,
-                              sample_count)
+                              sample_count, with_held)
 
 def true_wind(scene, heights, trailing=1):
     """True wind (north, east, up) [m s-1] at `heights` [m] of shape (..., *S, *T) with
@@ -142,7 +142,8 @@ def true_radial_velocity(scene, beams_earth, ship_velocity, height_error=0.0, pr
     return wind_only - ship_along[..., None], wind_only
 
 
-def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, **errors):
+def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, held=None,
+                      **errors):
     """Propagate errors through measurement and correction; see the module docstring.
 
     `scene_draws` (bool): the errors carry the scene axes (independent draws per scene).
@@ -150,6 +151,11 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
     errors, wind outputs), evaluate with the compiled loop of :mod:`uq.physics.fused`, which
     gives the same values to 1e-12; False forces the numpy arrays below. A time-resolved
     scene passes it on (:func:`uq.physics.timeresolved.measurement_model`).
+    `held` (dict, optional): inputs by name -> value (a scalar) that replace the given
+    ones in a second evaluation of the same trials, whose wind speed is the output
+    :data:`~uq.physics.scene.HELD_WIND_SPEED` (e.g. every error but the motion at its
+    mean: the motion alone, with the same draws of the motion). The compiled
+    time-resolved model shares the platform's kinematics between the two.
 
     Returns
     -------
@@ -163,7 +169,11 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
     if scene.time_resolved is not None:       # motion within the scan: its own model
         from uq.physics import timeresolved
         return timeresolved.measurement_model(scene, outputs, scene_draws, compiled=compiled,
-                                              **errors)
+                                              held=held, **errors)
+    if held is not None:                      # a second evaluation, nothing to share
+        result = measurement_model(scene, outputs, scene_draws, compiled, **errors)
+        return with_held(result, measurement_model(scene, ("wind_speed",), scene_draws,
+                                                   compiled, **{**errors, **held}))
     if compiled:
         from uq.physics import fused  # (numba: imported only where it may apply)
         result = fused.evaluate(scene, outputs, scene_draws, errors)

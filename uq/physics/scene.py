@@ -26,6 +26,18 @@ OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind", "radial_velocity", "
 NACELLE_OUTPUTS = ("yaw_misalignment", "shear_exponent")
 #: Every per-trial output a scenario may request.
 ALL_OUTPUTS = OUTPUTS + NACELLE_OUTPUTS
+#: The wind speed of a second evaluation with some inputs held (``held`` of
+#: :func:`uq.physics.measurement.measurement_model`): the same trials' speed with those
+#: inputs replaced, e.g. the motion alone (``wind_speed_motion_ti``) [m s-1].
+HELD_WIND_SPEED = "wind_speed_held"
+
+
+def with_held(result, second):
+    """`result` (outputs of a model call) with the wind speed of the `second` evaluation
+    (its inputs held) as :data:`HELD_WIND_SPEED`, as many trials as `result` has."""
+    speed = second["wind_speed"]
+    n = max(np.shape(v)[0] for v in result.values())
+    return {**result, HELD_WIND_SPEED: np.broadcast_to(speed, (n,) + np.shape(speed)[1:])}
 #: The outputs the compiled model (:mod:`uq.physics.fused`) computes: those of OUTPUTS.
 COMPILED_OUTPUTS = OUTPUTS
 #: What the INS reports with an error, and the angles among them (:mod:`uq.physics.modelinputs`).

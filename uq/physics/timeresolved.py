@@ -55,7 +55,7 @@ from uq.physics.rotation import (attitude_from_matrix_analytic, attitude_matrix,
                                  rotation_about_vertical)
 from uq.physics import modelinputs, nacelle
 from uq.physics.modelinputs import MOTION, MOTION_COMPILED
-from uq.physics.scene import NACELLE_OUTPUTS, sample_count
+from uq.physics.scene import NACELLE_OUTPUTS, sample_count, with_held
 from uq.physics.timing import dwell_frequency
 
 #: The inputs a scan in motion adds to the static model's (:mod:`uq.physics.modelinputs`).
@@ -65,7 +65,7 @@ TIME_RESOLVED_INPUTS = tuple(name for name in modelinputs.names(MOTION)
 PROBE_ERRORS = tuple(PARAMETER_SCALE)
 
 
-def measurement_model(scene, outputs, scene_draws=False, compiled=True, **errors):
+def measurement_model(scene, outputs, scene_draws=False, compiled=True, held=None, **errors):
     """The time-resolved model for a scene or a batch of scenes (evaluated scene by
     scene); same inputs and outputs as :func:`uq.physics.measurement.measurement_model`,
     plus those of :data:`TIME_RESOLVED_INPUTS`.
@@ -73,14 +73,23 @@ def measurement_model(scene, outputs, scene_draws=False, compiled=True, **errors
     `compiled` (bool): where it applies (:func:`uq.physics.fusedmotion.applicable`: real
     inputs, wind outputs), evaluate with the compiled loops of
     :mod:`uq.physics.fusedmotion`, which give the same values to 1e-12 m/s; False forces
-    the numpy arrays below.
+    the numpy arrays below. `held`: the wind speed of the same trials with these inputs
+    replaced, as the output ``wind_speed_held`` (the compiled loops share the
+    kinematics; here the model is evaluated twice).
     """
     if compiled:
         from uq.physics import fusedmotion    # (numba: imported only where it may apply)
-        reason = fusedmotion.declined(scene, outputs, errors, scene_draws)
+        reason = fusedmotion.declined(scene, outputs, errors, scene_draws) or \
+            (held is not None and fusedmotion.declined(scene, outputs, {**errors, **held},
+                                                       scene_draws))
         if not reason:
-            return fusedmotion.measurement_model(scene, outputs, scene_draws, **errors)
+            return fusedmotion.measurement_model(scene, outputs, scene_draws, held=held,
+                                                 **errors)
         modelinputs.log_fallback(MOTION_COMPILED, reason)
+    if held is not None:
+        return with_held(measurement_model(scene, outputs, scene_draws, False, **errors),
+                         measurement_model(scene, ("wind_speed",), scene_draws, False,
+                                           **{**errors, **held}))
     modelinputs.check_names(MOTION, errors)
     shape = scene.shape
     if not shape:

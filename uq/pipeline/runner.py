@@ -25,7 +25,8 @@ from uq.pipeline.modelsetup import (MOTION_INPUTS, error_inputs, input_label, sc
 from uq.physics.correction import describe_corrections
 from uq.physics import probe as probe_volume
 from uq.physics.measurement import measurement_model, true_values
-from uq.physics.scene import ALL_OUTPUTS, ANGULAR_NAVIGATION, NAVIGATION, OUTPUTS
+from uq.physics.scene import (ALL_OUTPUTS, ANGULAR_NAVIGATION, HELD_WIND_SPEED, NAVIGATION,
+                              OUTPUTS)
 from uq.pipeline.metadata import (COORDINATES, QUANTITIES, ancillary_variables, cf_encode,
                                   history, swept_key_attributes, variable_attributes)
 from uq.engine.propagate import propagate
@@ -148,10 +149,15 @@ def run_scene(scenario, scene, seed, compiled=True):
     n_gates = len(scene.ranges)
     scene = probe_volume.resolve(scene)       # the probe's node count, once per batch
     inputs = error_inputs(settings, scene.n_beams, n_gates)
-    engine = _propagate(scene, settings, outputs, inputs, seed, compiled)
+    held = _motion_held(settings, inputs) if wants_motion_ti(settings) else None
+    engine = _propagate(scene, settings, outputs, inputs, seed, compiled, held)
+    motion_u = None
+    if held is not None:                # the motion alone: u of the held speed, then gone
+        motion_u = engine[f"{HELD_WIND_SPEED}_mc_u"].values
+        engine = engine.drop_vars([f"{HELD_WIND_SPEED}_mc_{key}" for key in ("mean", "u")])
     dataset = _scene_dataset(scene, settings, outputs, engine, compiled)
     if wants_motion_ti(settings):
-        dataset = dataset.assign(_motion_ti(scene, settings, inputs, seed, dataset, compiled))
+        dataset = dataset.assign(_motion_ti(settings, inputs, motion_u, dataset))
     return dataset
 
 
@@ -172,19 +178,28 @@ def model_outputs(outputs):
     return tuple(model)
 
 
-def _motion_ti(scene, settings, inputs, seed, dataset, compiled):
-    """``wind_speed_motion_ti``: u of the scan's Vh from the motion alone (every other
-    error at its mean), over the true Vh; Monte Carlo with the run's seed and sampling,
-    and ``wind_speed_motion_ti_gum`` from the motion inputs' share of the GUM budget."""
-    truth = dataset["wind_speed_true"].values
-    motion_only = {name: spec if name in MOTION_INPUTS else _mean_of(spec)
-                   for name, spec in inputs.items()}
+def _motion_held(settings, inputs):
+    """The inputs held for the motion alone: every input but the motion's, at its mean
+    (None without Monte Carlo or without a motion input)."""
     if settings["sampling"]["method"] == "none" or not any(n in inputs for n in MOTION_INPUTS):
-        u_motion = np.zeros_like(truth) if not any(n in inputs for n in MOTION_INPUTS) \
-            else np.full_like(truth, np.nan)
+        return None
+    return {name: _mean_of(spec) for name, spec in inputs.items() if name not in MOTION_INPUTS}
+
+
+def _motion_ti(settings, inputs, motion_u, dataset):
+    """``wind_speed_motion_ti``: u of the scan's Vh from the motion alone (every other
+    error at its mean), over the true Vh: the Monte Carlo u of the run's own trials'
+    speeds reconstructed again with every input but the motion's held at its mean
+    (`motion_u`, :func:`_motion_held`: the same draws of the motion, common random
+    numbers); and ``wind_speed_motion_ti_gum`` from the motion inputs' share of the GUM
+    budget."""
+    truth = dataset["wind_speed_true"].values
+    if not any(n in inputs for n in MOTION_INPUTS):
+        u_motion = np.zeros_like(truth)
+    elif settings["sampling"]["method"] == "none":
+        u_motion = np.full_like(truth, np.nan)
     else:
-        engine = _propagate(scene, settings, ("wind_speed",), motion_only, seed, compiled)
-        u_motion = engine["wind_speed_mc_u"].values
+        u_motion = motion_u
     dims = dataset["wind_speed_true"].dims
     budget = dataset["wind_speed_budget"]
     labels = [input_label(name) for name in MOTION_INPUTS]
@@ -202,23 +217,30 @@ def _mean_of(spec):
     return float(distribution.mean())
 
 
-def _propagate(scene, settings, outputs, inputs, seed, compiled):
+def _propagate(scene, settings, outputs, inputs, seed, compiled, held=None):
+    """:func:`uq.propagate` of the scene's model; with `held` (inputs -> value) also the
+    Monte Carlo mean and u of the speed with those inputs held (auxiliary
+    ``wind_speed_held``, from the same trials)."""
     sampling = settings["sampling"]
     n_gates = len(scene.ranges)
 
     def model(**errors):
-        return measurement_model(scene, outputs, compiled=compiled, **errors)
+        # the GUM's complex steps need no held speed (it is Monte Carlo's alone)
+        real = held is not None and not any(np.iscomplexobj(v) for v in errors.values())
+        return measurement_model(scene, outputs, compiled=compiled,
+                                 held=held if real else None, **errors)
     model.whole_chunks = compiled and scene.time_resolved is None  # blocks its own trials
 
     return propagate(model, inputs,
                        n=sampling.get("n"), digits=sampling.get("digits"),
                        method=sampling["method"], seed=seed, circular=("wind_direction",),
-                       output_dims={q: _dims(q) for q in ALL_OUTPUTS},
+                       output_dims={q: _dims(q) for q in ALL_OUTPUTS + (HELD_WIND_SPEED,)},
                        interval=sampling["interval"], chunk_size=sampling.get("chunk_size"),
                        control_variate=sampling["control_variate"],
                        stopping=sampling["stopping"],
                        stop_when_gum_valid=sampling["stop_when_gum_valid"],
-                       covariance=profile_covariances(outputs, n_gates))
+                       covariance=profile_covariances(outputs, n_gates),
+                       auxiliary=(HELD_WIND_SPEED,) if held is not None else ())
 
 
 def profile_covariances(outputs, n_gates):
