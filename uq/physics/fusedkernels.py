@@ -382,6 +382,25 @@ def _mean_reading(error, base, i, s, zero):
     return total / error.shape[2]
 
 
+@_helper
+def _tilt2d_mean(heading_error, pitch_error, roll_error, cog_error, sog_error, base, sog0,
+                 i, s, zero, mean, cos_nominal, sin_nominal):
+    """tilt2d's mean reading over the beams (Eq. 13 [1]): its rotation and the ship's
+    velocity (north, east) it implies; `mean` (5,) scratch."""
+    mean[0] = _mean_reading(heading_error, base[0], i, s, zero)
+    mean[1] = _mean_reading(pitch_error, base[1], i, s, zero)
+    mean[2] = _mean_reading(roll_error, base[2], i, s, zero)
+    mean[3] = _mean_reading(cog_error, base[3], i, s, zero)
+    total = zero
+    for k in range(sog_error.shape[2]):
+        total += sog0 + _pick(sog_error, i, s, k)
+    mean[4] = total / sog_error.shape[2]
+    rotation = _rotation(FULL, np.cos(mean[0]), np.sin(mean[0]), np.cos(mean[1]),
+                         np.sin(mean[1]), np.cos(mean[2]), np.sin(mean[2]),
+                         cos_nominal, sin_nominal)
+    return rotation, (mean[4] * np.cos(mean[3]), mean[4] * np.sin(mean[3]))
+
+
 @njit(inline="always")
 def _gate_heights(table, s, shapes, shape, beams, r, height_error, n_slanted, n_gates,
                   at_slant, out):
@@ -611,18 +630,9 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
             if not (want_speed or want_direction or want_vertical):
                 continue
             if model == TILT2D:                      # tilt2d: the mean reading (Eq. 13 [1])
-                mean[0] = _mean_reading(heading_error, base[0], i, s, zero)
-                mean[1] = _mean_reading(pitch_error, base[1], i, s, zero)
-                mean[2] = _mean_reading(roll_error, base[2], i, s, zero)
-                mean[3] = _mean_reading(cog_error, base[3], i, s, zero)
-                total = zero
-                for k in range(sog_error.shape[2]):
-                    total += sog0 + _pick(sog_error, i, s, k)
-                mean[4] = total / sog_error.shape[2]
-                mean_rot = _rotation(FULL, np.cos(mean[0]), np.sin(mean[0]), np.cos(mean[1]),
-                                     np.sin(mean[1]), np.cos(mean[2]), np.sin(mean[2]),
-                                     cos_nominal, sin_nominal)
-                mean_ship = (mean[4] * np.cos(mean[3]), mean[4] * np.sin(mean[3]))
+                mean_rot, mean_ship = _tilt2d_mean(heading_error, pitch_error, roll_error,
+                                                   cog_error, sog_error, base, sog0, i, s,
+                                                   zero, mean, cos_nominal, sin_nominal)
             for g in range(n_gates):
                 for k in range(3):
                     total = zero
@@ -822,18 +832,9 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
                     inverse = _inverse2(normal[level_a, 0], normal[level_a, 1],
                                         normal[level_b, 0], normal[level_b, 1])
             if pointwise and model == TILT2D and n_beams > 2:   # the mean reading, Eq. 13 [1]
-                mean[0] = _mean_reading(heading_error, base[0], i, s, zero)
-                mean[1] = _mean_reading(pitch_error, base[1], i, s, zero)
-                mean[2] = _mean_reading(roll_error, base[2], i, s, zero)
-                mean[3] = _mean_reading(cog_error, base[3], i, s, zero)
-                total = zero
-                for k in range(sog_error.shape[2]):
-                    total += sog0 + _pick(sog_error, i, s, k)
-                mean[4] = total / sog_error.shape[2]
-                mean_rot = _rotation(FULL, np.cos(mean[0]), np.sin(mean[0]), np.cos(mean[1]),
-                                     np.sin(mean[1]), np.cos(mean[2]), np.sin(mean[2]),
-                                     cos_nominal, sin_nominal)
-                mean_ship = (mean[4] * np.cos(mean[3]), mean[4] * np.sin(mean[3]))
+                mean_rot, mean_ship = _tilt2d_mean(heading_error, pitch_error, roll_error,
+                                                   cog_error, sog_error, base, sog0, i, s,
+                                                   zero, mean, cos_nominal, sin_nominal)
             for g in range(n_gates):
                 x = y = z = zero
                 for b in range(n_beams):
