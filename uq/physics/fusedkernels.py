@@ -401,6 +401,18 @@ def _tilt2d_mean(heading_error, pitch_error, roll_error, cog_error, sog_error, b
     return rotation, (mean[4] * np.cos(mean[3]), mean[4] * np.sin(mean[3]))
 
 
+@_helper
+def _tilt2d_project(mean_rot, mean_ship, north, east, up):
+    """tilt2d's wind from the point-wise least squares u (Eq. 13 [1]): R_m^T (u - s_m),
+    then its horizontal part rotated back by the mean reading R_m and s_m added."""
+    d0, d1, d2 = north - mean_ship[0], east - mean_ship[1], up
+    x = mean_rot[0] * d0 + mean_rot[3] * d1 + mean_rot[6] * d2
+    y = mean_rot[1] * d0 + mean_rot[4] * d1 + mean_rot[7] * d2
+    up = mean_rot[2] * d0 + mean_rot[5] * d1 + mean_rot[8] * d2
+    return (mean_rot[0] * x + mean_rot[1] * y + mean_ship[0],
+            mean_rot[3] * x + mean_rot[4] * y + mean_ship[1], up)
+
+
 @njit(inline="always")
 def _gate_heights(table, s, shapes, shape, beams, r, height_error, n_slanted, n_gates,
                   at_slant, out):
@@ -648,13 +660,8 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                         matrix[k, m] = total
                 _solve3(matrix, rhs)
                 north, east, up = rhs[0], rhs[1], rhs[2]
-                if model == TILT2D:    # R_m^T (u - s_m), then its horizontal part rotated
-                    d0, d1, d2 = north - mean_ship[0], east - mean_ship[1], up
-                    x = mean_rot[0] * d0 + mean_rot[3] * d1 + mean_rot[6] * d2
-                    y = mean_rot[1] * d0 + mean_rot[4] * d1 + mean_rot[7] * d2
-                    up = mean_rot[2] * d0 + mean_rot[5] * d1 + mean_rot[8] * d2
-                    north = mean_rot[0] * x + mean_rot[1] * y + mean_ship[0]
-                    east = mean_rot[3] * x + mean_rot[4] * y + mean_ship[1]
+                if model == TILT2D:
+                    north, east, up = _tilt2d_project(mean_rot, mean_ship, north, east, up)
                 if want_speed:
                     speed[s, g, i] = _hypot(north, east)
                 if want_vertical:
@@ -878,12 +885,8 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
                     _solve3(matrix, rhs)
                     north, east, up = rhs[0], rhs[1], rhs[2]
                     if model == TILT2D:
-                        d0, d1, d2 = north - mean_ship[0], east - mean_ship[1], up
-                        x = mean_rot[0] * d0 + mean_rot[3] * d1 + mean_rot[6] * d2
-                        y = mean_rot[1] * d0 + mean_rot[4] * d1 + mean_rot[7] * d2
-                        up = mean_rot[2] * d0 + mean_rot[5] * d1 + mean_rot[8] * d2
-                        north = mean_rot[0] * x + mean_rot[1] * y + mean_ship[0]
-                        east = mean_rot[3] * x + mean_rot[4] * y + mean_ship[1]
+                        north, east, up = _tilt2d_project(mean_rot, mean_ship, north, east,
+                                                          up)
                 if level_a >= 0:                # the hub-height wind of the level beams
                     r0 = corrected[level_a] - normal[level_a, 2] * up
                     r1 = corrected[level_b] - normal[level_b, 2] * up

@@ -118,12 +118,13 @@ def measurement_model(scene, outputs, scene_draws=False, held=None, **errors):
               if q in outputs}
     if held is not None:
         result[HELD_WIND_SPEED] = np.empty((n,) + shape + (gates,))
+    layout = _mounted_layout(scene, outputs)           # the batch's beams: one layout
     for index in np.ndindex(*shape):
         mine = errors if not scene_draws else {
             name: value[(slice(None),) + index] if np.ndim(value) > 1 else value
             for name, value in errors.items()}
         into = {q: result[q][(slice(None),) + index] for q in result}      # (n, gates) views
-        plan, layout = scene_plan(_scene_at(scene, index)), _mounted_layout(scene, outputs)
+        plan = scene_plan(_scene_at(scene, index))
         if held is None or shares_kinematics(held, mine):
             _evaluate(plan, mine, n, into, scene.probe, layout, held)
         else:
