@@ -66,6 +66,9 @@ from uq.constants import (IEC_COHERENCE_DECREMENT, IEC_COHERENCE_LENGTH_FACTOR,
 
 #: Models of the ``turbulence`` section.
 TURBULENCE_MODELS = ("mann", "kaimal")
+#: k1 nodes of the quadrature that :func:`point_variances` evaluates at once (a work size,
+#: not physics: ~2.5 MB of temporaries per node of the standard grid).
+K1_PER_BLOCK = 12
 
 
 def iec_scale_parameter(height):
@@ -303,14 +306,20 @@ def point_variances(tensor, grid=None, spectral_filter=None):
     """
     grid = grid or WavenumberGrid(tensor.length_scale)
     k1, w1 = grid.k1()
-    k2, k3, w23 = grid.cross_section(k1)
-    k1b = np.broadcast_to(k1[:, None], k2.shape)
-    factor, k0, (zeta1, zeta2, ratio) = tensor.distortion(k1b, k2, k3)
-    phi = tensor.matrix(k1b, k2, k3)
-    diagonal = np.einsum("...ii->...i", phi)
-    per_k1 = np.einsum("nqi,nq->ni", diagonal, w23)
+    # A few k1 at a time: the (k1, k2, k3, 3, 3) tensor of the whole grid is ~0.2 GB of
+    # temporaries (the peak of a ``uq golden`` run); each k1's sum is the same either way.
+    per_k1 = np.concatenate([_diagonal_per_k1(tensor, grid, k1[start:start + K1_PER_BLOCK])
+                             for start in range(0, len(k1), K1_PER_BLOCK)])
     h = np.ones_like(k1) if spectral_filter is None else spectral_filter(k1)
     return np.einsum("ni,n->i", per_k1, w1 * h)
+
+
+def _diagonal_per_k1(tensor, grid, k1):
+    """``integral Phi_ii(k) dk2 dk3`` [m3 s-2] at each of `k1` (shape (n,)), shape (n, 3)."""
+    k2, k3, w23 = grid.cross_section(k1)
+    k1b = np.broadcast_to(k1[:, None], k2.shape)
+    diagonal = np.einsum("...ii->...i", tensor.matrix(k1b, k2, k3))
+    return np.einsum("nqi,nq->ni", diagonal, w23)
 
 
 @functools.lru_cache(maxsize=64)
