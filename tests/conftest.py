@@ -1,4 +1,5 @@
 """Shared helpers for the tests."""
+import copy
 import resource
 
 import numpy as np
@@ -10,17 +11,24 @@ from uq.pipeline.scenario import load_scenario
 
 def make_scene(**changes):
     """A Scene from the default scenario with dotted-key changes (degrees, as in YAML)."""
-    return scene_from_settings(load_scenario({"name": "test", **_nest(changes)}).settings)
+    return scene_from_settings(load_scenario({"name": "test",
+                                              **with_changes({}, changes)}).settings)
 
 
-def _nest(changes):
-    out = {}
+def with_changes(settings, changes):
+    """A deep copy of the scenario mapping `settings` with the dotted-key `changes`
+    applied (``{"lidar.errors.height": None}`` removes that key; any other value sets it,
+    making the mappings on its path where they are missing); `settings` is not changed."""
+    out = copy.deepcopy(settings)
     for dotted, value in changes.items():
         node = out
-        parts = dotted.split(".")
-        for part in parts[:-1]:
+        *parents, last = dotted.split(".")
+        for part in parents:
             node = node.setdefault(part, {})
-        node[parts[-1]] = value
+        if value is None:
+            node.pop(last, None)
+        else:
+            node[last] = value
     return out
 
 

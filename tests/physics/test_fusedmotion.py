@@ -20,6 +20,8 @@ from uq.physics.measurement import measurement_model
 from uq.pipeline.modelsetup import error_inputs, scene_from_settings
 from uq.pipeline.scenario import load_scenario
 
+from conftest import with_changes as merged
+
 OUTPUTS = ("wind_speed", "wind_direction", "vertical_wind")
 VAD = [i * 7.2 for i in range(50)]
 TOLERANCE = 1e-12          # [m s-1] the module docstring's rounding bound
@@ -36,22 +38,6 @@ BASE = {"wind": {"speed": 12.0, "direction": 210.0, "vertical": 0.1, "shear": 0.
                 "roll": {"dist": "normal", "u": 0.1}, "sog": {"dist": "normal", "u": 0.05},
                 "cog": {"dist": "normal", "u": 1.0}},
         "correction": "pointwise"}
-
-
-def merged(base, changes):
-    out = {key: (dict(value) if isinstance(value, dict) else value)
-           for key, value in base.items()}
-    for dotted, value in changes.items():
-        node = out
-        *parents, last = dotted.split(".")
-        for part in parents:
-            node[part] = dict(node.get(part, {}))
-            node = node[part]
-        if value is None:
-            node.pop(last, None)
-        else:
-            node[last] = value
-    return out
 
 
 def both(changes, n=300, seed=7, scene_draws=False, batch=None):

@@ -23,6 +23,8 @@ from uq.pipeline.modelsetup import error_inputs, scene_from_settings
 from uq.pipeline.scenario import load_scenario
 from uq.pipeline.shipped import scenario_path
 
+from conftest import with_changes
+
 TOLERANCE = 1e-12           # [m s-1] the module docstring's rounding bound
 WIND = ("wind_speed", "wind_direction", "vertical_wind")
 #: Both kinds' parameters are given (as probe_volume does), so that either kind's errors
@@ -103,7 +105,7 @@ def test_static_tilted_and_drifting_with_every_error(probe, changes):
     """A tilted, drifting buoy; the first gate's probe reaches the sea (NaN where numpy
     has NaN); the truth per trial (geometry and probe errors) or per trial for the probe
     alone."""
-    settings = _without(TILTED, changes)
+    settings = with_changes(TILTED, changes)
     scenario = load_scenario(settings, {"lidar.probe": probe})
     scene, errors = trials(scenario, 300)
     outputs = WIND + ("radial_velocity", "gate_height")
@@ -151,19 +153,3 @@ def test_a_probe_complex_step_runs_the_numpy_model():
     gum = measurement_model(scene, WIND, **complex_errors)
     np.testing.assert_array_equal(gum["wind_speed"], measurement_model(
         scene, WIND, compiled=False, **complex_errors)["wind_speed"])
-
-
-def _without(settings, changes):
-    """A deep copy of `settings` with dotted keys set (None: removed)."""
-    import copy
-    out = copy.deepcopy(settings)
-    for dotted, value in changes.items():
-        node = out
-        *parents, last = dotted.split(".")
-        for part in parents:
-            node = node[part]
-        if value is None:
-            node.pop(last, None)
-        else:
-            node[last] = value
-    return out
