@@ -80,41 +80,54 @@ def transpose(values, reference, circular, out, offset):
                 out[e, offset + i] = value
 
 
+@njit(cache=True, nogil=True)
+def _column_moments(column):
+    """(count, mean, m2) of the finite values of the 1-D `column`: two passes, each
+    summed in :data:`LANES` interleaved partial sums, lane j % LANES (a fixed order).
+    A non-finite value adds +0.0 instead of being skipped: the same sums (a partial
+    sum that starts at +0.0 is never -0.0), and a loop without branches (SIMD)."""
+    n = column.shape[0]
+    body = n - n % LANES
+    s0 = s1 = s2 = s3 = 0.0
+    finite = 0
+    for j in range(0, body, LANES):
+        v0, v1, v2, v3 = column[j], column[j + 1], column[j + 2], column[j + 3]
+        f0, f1, f2, f3 = (math.isfinite(v0), math.isfinite(v1), math.isfinite(v2),
+                          math.isfinite(v3))
+        s0 += v0 if f0 else 0.0
+        s1 += v1 if f1 else 0.0
+        s2 += v2 if f2 else 0.0
+        s3 += v3 if f3 else 0.0
+        finite += f0 + f1 + f2 + f3
+    total = 0.0
+    for j in range(body, n):
+        if math.isfinite(column[j]):
+            total += column[j]
+            finite += 1
+    total += (s0 + s1) + (s2 + s3)
+    centre = total / finite if finite else 0.0
+    s0 = s1 = s2 = s3 = 0.0
+    for j in range(0, body, LANES):
+        d0, d1 = column[j] - centre, column[j + 1] - centre
+        d2, d3 = column[j + 2] - centre, column[j + 3] - centre
+        s0 += d0 * d0 if math.isfinite(column[j]) else 0.0
+        s1 += d1 * d1 if math.isfinite(column[j + 1]) else 0.0
+        s2 += d2 * d2 if math.isfinite(column[j + 2]) else 0.0
+        s3 += d3 * d3 if math.isfinite(column[j + 3]) else 0.0
+    square = 0.0
+    for j in range(body, n):
+        if math.isfinite(column[j]):
+            square += (column[j] - centre) * (column[j] - centre)
+    return finite, centre, square + ((s0 + s1) + (s2 + s3))
+
+
 @njit("void(float64[:, ::1], int64, int64, int64[::1], float64[::1], float64[::1])",
       cache=True, nogil=True)
 def moments(columns, start, stop, count, mean, m2):
     """Count, mean and sum of squared deviations of the finite values of
     columns[e, start:stop], for every element e."""
     for e in range(columns.shape[0]):
-        column = columns[e, start:stop]
-        n = column.shape[0]
-        sums = np.zeros(LANES)
-        finite = 0
-        for j in range(n - n % LANES):
-            lane = j % LANES
-            value = column[j]
-            if math.isfinite(value):
-                sums[lane] += value
-                finite += 1
-        total = 0.0
-        for j in range(n - n % LANES, n):
-            if math.isfinite(column[j]):
-                total += column[j]
-                finite += 1
-        total += (sums[0] + sums[1]) + (sums[2] + sums[3])
-        count[e] = finite
-        centre = total / finite if finite else 0.0
-        sums[:] = 0.0
-        for j in range(n - n % LANES):
-            value = column[j]
-            if math.isfinite(value):
-                sums[j % LANES] += (value - centre) * (value - centre)
-        square = 0.0
-        for j in range(n - n % LANES, n):
-            if math.isfinite(column[j]):
-                square += (column[j] - centre) * (column[j] - centre)
-        mean[e] = centre
-        m2[e] = square + ((sums[0] + sums[1]) + (sums[2] + sums[3]))
+        count[e], mean[e], m2[e] = _column_moments(columns[e, start:stop])
 
 
 @njit("void(float64[:, ::1], int64, int64, float64[::1], float64[::1], float64[::1])",
@@ -303,3 +316,276 @@ def comoments(values, count, mean, comoment):
         for a in range(g):
             for b in range(a):
                 comoment[s, a, b] = comoment[s, b, a]
+
+
+# --- one pass per batch: the store, the moments, the batch endpoints, the run's brackets
+
+#: Global-bracket states of an element (:func:`batch_pass`): not yet bracketed, counting
+#: (bracketed at the run's first batch), given up (the run's selection decides at the end).
+GLOBAL_UNSET, GLOBAL_COUNTING, GLOBAL_OFF = 0, 1, -1
+
+
+@njit(cache=True, nogil=True)
+def _run_margin(rank, n):
+    """Ranks either side of `rank` of n values whose values bracket the same quantile in
+    any other n values drawn alike, and in the whole run: 4 standard deviations of the
+    difference of two sample ranks, sqrt(2 n p (1 - p)) [1], plus 2."""
+    p = (rank + 0.5) / n
+    return int(_MARGIN_SIGMAS * math.sqrt(2.0 * n * p * (1.0 - p))) + 2
+
+
+@njit(cache=True, nogil=True)
+def symmetric_ranks(m, probability):
+    """0-based ranks (low, high) of the probabilistically symmetric endpoints among m
+    values, (-1, -1) without an interval (as :func:`uq.engine.statistics._symmetric_ranks`)."""
+    q = int(np.floor(probability * m + 0.5))             # JCGM 101 7.7.1
+    if m * (1 - probability) < 1 - 1e-9:
+        return -1, -1
+    r = (m - q) // 2 if (m - q) % 2 == 0 else (m - q + 1) // 2
+    return r - 1, r + q - 1
+
+
+@njit(cache=True, nogil=True)
+def _gather(column, bracket, below, kept, values):
+    """Add the values of `column` under each bracket (bracket[0:2], [2:4]) to below[0],
+    below[1] and append those inside to values[0, kept[0]:], values[1, kept[1]:].
+    Branch-free: every value is written, kept by the count; the last slot is a sink, so
+    the kept values are whole while kept < values.shape[1] (else an overflow, which
+    the caller detects: the count goes on)."""
+    low_a, low_b, high_a, high_b = bracket[0], bracket[1], bracket[2], bracket[3]
+    last = values.shape[1] - 1
+    b0, b1, k0, k1 = below[0], below[1], kept[0], kept[1]
+    for j in range(column.shape[0]):
+        value = column[j]
+        b0 += value < low_a
+        b1 += value < high_a
+        values[0, min(k0, last)] = value
+        k0 += (value >= low_a) & (value <= low_b)
+        values[1, min(k1, last)] = value
+        k1 += (value >= high_a) & (value <= high_b)
+    below[0], below[1], kept[0], kept[1] = b0, b1, k0, k1
+
+
+@njit(cache=True, nogil=True)
+def _from_kept(column, keep, below, kept, rank):
+    """The value of `rank` among `column` from the `kept` values of its bracket with
+    `below` values under it (reordered in place); all values partitioned (a copy) where
+    the bracket missed the rank or overflowed `keep`: exact either way."""
+    if below <= rank < below + kept and kept <= keep.shape[0]:
+        return _select(keep, rank - below, 0, kept)
+    return _select(column.copy(), rank, 0, column.shape[0])
+
+
+@njit(cache=True, nogil=True)
+def _first_pair(column, low_rank, high_rank, bracket, keep_low, keep_high):
+    """As :func:`_select_two` (a sorted prefix sample brackets the ranks), and the run's
+    brackets in bracket[0:4]: the values :func:`_run_margin` ranks either side of each
+    rank (NaN where they are not among the kept values)."""
+    n = column.shape[0]
+    size = min(ORDER_SAMPLE, max(32, int(4.0 * math.sqrt(n))), n)
+    sample = np.sort(column[:size].copy())
+    low_a, low_b = _bracket(low_rank, n, sample)
+    high_a, high_b = _bracket(high_rank, n, sample)
+    sample_bracket = np.array([low_a, low_b, high_a, high_b])
+    below, kept = np.zeros(2, dtype=np.int64), np.zeros(2, dtype=np.int64)
+    room = min(keep_low.shape[0], keep_high.shape[0])
+    keep = np.empty((2, room))
+    _gather(column, sample_bracket, below, kept, keep)
+    kept[0] = kept[0] if kept[0] < room else room + 1   # overflowed: all values then
+    kept[1] = kept[1] if kept[1] < room else room + 1
+    values = (_from_kept(column, keep[0], below[0], kept[0], low_rank),
+              _from_kept(column, keep[1], below[1], kept[1], high_rank))
+    bracket[:] = np.nan
+    for side, rank in enumerate((low_rank, high_rank)):
+        local, margin = rank - below[side], _run_margin(rank, n)
+        if kept[side] <= room and local - margin >= 0 and local + margin < kept[side]:
+            bracket[2 * side] = _select(keep[side], local - margin, 0, kept[side])
+            bracket[2 * side + 1] = _select(keep[side], local + margin, 0, kept[side])
+    return values
+
+
+@njit(cache=True, nogil=True)
+def _store_column(values, e, start, stop, reference, circular, out):
+    """out[i - start] = values[i, e] for i in [start, stop), unwrapped about
+    reference[e] for a circular output (as :func:`transpose`)."""
+    ref = reference[e] if circular else 0.0
+    for i in range(start, stop):
+        value = values[i, e]
+        if circular:
+            value = ref - _mod360(ref - value + HALF_CIRCLE_DEG) + HALF_CIRCLE_DEG
+        out[i - start] = value
+
+
+@njit(cache=True, nogil=True)
+def _column_resultant(column, ref, c, s):
+    """(sum cos d, sum sin d) of the finite deviations d = value - ref [deg] of
+    `column`, as :func:`resultant` adds them (c, s: scratch of its length)."""
+    n = column.shape[0]
+    for j in range(n):                   # no calls: SIMD
+        x = (column[j] - ref) * _DEG
+        x2 = x * x
+        s[j] = x * (_S[0] + x2 * (_S[1] + x2 * (_S[2] + x2 * (_S[3] + x2 * (
+            _S[4] + x2 * (_S[5] + x2 * (_S[6] + x2 * _S[7])))))))
+        c[j] = _C[0] + x2 * (_C[1] + x2 * (_C[2] + x2 * (_C[3] + x2 * (_C[4] + x2 * (
+            _C[5] + x2 * (_C[6] + x2 * (_C[7] + x2 * _C[8])))))))
+    sums = np.zeros(2 * LANES)
+    for j in range(n):
+        x = (column[j] - ref) * _DEG
+        if not math.isfinite(x):
+            continue                     # as numpy.nansum: NaN trials add nothing
+        if abs(x) > SMALL_ANGLE:         # libm beyond the polynomials' range
+            c[j], s[j] = math.cos(x), math.sin(x)
+        lane = j % LANES
+        sums[lane] += c[j]
+        sums[LANES + lane] += s[j]
+    return (sums[0] + sums[1]) + (sums[2] + sums[3]), (sums[4] + sums[5]) + (sums[6] + sums[7])
+
+
+@njit(cache=True, nogil=True)
+def _finite_copy(column, n_finite):
+    """The finite values of `column` (a new array of n_finite)."""
+    out = np.empty(n_finite)
+    _finite(column, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _sub_batch_pair(part, n_k, probability, first, state, bracket, below, kept, values,
+                    scratch):
+    """The symmetric endpoints of one sub-batch `part` with n_k finite values (NaN
+    without an interval), and its values counted and kept for the run's brackets: one
+    pass with the run's brackets, which bracket each sub-batch's ranks too (set at the
+    run's first sub-batch by :func:`_first_pair`)."""
+    size = part.shape[0]
+    low_rank, high_rank = symmetric_ranks(n_k, probability)
+    if state[0] == GLOBAL_COUNTING:
+        if n_k == size:
+            kept_before = kept.copy()
+            below_before = below.copy()
+            _gather(part, bracket, below, kept, values)
+            room = values.shape[1]
+            pair = np.empty(2)
+            for side, rank in enumerate((low_rank, high_rank)):
+                if rank < 0:
+                    pair[side] = np.nan
+                    continue
+                # the last slot is _gather's sink: kept values fill [0, room - 1)
+                end = min(kept[side], room - 1)
+                segment = values[side, min(kept_before[side], end):end]
+                n_kept = kept[side] - kept_before[side] if kept[side] < room else room
+                pair[side] = _from_kept(part, segment, below[side] - below_before[side],
+                                        n_kept, rank)
+            return pair[0], pair[1]
+        state[0] = GLOBAL_OFF                          # NaN among the values: given up
+    if low_rank < 0:
+        return np.nan, np.nan
+    if n_k < 2 * ORDER_SAMPLE:                         # few: partition them all
+        finite = _finite(part, scratch[0])
+        return (_select(scratch[0], low_rank, 0, finite),
+                _select(scratch[0], high_rank, low_rank, finite))
+    if n_k < size:                                     # NaN among them: the finite ones
+        return _select_two(_finite_copy(part, n_k), n_k, low_rank, high_rank, scratch[0],
+                           scratch[1])
+    if first and state[0] == GLOBAL_UNSET:
+        pair = _first_pair(part, low_rank, high_rank, bracket, scratch[0], scratch[1])
+        if not np.any(np.isnan(bracket)):
+            state[0] = GLOBAL_COUNTING
+            _gather(part, bracket, below, kept, values)
+        return pair
+    return _select_two(part, n_k, low_rank, high_rank, scratch[0], scratch[1])
+
+
+_PASS_SIG = types.void(
+    types.Array(types.float64, 2, "A", readonly=True), types.int64, types.int64,
+    types.float64[::1], types.boolean, types.boolean, types.float64[:, ::1], types.int64,
+    types.int64, types.float64,
+    types.int64[::1], types.float64[::1], types.float64[::1],
+    types.float64[::1], types.float64[::1],
+    types.int64[:, ::1], types.float64[:, ::1], types.float64[:, ::1],
+    types.float64[:, ::1], types.float64[:, ::1],
+    types.int64[::1], types.float64[:, ::1], types.int64[:, ::1], types.int64[:, ::1],
+    types.float64[:, :, ::1], types.float64[:, ::1])
+
+
+@njit(_PASS_SIG, cache=True, nogil=True)
+def batch_pass(values, start, stop, reference, circular, copy, columns, offset, size,
+               probability, count, mean, m2, cos_sum, sin_sum, sub_count, sub_mean,
+               sub_m2, low, high, global_state, global_brackets, global_below,
+               global_kept, global_values, scratch):
+    """Every statistic of the batch values[start:stop] (trials, elements), element by
+    element while its column is in the cache:
+
+    * with `copy`, the column stored in columns[e, offset + start:offset + stop]
+      (unwrapped for a circular output; else it is there already);
+    * count[e], mean[e], m2[e]: the batch's moments (:func:`moments`);
+    * cos_sum[e], sin_sum[e] += the circular resultant (:func:`resultant`);
+    * with `size` > 0, per full sub-batch k of `size` trials: sub_count, sub_mean,
+      sub_m2 [k, e] (the batch's own where `size` is the batch) and the probabilistically
+      symmetric endpoints low, high [k, e] (NaN without an interval) at `probability`
+      (:func:`_sub_batch_pair`);
+    * the run's brackets of each element (global_brackets[e]: the values of its first
+      sub-batch :func:`_run_margin` ranks either side of each endpoint's rank, which
+      bracket that rank in every sub-batch and in the run): every value is counted
+      below them or kept inside (global_below, global_kept, global_values [e, side]),
+      in the same pass that selects the sub-batch's endpoints among the kept; the
+      run's endpoints are then selected among these few (:func:`global_pairs`). An
+      element without brackets after the run's first batch (or with NaN values) gives
+      up (GLOBAL_OFF): the run's selection decides.
+
+    scratch (2, k): the kept values of a sub-batch, k >= 2 ORDER_SAMPLE and >= size / 8.
+    The results do not depend on the brackets (exact selection), only the time does."""
+    m = stop - start
+    first = offset + start == 0
+    c = np.empty(m if circular else 0)
+    s = np.empty(m if circular else 0)
+    parts = m // size if size > 0 else 0
+    for e in range(columns.shape[0]):
+        column = columns[e, offset + start:offset + stop]
+        if copy:
+            _store_column(values, e, start, stop, reference, circular, column)
+        count[e], mean[e], m2[e] = _column_moments(column)
+        if circular:
+            cos_part, sin_part = _column_resultant(column, reference[e], c, s)
+            cos_sum[e] += cos_part
+            sin_sum[e] += sin_part
+        for k in range(parts):
+            part = column[k * size:(k + 1) * size]
+            if size == m:
+                n_k, mean_k, m2_k = count[e], mean[e], m2[e]
+            else:
+                n_k, mean_k, m2_k = _column_moments(part)
+            sub_count[k, e], sub_mean[k, e], sub_m2[k, e] = n_k, mean_k, m2_k
+            low[k, e], high[k, e] = _sub_batch_pair(
+                part, n_k, probability, first and k == 0, global_state[e:e + 1],
+                global_brackets[e], global_below[e], global_kept[e], global_values[e],
+                scratch)
+        if global_state[e] == GLOBAL_UNSET:
+            global_state[e] = GLOBAL_OFF
+        if global_state[e] == GLOBAL_COUNTING and parts * size < m:   # the rest
+            _gather(column[parts * size:], global_brackets[e], global_below[e],
+                    global_kept[e], global_values[e])
+
+
+@njit("void(float64[:, :, ::1], int64[:, ::1], int64[:, ::1], int64[::1], int64[::1], "
+      "float64[::1], float64[::1], boolean[::1])", cache=True, nogil=True)
+def global_pairs(global_values, global_below, global_kept, low_rank, high_rank, low,
+                 high, found):
+    """low[e], high[e]: the values of 0-based ranks low_rank[e], high_rank[e] of the
+    run, from the values kept inside the run's brackets (:func:`batch_pass`); found[e]
+    False where a rank is not among them or they overflowed (the caller selects among
+    all values). The kept values are reordered in place (a multiset: later batches may
+    add to them)."""
+    room = global_values.shape[2]
+    for e in range(global_values.shape[0]):
+        found[e] = False
+        if low_rank[e] < 0:
+            continue
+        below_low, kept_low = global_below[e, 0], global_kept[e, 0]
+        below_high, kept_high = global_below[e, 1], global_kept[e, 1]
+        if not (below_low <= low_rank[e] < below_low + kept_low and kept_low < room):
+            continue
+        if not (below_high <= high_rank[e] < below_high + kept_high and kept_high < room):
+            continue
+        low[e] = _select(global_values[e, 0], low_rank[e] - below_low, 0, kept_low)
+        high[e] = _select(global_values[e, 1], high_rank[e] - below_high, 0, kept_high)
+        found[e] = True
