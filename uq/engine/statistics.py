@@ -547,21 +547,21 @@ class _RunBrackets:
     the values fall inside (the brackets span 4 standard deviations of a sample rank
     either side of it)."""
 
-    #: Room for the kept values, as a fraction of the trials.
-    ROOM_FRACTION = 0.125
+    #: Room for the kept values, as a fraction of the trials, and at least.
+    ROOM_FRACTION, MIN_ROOM = 0.125, 4096
 
     def __init__(self, size, expected):
         self.brackets = np.full((size, 4), np.nan)
         self.state = np.zeros(size, dtype=np.int64)
         self.below = np.zeros((size, 2), dtype=np.int64)
         self.kept = np.zeros((size, 2), dtype=np.int64)
-        self.values = np.empty((size, 2, int(self.ROOM_FRACTION * expected) + 4096))
+        self.values = np.empty((size, 2, int(self.ROOM_FRACTION * expected) + self.MIN_ROOM))
         self.counted = 0
 
     def make_room(self, m):
         """Room for m more trials' kept values (grown by doubling; an overflow is
         detected, and exact anyway)."""
-        need = int(self.kept.max(initial=0) + self.ROOM_FRACTION * m) + 4096
+        need = int(self.kept.max(initial=0) + self.ROOM_FRACTION * m) + self.MIN_ROOM
         if need > self.values.shape[2]:
             grown = np.empty(self.values.shape[:2] + (max(need, 2 * self.values.shape[2]),))
             used = min(int(self.kept.max()), self.values.shape[2])

@@ -286,36 +286,39 @@ def scratch_length(n):
                  types.float64[:, ::1], types.float64[:, :, ::1]), cache=True, nogil=True)
 def comoments(values, count, mean, comoment):
     """For values (m, S, g): per s, the count of trials whose g values are all finite,
-    their mean (g) and the sum of products of their deviations (g, g), two passes."""
+    their mean (g) and the sum of products of their deviations (g, g), two passes. Each
+    sum runs over the trials in order from 0.0 (the same sums in any loop order); the
+    completeness test is skipped where every trial is complete."""
     m, scenes, g = values.shape
+    complete = np.empty(m, dtype=np.bool_)
+    sums = np.empty(g)
     for s in range(scenes):
         n = 0
-        mean[s, :] = 0.0
         for i in range(m):
-            complete = True
+            ok = True
             for a in range(g):
-                complete = complete and math.isfinite(values[i, s, a])
-            if complete:
-                n += 1
-                for a in range(g):
-                    mean[s, a] += values[i, s, a]
+                ok = ok and math.isfinite(values[i, s, a])
+            complete[i] = ok
+            n += ok
         count[s] = n
-        for a in range(g):
-            mean[s, a] = mean[s, a] / n if n else 0.0
-        comoment[s, :, :] = 0.0
+        sums[:] = 0.0
         for i in range(m):
-            complete = True
-            for a in range(g):
-                complete = complete and math.isfinite(values[i, s, a])
-            if not complete:
-                continue
-            for a in range(g):
-                deviation = values[i, s, a] - mean[s, a]
-                for b in range(a, g):
-                    comoment[s, a, b] += deviation * (values[i, s, b] - mean[s, b])
+            if n == m or complete[i]:
+                for a in range(g):
+                    sums[a] += values[i, s, a]
         for a in range(g):
-            for b in range(a):
-                comoment[s, a, b] = comoment[s, b, a]
+            mean[s, a] = sums[a] / n if n else 0.0
+        for a in range(g):
+            sums[:] = 0.0
+            centre = mean[s, a]
+            for i in range(m):
+                if n == m or complete[i]:
+                    deviation = values[i, s, a] - centre
+                    for b in range(a, g):
+                        sums[b] += deviation * (values[i, s, b] - mean[s, b])
+            for b in range(a, g):
+                comoment[s, a, b] = sums[b]
+                comoment[s, b, a] = sums[b]
 
 
 # --- one pass per batch: the store, the moments, the batch endpoints, the run's brackets
@@ -348,22 +351,32 @@ def symmetric_ranks(m, probability):
 @njit(cache=True, nogil=True)
 def _gather(column, bracket, below, kept, values):
     """Add the values of `column` under each bracket (bracket[0:2], [2:4]) to below[0],
-    below[1] and append those inside to values[0, kept[0]:], values[1, kept[1]:].
-    Branch-free: every value is written, kept by the count; the last slot is a sink, so
-    the kept values are whole while kept < values.shape[1] (else an overflow, which
-    the caller detects: the count goes on)."""
+    below[1] and append those inside to values[0, kept[0]:], values[1, kept[1]:]. A
+    counting pass (SIMD), then a gathering pass where they fit; where they do not, the
+    counts go on without them (kept >= values.shape[1]: an overflow the caller sees)."""
     low_a, low_b, high_a, high_b = bracket[0], bracket[1], bracket[2], bracket[3]
-    last = values.shape[1] - 1
-    b0, b1, k0, k1 = below[0], below[1], kept[0], kept[1]
-    for j in range(column.shape[0]):
+    n = column.shape[0]
+    b0 = b1 = i0 = i1 = 0
+    for j in range(n):
         value = column[j]
         b0 += value < low_a
+        i0 += value <= low_b
         b1 += value < high_a
-        values[0, min(k0, last)] = value
-        k0 += (value >= low_a) & (value <= low_b)
-        values[1, min(k1, last)] = value
-        k1 += (value >= high_a) & (value <= high_b)
-    below[0], below[1], kept[0], kept[1] = b0, b1, k0, k1
+        i1 += value <= high_b
+    k0, k1 = kept[0], kept[1]
+    if k0 + i0 - b0 < values.shape[1] and k1 + i1 - b1 < values.shape[1]:
+        for j in range(n):
+            value = column[j]
+            if value <= low_b and value >= low_a:
+                values[0, k0] = value
+                k0 += 1
+            if value >= high_a and value <= high_b:
+                values[1, k1] = value
+                k1 += 1
+    below[0] += b0
+    below[1] += b1
+    kept[0] += i0 - b0
+    kept[1] += i1 - b1
 
 
 @njit(cache=True, nogil=True)
@@ -469,10 +482,9 @@ def _sub_batch_pair(part, n_k, probability, first, state, bracket, below, kept, 
                 if rank < 0:
                     pair[side] = np.nan
                     continue
-                # the last slot is _gather's sink: kept values fill [0, room - 1)
-                end = min(kept[side], room - 1)
+                end = min(kept[side], room)
                 segment = values[side, min(kept_before[side], end):end]
-                n_kept = kept[side] - kept_before[side] if kept[side] < room else room
+                n_kept = kept[side] - kept_before[side] if kept[side] < room else room + 1
                 pair[side] = _from_kept(part, segment, below[side] - below_before[side],
                                         n_kept, rank)
             return pair[0], pair[1]
