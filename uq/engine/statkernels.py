@@ -130,6 +130,31 @@ def moments(columns, start, stop, count, mean, m2):
         count[e], mean[e], m2[e] = _column_moments(columns[e, start:stop])
 
 
+@njit(cache=True, nogil=True)
+def _column_resultant(column, ref, c, s):
+    """(sum cos d, sum sin d) of the finite deviations d = value - ref [deg] of
+    `column`, as :func:`resultant` adds them (c, s: scratch of its length)."""
+    n = column.shape[0]
+    for j in range(n):                   # no calls: SIMD
+        x = (column[j] - ref) * _DEG
+        x2 = x * x
+        s[j] = x * (_S[0] + x2 * (_S[1] + x2 * (_S[2] + x2 * (_S[3] + x2 * (
+            _S[4] + x2 * (_S[5] + x2 * (_S[6] + x2 * _S[7])))))))
+        c[j] = _C[0] + x2 * (_C[1] + x2 * (_C[2] + x2 * (_C[3] + x2 * (_C[4] + x2 * (
+            _C[5] + x2 * (_C[6] + x2 * (_C[7] + x2 * _C[8])))))))
+    sums = np.zeros(2 * LANES)
+    for j in range(n):
+        x = (column[j] - ref) * _DEG
+        if not math.isfinite(x):
+            continue                     # as numpy.nansum: NaN trials add nothing
+        if abs(x) > SMALL_ANGLE:         # libm beyond the polynomials' range
+            c[j], s[j] = math.cos(x), math.sin(x)
+        lane = j % LANES
+        sums[lane] += c[j]
+        sums[LANES + lane] += s[j]
+    return (sums[0] + sums[1]) + (sums[2] + sums[3]), (sums[4] + sums[5]) + (sums[6] + sums[7])
+
+
 @njit("void(float64[:, ::1], int64, int64, float64[::1], float64[::1], float64[::1])",
       cache=True, nogil=True)
 def resultant(columns, start, stop, reference, cos_sum, sin_sum):
@@ -140,30 +165,12 @@ def resultant(columns, start, stop, reference, cos_sum, sin_sum):
     c = np.empty(n)
     s = np.empty(n)
     for e in range(columns.shape[0]):
-        column = columns[e, start:stop]
-        ref = reference[e]
-        for j in range(n):                   # no calls: SIMD
-            x = (column[j] - ref) * _DEG
-            x2 = x * x
-            s[j] = x * (_S[0] + x2 * (_S[1] + x2 * (_S[2] + x2 * (_S[3] + x2 * (
-                _S[4] + x2 * (_S[5] + x2 * (_S[6] + x2 * _S[7])))))))
-            c[j] = _C[0] + x2 * (_C[1] + x2 * (_C[2] + x2 * (_C[3] + x2 * (_C[4] + x2 * (
-                _C[5] + x2 * (_C[6] + x2 * (_C[7] + x2 * _C[8])))))))
-        sums = np.zeros(2 * LANES)
-        for j in range(n):
-            x = (column[j] - ref) * _DEG
-            if not math.isfinite(x):
-                continue                     # as numpy.nansum: NaN trials add nothing
-            if abs(x) > SMALL_ANGLE:         # libm beyond the polynomials' range
-                c[j], s[j] = math.cos(x), math.sin(x)
-            lane = j % LANES
-            sums[lane] += c[j]
-            sums[LANES + lane] += s[j]
-        cos_sum[e] += (sums[0] + sums[1]) + (sums[2] + sums[3])
-        sin_sum[e] += (sums[4] + sums[5]) + (sums[6] + sums[7])
+        cos_part, sin_part = _column_resultant(columns[e, start:stop], reference[e], c, s)
+        cos_sum[e] += cos_part
+        sin_sum[e] += sin_part
 
 
-@njit(cache=True, nogil=True)
+@njit("float64(float64[::1], int64, int64, int64)", cache=True, nogil=True)
 def _select(values, rank, low, high):
     """The value of 0-based `rank` of values[low:high] (reordered in place): Hoare's
     selection with a median-of-three pivot."""
@@ -192,12 +199,25 @@ def _select(values, rank, low, high):
 
 @njit(cache=True, nogil=True)
 def _bracket(rank, n, sample):
-    """Sample values (a, b) that enclose `rank` of n with a margin (+-inf at the ends)."""
+    """Sample values (a, b) that enclose `rank` of n with a margin (+-inf at the ends):
+    order statistics of the (unsorted) sample, by selection (reordering it)."""
     s = sample.shape[0]
     p = (rank + 0.5) / n
     margin = _MARGIN_SIGMAS * math.sqrt(s * p * (1.0 - p)) + 1.0
     first, last = math.floor(p * s - margin), math.ceil(p * s + margin)
-    return (sample[first] if first >= 0 else -np.inf), (sample[last] if last < s else np.inf)
+    return (_select(sample, first, 0, s) if first >= 0 else -np.inf), \
+        (_select(sample, last, 0, s) if last < s else np.inf)
+
+
+@njit(cache=True, nogil=True)
+def _sample_brackets(column, n_finite, low_rank, high_rank):
+    """(low_a, low_b, high_a, high_b): brackets of the two ranks of n_finite values from
+    the first ~4 sqrt(n) values of `column` (at most ORDER_SAMPLE), a sample of them."""
+    size = min(ORDER_SAMPLE, max(32, int(4.0 * math.sqrt(n_finite))), column.shape[0])
+    sample = column[:size].copy()
+    low_a, low_b = _bracket(low_rank, n_finite, sample)
+    high_a, high_b = _bracket(high_rank, n_finite, sample)
+    return low_a, low_b, high_a, high_b
 
 
 @njit(cache=True, nogil=True)
@@ -211,10 +231,7 @@ def _select_two(column, n_finite, low_rank, high_rank, keep_low, keep_high):
     overflow the buffer (rare; or an ordered column), all values are partitioned (in a
     fresh array): exact either way."""
     n = column.shape[0]
-    size = min(ORDER_SAMPLE, max(32, int(4.0 * math.sqrt(n_finite))), n)
-    sample = np.sort(column[:size].copy())
-    low_a, low_b = _bracket(low_rank, n_finite, sample)
-    high_a, high_b = _bracket(high_rank, n_finite, sample)
+    low_a, low_b, high_a, high_b = _sample_brackets(column, n_finite, low_rank, high_rank)
     below_low = below_high = kept_low = kept_high = 0
     last_low, last_high = keep_low.shape[0] - 1, keep_high.shape[0] - 1
     for j in range(n):              # branch-free: every value is written, kept by the count
@@ -353,7 +370,8 @@ def _gather(column, bracket, below, kept, values):
     """Add the values of `column` under each bracket (bracket[0:2], [2:4]) to below[0],
     below[1] and append those inside to values[0, kept[0]:], values[1, kept[1]:]. A
     counting pass (SIMD), then a gathering pass where they fit; where they do not, the
-    counts go on without them (kept >= values.shape[1]: an overflow the caller sees)."""
+    counts go on without them and both sides are marked overflowed (kept >=
+    values.shape[1]), which the callers check."""
     low_a, low_b, high_a, high_b = bracket[0], bracket[1], bracket[2], bracket[3]
     n = column.shape[0]
     b0 = b1 = i0 = i1 = 0
@@ -364,19 +382,22 @@ def _gather(column, bracket, below, kept, values):
         b1 += value < high_a
         i1 += value <= high_b
     k0, k1 = kept[0], kept[1]
-    if k0 + i0 - b0 < values.shape[1] and k1 + i1 - b1 < values.shape[1]:
-        for j in range(n):
-            value = column[j]
-            if value <= low_b and value >= low_a:
-                values[0, k0] = value
-                k0 += 1
-            if value >= high_a and value <= high_b:
-                values[1, k1] = value
-                k1 += 1
+    room = values.shape[1]
     below[0] += b0
     below[1] += b1
-    kept[0] += i0 - b0
-    kept[1] += i1 - b1
+    if k0 + i0 - b0 >= room or k1 + i1 - b1 >= room:   # both sides marked overflowed
+        kept[0] = max(k0 + i0 - b0, room)
+        kept[1] = max(k1 + i1 - b1, room)
+        return
+    for j in range(n):
+        value = column[j]
+        if value <= low_b and value >= low_a:
+            values[0, k0] = value
+            k0 += 1
+        if value >= high_a and value <= high_b:
+            values[1, k1] = value
+            k1 += 1
+    kept[0], kept[1] = k0, k1
 
 
 @njit(cache=True, nogil=True)
@@ -395,11 +416,7 @@ def _first_pair(column, low_rank, high_rank, bracket, keep_low, keep_high):
     brackets in bracket[0:4]: the values :func:`_run_margin` ranks either side of each
     rank (NaN where they are not among the kept values)."""
     n = column.shape[0]
-    size = min(ORDER_SAMPLE, max(32, int(4.0 * math.sqrt(n))), n)
-    sample = np.sort(column[:size].copy())
-    low_a, low_b = _bracket(low_rank, n, sample)
-    high_a, high_b = _bracket(high_rank, n, sample)
-    sample_bracket = np.array([low_a, low_b, high_a, high_b])
+    sample_bracket = np.array(_sample_brackets(column, n, low_rank, high_rank))
     below, kept = np.zeros(2, dtype=np.int64), np.zeros(2, dtype=np.int64)
     room = min(keep_low.shape[0], keep_high.shape[0])
     keep = np.empty((2, room))
@@ -430,36 +447,23 @@ def _store_column(values, e, start, stop, reference, circular, out):
 
 
 @njit(cache=True, nogil=True)
-def _column_resultant(column, ref, c, s):
-    """(sum cos d, sum sin d) of the finite deviations d = value - ref [deg] of
-    `column`, as :func:`resultant` adds them (c, s: scratch of its length)."""
-    n = column.shape[0]
-    for j in range(n):                   # no calls: SIMD
-        x = (column[j] - ref) * _DEG
-        x2 = x * x
-        s[j] = x * (_S[0] + x2 * (_S[1] + x2 * (_S[2] + x2 * (_S[3] + x2 * (
-            _S[4] + x2 * (_S[5] + x2 * (_S[6] + x2 * _S[7])))))))
-        c[j] = _C[0] + x2 * (_C[1] + x2 * (_C[2] + x2 * (_C[3] + x2 * (_C[4] + x2 * (
-            _C[5] + x2 * (_C[6] + x2 * (_C[7] + x2 * _C[8])))))))
-    sums = np.zeros(2 * LANES)
-    for j in range(n):
-        x = (column[j] - ref) * _DEG
-        if not math.isfinite(x):
-            continue                     # as numpy.nansum: NaN trials add nothing
-        if abs(x) > SMALL_ANGLE:         # libm beyond the polynomials' range
-            c[j], s[j] = math.cos(x), math.sin(x)
-        lane = j % LANES
-        sums[lane] += c[j]
-        sums[LANES + lane] += s[j]
-    return (sums[0] + sums[1]) + (sums[2] + sums[3]), (sums[4] + sums[5]) + (sums[6] + sums[7])
-
-
-@njit(cache=True, nogil=True)
 def _finite_copy(column, n_finite):
     """The finite values of `column` (a new array of n_finite)."""
     out = np.empty(n_finite)
     _finite(column, out)
     return out
+
+
+@njit(cache=True, nogil=True)
+def _segment_value(part, kept_values, below, first, end, rank):
+    """The value of `rank` (-1: NaN) of `part`, whose values inside its bracket are
+    kept_values[first:end] with `below` values under it (all values decide where the
+    bracket missed the rank or the kept values overflowed their room)."""
+    if rank < 0:
+        return np.nan
+    if end >= kept_values.shape[0]:                     # overflowed: not all kept
+        return _select(part.copy(), rank, 0, part.shape[0])
+    return _from_kept(part, kept_values[first:end], below, end - first, rank)
 
 
 @njit(cache=True, nogil=True)
@@ -473,21 +477,12 @@ def _sub_batch_pair(part, n_k, probability, first, state, bracket, below, kept, 
     low_rank, high_rank = symmetric_ranks(n_k, probability)
     if state[0] == GLOBAL_COUNTING:
         if n_k == size:
-            kept_before = kept.copy()
-            below_before = below.copy()
+            below_low, below_high, kept_low, kept_high = below[0], below[1], kept[0], kept[1]
             _gather(part, bracket, below, kept, values)
-            room = values.shape[1]
-            pair = np.empty(2)
-            for side, rank in enumerate((low_rank, high_rank)):
-                if rank < 0:
-                    pair[side] = np.nan
-                    continue
-                end = min(kept[side], room)
-                segment = values[side, min(kept_before[side], end):end]
-                n_kept = kept[side] - kept_before[side] if kept[side] < room else room + 1
-                pair[side] = _from_kept(part, segment, below[side] - below_before[side],
-                                        n_kept, rank)
-            return pair[0], pair[1]
+            return (_segment_value(part, values[0], below[0] - below_low, kept_low, kept[0],
+                                   low_rank),
+                    _segment_value(part, values[1], below[1] - below_high, kept_high,
+                                   kept[1], high_rank))
         state[0] = GLOBAL_OFF                          # NaN among the values: given up
     if low_rank < 0:
         return np.nan, np.nan
@@ -500,7 +495,8 @@ def _sub_batch_pair(part, n_k, probability, first, state, bracket, below, kept, 
                            scratch[1])
     if first and state[0] == GLOBAL_UNSET:
         pair = _first_pair(part, low_rank, high_rank, bracket, scratch[0], scratch[1])
-        if not np.any(np.isnan(bracket)):
+        if not (math.isnan(bracket[0]) or math.isnan(bracket[1]) or math.isnan(bracket[2])
+                or math.isnan(bracket[3])):
             state[0] = GLOBAL_COUNTING
             _gather(part, bracket, below, kept, values)
         return pair
