@@ -299,6 +299,46 @@ def scratch_length(n):
     return max(2 * ORDER_SAMPLE, n // 8)
 
 
+@njit(cache=True, nogil=True)
+def _complete_comoments(values, s, mean, comoment):
+    """mean[s] and comoment[s] of values[:, s, :] (m, g), every trial complete: each sum
+    runs over the trials in order from 0.0, as in :func:`comoments`, four sums per pass
+    in registers (independent chains) instead of g sums in memory."""
+    m, g = values.shape[0], values.shape[2]
+    for a0 in range(0, g, 4):
+        a1, a2, a3 = min(a0 + 1, g - 1), min(a0 + 2, g - 1), min(a0 + 3, g - 1)
+        t0 = t1 = t2 = t3 = 0.0
+        for i in range(m):
+            t0 += values[i, s, a0]
+            t1 += values[i, s, a1]
+            t2 += values[i, s, a2]
+            t3 += values[i, s, a3]
+        for a, total in ((a0, t0), (a1, t1), (a2, t2), (a3, t3)):
+            mean[s, a] = total / m
+    pairs = np.empty((g * (g + 1) // 2, 2), dtype=np.int64)
+    p = 0
+    for a in range(g):
+        for b in range(a, g):
+            pairs[p, 0], pairs[p, 1] = a, b
+            p += 1
+    last = pairs.shape[0] - 1
+    for p0 in range(0, pairs.shape[0], 4):
+        p1, p2, p3 = min(p0 + 1, last), min(p0 + 2, last), min(p0 + 3, last)
+        a0, b0, a1, b1 = pairs[p0, 0], pairs[p0, 1], pairs[p1, 0], pairs[p1, 1]
+        a2, b2, a3, b3 = pairs[p2, 0], pairs[p2, 1], pairs[p3, 0], pairs[p3, 1]
+        c0, d0, c1, d1 = mean[s, a0], mean[s, b0], mean[s, a1], mean[s, b1]
+        c2, d2, c3, d3 = mean[s, a2], mean[s, b2], mean[s, a3], mean[s, b3]
+        t0 = t1 = t2 = t3 = 0.0
+        for i in range(m):
+            t0 += (values[i, s, a0] - c0) * (values[i, s, b0] - d0)
+            t1 += (values[i, s, a1] - c1) * (values[i, s, b1] - d1)
+            t2 += (values[i, s, a2] - c2) * (values[i, s, b2] - d2)
+            t3 += (values[i, s, a3] - c3) * (values[i, s, b3] - d3)
+        for q, total in ((p0, t0), (p1, t1), (p2, t2), (p3, t3)):
+            comoment[s, pairs[q, 0], pairs[q, 1]] = total
+            comoment[s, pairs[q, 1], pairs[q, 0]] = total
+
+
 @njit(types.void(types.Array(types.float64, 3, "A", readonly=True), types.int64[::1],
                  types.float64[:, ::1], types.float64[:, :, ::1]), cache=True, nogil=True)
 def comoments(values, count, mean, comoment):
@@ -318,9 +358,12 @@ def comoments(values, count, mean, comoment):
             complete[i] = ok
             n += ok
         count[s] = n
+        if n == m and m > 0:             # every trial complete: sums in registers
+            _complete_comoments(values, s, mean, comoment)
+            continue
         sums[:] = 0.0
         for i in range(m):
-            if n == m or complete[i]:
+            if complete[i]:
                 for a in range(g):
                     sums[a] += values[i, s, a]
         for a in range(g):
@@ -329,7 +372,7 @@ def comoments(values, count, mean, comoment):
             sums[:] = 0.0
             centre = mean[s, a]
             for i in range(m):
-                if n == m or complete[i]:
+                if complete[i]:
                     deviation = values[i, s, a] - centre
                     for b in range(a, g):
                         sums[b] += deviation * (values[i, s, b] - mean[s, b])
