@@ -6,7 +6,11 @@
   statistics of rank about (1 - p) M / 2 and (1 + p) M / 2, so only the
   ``M - q + 1`` smallest and largest values (q = round(p M)) are kept: 5 % of the
   samples on each side at p = 0.95, exact, not an approximation. The probabilistically
-  symmetric and the shortest intervals both follow from them.
+  symmetric and the shortest intervals both follow from them. While every value is
+  stored, the symmetric endpoints of each batch (JCGM 101 7.9's standard errors) and of
+  the run are selected among the values inside brackets set at the run's first batch
+  (:func:`uq.engine.statkernels.batch_pass`): one pass per batch, ~1 % of the values
+  partitioned, the exact order statistics.
 * Circular outputs (directions [deg]) are unwrapped into ``reference +- 180`` before
   anything else; the reference is the model value at the input means. Their mean and
   interval endpoints are then wrapped to [0, 360). The circular standard deviation

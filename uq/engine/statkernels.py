@@ -17,7 +17,15 @@ columns that stay in the cache:
 * :func:`select_pairs`: the two order statistics of the probabilistically symmetric
   interval of each element, exact, by sample-bracketed selection (Floyd and Rivest
   1975; as :mod:`uq.engine.orderstats`): one pass counts the values below each bracket
-  and keeps those inside it, and only these are partitioned.
+  and keeps those inside it, and only these are partitioned;
+* :func:`batch_pass`: all of the above for one batch, element by element while its
+  column is in the cache (stored, moments, resultant, the sub-batches' endpoints),
+  with the run's brackets: the values of the run's first sub-batch 4 standard
+  deviations of a sample rank either side of each endpoint's rank bracket that rank in
+  every later sub-batch and in the whole run, so one counting pass per sub-batch serves
+  both selections, and :func:`global_pairs` selects the run's endpoints among the ~1 %
+  of values kept inside (the run's selection over all values where a bracket missed).
+  Every result is the exact order statistic; the brackets change only the time.
 
 References
 ----------
