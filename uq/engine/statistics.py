@@ -350,7 +350,9 @@ class StreamingStatistics:
         if not copy:                                 # trial-major: tiles of trials
             _kernels().transpose(flat, reference, circular, columns, offset)
         if self._run is None:
-            self._run = _RunBrackets(self.size, self._expected or m)
+            # (the values stored at most: the room is a fraction of the store's)
+            self._run = _RunBrackets(self.size, min(self._expected or m,
+                                                    self._budget // max(self.size, 1)))
         run = self._run
         size = size if summarize else 0
         count, mean, m2 = (np.empty(self.size, dtype=np.int64), np.empty(self.size),
@@ -475,6 +477,7 @@ class StreamingStatistics:
         """Hand the stored values to the tails (the memory bound of long runs)."""
         self._low = [_Tail(self.capacity) for _ in range(self.size)]
         self._high = [_Tail(self.capacity) for _ in range(self.size)]      # holds -values
+        self._run = None                            # the tails decide from now on
         for start in range(0, self._count, _SPILL_VALUES):   # bounded temporaries
             self._add_to_tails(self._columns[:, start:min(self._count,
                                                           start + _SPILL_VALUES)].T)
@@ -547,12 +550,13 @@ class _RunBrackets:
     the values counted below them (``below``, (elements, 2)), the values kept inside
     (``values``, (elements, 2, room); ``kept`` counts them, on past the room: an
     overflow), the state of each element, and the trials counted (``counted``; -1 once
-    values went by without being counted). Memory is reserved, not touched: ~1-5 % of
-    the values fall inside (the brackets span 4 standard deviations of a sample rank
-    either side of it)."""
+    values went by without being counted). ~1-5 % of the values fall inside (the
+    brackets span 4 standard deviations of a sample rank either side of it): the room
+    is an eighth of the stored values (grown where needed), so at most an eighth more
+    memory than the store."""
 
     #: Room for the kept values, as a fraction of the trials, and at least.
-    ROOM_FRACTION, MIN_ROOM = 0.125, 4096
+    ROOM_FRACTION, MIN_ROOM = 0.125, 64
 
     def __init__(self, size, expected):
         self.brackets = np.full((size, 4), np.nan)
