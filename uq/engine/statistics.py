@@ -32,7 +32,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from uq.constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG, STORED_VALUES
+from uq.constants import (COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG,
+                          ONE_PASS_MIN_TRIALS, STORED_VALUES)
 from uq.engine.orderstats import order_statistics
 
 INTERVALS = ("symmetric", "shortest")
@@ -45,6 +46,13 @@ def _kernels():
     only reads a scenario (``uq fit``, ``uq check``) must not pay."""
     from uq.engine import statkernels
     return statkernels
+
+
+def _pass_kernels():
+    """:mod:`uq.engine.passkernels`, imported at the first long run's statistics (their
+    compile, ~2 s after an install, is for runs of ONE_PASS_MIN_TRIALS and more)."""
+    from uq.engine import passkernels
+    return passkernels
 
 
 def unwrap(values, reference):
@@ -302,7 +310,7 @@ class StreamingStatistics:
         values = np.asarray(values, dtype=float)
         m = len(values)
         flat = values.reshape(m, self.size)          # (a view where the layout allows)
-        if kind == "symmetric" and self._stored:
+        if kind == "symmetric" and self._stored and self._expected >= ONE_PASS_MIN_TRIALS:
             return self._add_in_one_pass(flat, batch_size, summarize,
                                          min(summary_size or batch_size, batch_size))
         if self._run is not None:
@@ -368,7 +376,7 @@ class StreamingStatistics:
                    np.empty((parts, self.size)), np.empty((parts, self.size)))
             low, high = np.empty((parts, self.size)), np.empty((parts, self.size))
             run.make_room(stop - start)
-            _kernels().batch_pass(flat, start, stop, reference, circular, copy, columns,
+            _pass_kernels().batch_pass(flat, start, stop, reference, circular, copy, columns,
                                   offset, size, COVERAGE_PROBABILITY, count, mean, m2,
                                   self._cos, self._sin, *sub, low, high,
                                   run.state, run.brackets, run.below, run.kept, run.values,
@@ -462,9 +470,9 @@ class StreamingStatistics:
         found = np.zeros(self.size, dtype=bool)
         run = self._run
         if run is not None and run.counted == self._count:
-            usable = (run.state == _kernels().GLOBAL_COUNTING) & (count == self._count)
+            usable = (run.state == _pass_kernels().GLOBAL_COUNTING) & (count == self._count)
             low_rank = np.where(usable, ranks[:, 0], -1).astype(np.int64)
-            _kernels().global_pairs(run.values, run.below, run.kept, low_rank,
+            _pass_kernels().global_pairs(run.values, run.below, run.kept, low_rank,
                                     ranks[:, 1].copy(), low, high, found)
         missing = np.flatnonzero(~found)
         if len(missing):
