@@ -177,6 +177,13 @@ MODEL_SLICE_VALUES = 2**18
 #: statistics), which is ~3x cheaper than maintaining the tails batch by batch; above it
 #: memory stays bounded (10^8 trials).
 STORED_VALUES = 2**23
+#: Trials of a run from which its statistics take each batch in one compiled pass with
+#: the run's brackets (:mod:`uq.engine.passkernels`: at 2^19 trials of
+#: ``floating_lidar_full`` the statistics cost half as much CPU); below it the kernels of
+#: :mod:`uq.engine.statkernels` alone, so that the shipped scenarios (at most 10^5 trials)
+#: and a cold start do not compile the one-pass kernels (~2 s of CPU). Both give the
+#: same numbers (exact order statistics, the same sums).
+ONE_PASS_MIN_TRIALS = 2**17
 
 #: Largest |angular error| [rad] whose sine and cosine the compiled model takes from
 #: their Taylor polynomials (sin to x^15, cos to x^16; :mod:`uq.physics.fusedkernels`) [1].

@@ -177,3 +177,110 @@ def test_smaller_summary_batches_leave_the_results_unchanged(rng):
             np.testing.assert_allclose(summary[key], expected[key], rtol=1e-12)
     for key, value in whole.result().items():
         np.testing.assert_array_equal(value, parts.result()[key])
+
+
+@pytest.fixture
+def one_pass(monkeypatch):
+    """Runs of any length take the one-pass batches (uq.engine.passkernels)."""
+    from uq.engine import statistics
+    monkeypatch.setattr(statistics, "ONE_PASS_MIN_TRIALS", 0)
+
+
+def _sorted_ranks(values):
+    """Ascending values of every element and the JCGM 101 7.7.2 ranks of their count."""
+    from uq.engine.statistics import _symmetric_ranks
+    return np.sort(values, axis=0), _symmetric_ranks(len(values), 0.95)
+
+
+RUN_CASES = {
+    "normal": lambda rng, n: rng.standard_normal((n, 3)),
+    "heavy tails": lambda rng, n: rng.standard_cauchy((n, 3)),
+    "ties": lambda rng, n: rng.integers(0, 7, (n, 3)).astype(float),
+    "constant": lambda rng, n: np.full((n, 3), 2.5),
+    # ascending through the run: the first batch's brackets miss the run's ranks
+    "drifting": lambda rng, n: np.sort(rng.standard_normal((n, 3)), axis=0),
+}
+
+
+@pytest.mark.parametrize("summary_size", [2048, 4096])
+@pytest.mark.parametrize("case", sorted(RUN_CASES))
+def test_run_and_batch_endpoints_from_the_brackets_are_exact(case, summary_size, rng,
+                                                              one_pass):
+    """The endpoints of every sub-batch and of the run, selected among the values kept
+    inside the run's brackets (set at its first sub-batch), are the exact order
+    statistics, whether the brackets hold the ranks (normal, heavy tails, ties) or miss
+    them (a constant output, values drifting through the run: all values decide)."""
+    n = 5 * 4096 + 123
+    values = RUN_CASES[case](rng, n)
+    stats = StreamingStatistics((3,), tail_capacity(n) + 1, expected=n)
+    summaries = []
+    for start in range(0, n, 8192):                   # chunks of two batches
+        summaries += [(start + first, summary) for first, summary in stats.add(
+            values[start:start + 8192], 4096, summarize=True, summary_size=summary_size)]
+    assert len(summaries) == 5 * 4096 // summary_size
+    for first, summary in summaries:
+        ordered, (low, high) = _sorted_ranks(values[first:first + summary_size])
+        np.testing.assert_array_equal(summary["low"], ordered[low])
+        np.testing.assert_array_equal(summary["high"], ordered[high])
+    result = stats.result()
+    ordered, (low, high) = _sorted_ranks(values)
+    np.testing.assert_array_equal(result["low"], ordered[low])
+    np.testing.assert_array_equal(result["high"], ordered[high])
+    if case in ("normal", "heavy tails"):             # the brackets were used, and held
+        from uq.engine import passkernels
+        assert np.all(stats._run.state == passkernels.GLOBAL_COUNTING)
+        assert np.all(stats._run.kept < 0.1 * n)      # a few per cent of the values
+
+
+def test_run_endpoints_exact_when_the_kept_values_overflow(rng, monkeypatch, one_pass):
+    """Too little room for the values inside the brackets: counted on, detected, and
+    the run's endpoints come from all values."""
+    from uq.engine import statistics
+    monkeypatch.setattr(statistics._RunBrackets, "ROOM_FRACTION", 0.0)
+    monkeypatch.setattr(statistics._RunBrackets, "MIN_ROOM", 300)
+    values = rng.standard_normal((6 * 4096, 2))
+    stats = StreamingStatistics((2,), tail_capacity(len(values)) + 1, expected=len(values))
+    stats.add(values, 4096, summarize=True)
+    assert np.all(stats._run.kept >= 300)             # overflowed
+    ordered, (low, high) = _sorted_ranks(values)
+    np.testing.assert_array_equal(stats.result()["low"], ordered[low])
+    np.testing.assert_array_equal(stats.result()["high"], ordered[high])
+
+
+def test_an_element_with_nan_gives_up_its_brackets(rng, one_pass):
+    """A NaN after the first batch: that element's run endpoints come from all its
+    finite values; the other element keeps its brackets."""
+    from uq.engine import passkernels
+    values = rng.standard_normal((4 * 4096, 2))
+    values[3 * 4096 + 5, 1] = np.nan
+    stats = StreamingStatistics((2,), tail_capacity(len(values)) + 1, expected=len(values))
+    stats.add(values, 4096, summarize=True)
+    assert list(stats._run.state) == [passkernels.GLOBAL_COUNTING, passkernels.GLOBAL_OFF]
+    result = stats.result()
+    for j in range(2):
+        finite = values[:, j][np.isfinite(values[:, j])]
+        assert (result["low"][j], result["high"][j]) == direct_interval(finite)
+
+
+def test_short_and_long_runs_give_the_same_numbers(rng, monkeypatch):
+    """The one-pass batches of long runs (from ONE_PASS_MIN_TRIALS) and the kernels of
+    short runs: the same summaries and results, bit for bit (exact order statistics, the
+    same sums in the same order), a direction included."""
+    from uq.engine import statistics
+    values = rng.standard_normal((3 * 4096 + 77, 2, 3)) * [1.0, 2.0, 3.0]
+    values[:, 1] = np.mod(350.0 + 8.0 * values[:, 1], 360.0)   # about north
+    outputs = []
+    for threshold in (2**40, 0):
+        monkeypatch.setattr(statistics, "ONE_PASS_MIN_TRIALS", threshold)
+        for reference in (None, np.full((2, 3), 355.0)):
+            stats = StreamingStatistics((2, 3), tail_capacity(len(values)) + 1, reference,
+                                        expected=len(values))
+            summaries = stats.add(values, 4096, summarize=True, summary_size=2048)
+            outputs.append((summaries, stats.result()))
+    for (one, result_one), (two, result_two) in zip(outputs[:2], outputs[2:]):
+        assert [start for start, _ in one] == [start for start, _ in two]
+        for (_, a), (_, b) in zip(one, two):
+            for key in a:
+                np.testing.assert_array_equal(a[key], b[key])
+        for key in result_one:
+            np.testing.assert_array_equal(result_one[key], result_two[key])

@@ -117,3 +117,4 @@ def test_covariance_of_complete_trials_equals_numpy(rng):
         # sums of ~3000 products each: 3000 eps = 7e-13 relative at most
         np.testing.assert_allclose(moments.covariance()[s], np.cov(complete.T),
                                    rtol=len(complete) * EPS)
+

@@ -19,6 +19,7 @@ def command(args):
     started = time.perf_counter()
     import numba
     import uq.engine.statkernels  # noqa: F401  (explicit signatures: compiled on import)
+    import uq.engine.passkernels  # noqa: F401  (the same: long runs' one-pass batches)
     from uq.physics import fusedmotionkernels  # (the same)
     from uq.physics import fusedkernels
     for number in (float, complex):

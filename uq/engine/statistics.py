@@ -6,7 +6,11 @@
   statistics of rank about (1 - p) M / 2 and (1 + p) M / 2, so only the
   ``M - q + 1`` smallest and largest values (q = round(p M)) are kept: 5 % of the
   samples on each side at p = 0.95, exact, not an approximation. The probabilistically
-  symmetric and the shortest intervals both follow from them.
+  symmetric and the shortest intervals both follow from them. While every value is
+  stored, the symmetric endpoints of each batch (JCGM 101 7.9's standard errors) and of
+  the run are selected among the values inside brackets set at the run's first batch
+  (:func:`uq.engine.statkernels.batch_pass`): one pass per batch, ~1 % of the values
+  partitioned, the exact order statistics.
 * Circular outputs (directions [deg]) are unwrapped into ``reference +- 180`` before
   anything else; the reference is the model value at the input means. Their mean and
   interval endpoints are then wrapped to [0, 360). The circular standard deviation
@@ -28,7 +32,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from uq.constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG, STORED_VALUES
+from uq.constants import (COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG,
+                          ONE_PASS_MIN_TRIALS, STORED_VALUES)
 from uq.engine.orderstats import order_statistics
 
 INTERVALS = ("symmetric", "shortest")
@@ -41,6 +46,13 @@ def _kernels():
     only reads a scenario (``uq fit``, ``uq check``) must not pay."""
     from uq.engine import statkernels
     return statkernels
+
+
+def _pass_kernels():
+    """:mod:`uq.engine.passkernels`, imported at the first long run's statistics (their
+    compile, ~2 s after an install, is for runs of ONE_PASS_MIN_TRIALS and more)."""
+    from uq.engine import passkernels
+    return passkernels
 
 
 def unwrap(values, reference):
@@ -275,6 +287,8 @@ class StreamingStatistics:
         self._columns = np.empty((self.size, min(int(expected), room) if expected else 0))
         self._count = 0                            # samples held in _columns
         self._scratch = []                         # per part of the elements
+        self._expected = int(expected) if expected else 0
+        self._run = None                           # the run's brackets (_RunBrackets)
 
     @property
     def _stored(self):
@@ -296,6 +310,11 @@ class StreamingStatistics:
         values = np.asarray(values, dtype=float)
         m = len(values)
         flat = values.reshape(m, self.size)          # (a view where the layout allows)
+        if kind == "symmetric" and self._stored and self._expected >= ONE_PASS_MIN_TRIALS:
+            return self._add_in_one_pass(flat, batch_size, summarize,
+                                         min(summary_size or batch_size, batch_size))
+        if self._run is not None:
+            self._run.counted = -1                   # values the run's brackets missed
         columns, offset = self._room(m)
         circular = self.reference is not None
         if not circular and flat.strides[0] == flat.itemsize:  # element-major (the
@@ -324,6 +343,61 @@ class StreamingStatistics:
         else:
             self._add_to_tails(columns[:, :m].T)
         return summaries
+
+    def _add_in_one_pass(self, flat, batch_size, summarize, size):
+        """:meth:`add` while every value is stored and the interval is probabilistically
+        symmetric: one compiled pass per batch and element (:func:`statkernels.batch_pass`)
+        stores the column, takes its moments and the endpoints of its sub-batches, and
+        counts the values around the run's endpoints (:class:`_RunBrackets`), so that
+        :meth:`result` selects among a few per cent of the values."""
+        m = len(flat)
+        columns, offset = self._room(m)
+        circular = self.reference is not None
+        reference = self.reference if circular else _NO_REFERENCE
+        copy = flat.strides[0] == flat.itemsize      # element-major: copied in the pass
+        if not copy:                                 # trial-major: tiles of trials
+            _kernels().transpose(flat, reference, circular, columns, offset)
+        if self._run is None:
+            # (the values stored at most: the room is a fraction of the store's)
+            self._run = _RunBrackets(self.size, min(self._expected or m,
+                                                    self._budget // max(self.size, 1)))
+        run = self._run
+        size = size if summarize else 0
+        count, mean, m2 = (np.empty(self.size, dtype=np.int64), np.empty(self.size),
+                           np.empty(self.size))
+        length = _kernels().scratch_length(size)
+        if len(self._scratch) != 1 or self._scratch[0].shape[1] < length:
+            self._scratch = [np.empty((2, length))]
+        summaries = []
+        for start in range(0, m, batch_size):
+            stop = min(m, start + batch_size)
+            parts = (stop - start) // size if size else 0
+            sub = (np.empty((parts, self.size), dtype=np.int64),
+                   np.empty((parts, self.size)), np.empty((parts, self.size)))
+            low, high = np.empty((parts, self.size)), np.empty((parts, self.size))
+            run.make_room(stop - start)
+            _pass_kernels().batch_pass(flat, start, stop, reference, circular, copy, columns,
+                                  offset, size, COVERAGE_PROBABILITY, count, mean, m2,
+                                  self._cos, self._sin, *sub, low, high,
+                                  run.state, run.brackets, run.below, run.kept, run.values,
+                                  self._scratch[0])
+            run.counted += stop - start if run.counted >= 0 else 0
+            self.moments.merge(count.reshape(self.shape), mean.reshape(self.shape),
+                               m2.reshape(self.shape))
+            summaries.extend((start + k * size, self._sub_summary(*sub, low, high, k))
+                             for k in range(parts))
+        self._count += m
+        if self._count * self.size > self._budget:
+            self._spill()
+        return summaries
+
+    def _sub_summary(self, count, mean, m2, low, high, k):
+        """Mean, u, low and high of sub-batch k (rows k of the arrays), of `shape`."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            u = np.sqrt(np.where(count[k] > 1, m2[k] / np.maximum(count[k] - 1, 1), np.nan))
+        return {"mean": np.where(count[k] > 0, mean[k], np.nan).reshape(self.shape),
+                "u": u.reshape(self.shape), "low": low[k].reshape(self.shape),
+                "high": high[k].reshape(self.shape)}
 
     def _summaries(self, columns, offset, start, stop, moments, kind, size, batch_size):
         """``[(start, summary), ...]`` of the full sub-batches of `size` of the batch
@@ -366,10 +440,11 @@ class StreamingStatistics:
 
     def _endpoints(self, columns, start, stop, count, kind, probability=COVERAGE_PROBABILITY):
         """Coverage interval of every element from columns[:, start:stop]."""
-        low, high = np.empty(self.size), np.empty(self.size)
+        size = columns.shape[0]
+        low, high = np.empty(size), np.empty(size)
         if kind == "symmetric":
             ranks = _rank_pairs(count, probability)
-            parts = element_parts(self.size)
+            parts = element_parts(size)
             length = _kernels().scratch_length(stop - start)
             if len(self._scratch) != len(parts) or self._scratch[0].shape[1] < length:
                 self._scratch = [np.empty((2, length)) for _ in parts]
@@ -379,16 +454,38 @@ class StreamingStatistics:
                           low_rank[part], high_rank[part], low[part], high[part], scratch)
                          for part, scratch in zip(parts, self._scratch)])
             return low, high
-        for j in range(self.size):
+        for j in range(size):
             column = columns[j, start:stop]
             column = np.sort(column[np.isfinite(column)])
             low[j], high[j] = coverage_interval(column, column, len(column), probability, kind)
+        return low, high
+
+    def _run_endpoints(self, count, probability):
+        """Symmetric endpoints of the run: among the values kept around the run's
+        brackets where they hold the ranks (every value finite and counted), else by
+        selection among all stored values (exact either way)."""
+        count = np.ascontiguousarray(count, dtype=np.int64)
+        ranks = _rank_pairs(count, probability)
+        low, high = np.full(self.size, np.nan), np.full(self.size, np.nan)
+        found = np.zeros(self.size, dtype=bool)
+        run = self._run
+        if run is not None and run.counted == self._count:
+            usable = (run.state == _pass_kernels().GLOBAL_COUNTING) & (count == self._count)
+            low_rank = np.where(usable, ranks[:, 0], -1).astype(np.int64)
+            _pass_kernels().global_pairs(run.values, run.below, run.kept, low_rank,
+                                    ranks[:, 1].copy(), low, high, found)
+        missing = np.flatnonzero(~found)
+        if len(missing):
+            low[missing], high[missing] = self._endpoints(
+                np.ascontiguousarray(self._columns[missing, :self._count]), 0, self._count,
+                count[missing], "symmetric", probability)
         return low, high
 
     def _spill(self):
         """Hand the stored values to the tails (the memory bound of long runs)."""
         self._low = [_Tail(self.capacity) for _ in range(self.size)]
         self._high = [_Tail(self.capacity) for _ in range(self.size)]      # holds -values
+        self._run = None                            # the tails decide from now on
         for start in range(0, self._count, _SPILL_VALUES):   # bounded temporaries
             self._add_to_tails(self._columns[:, start:min(self._count,
                                                           start + _SPILL_VALUES)].T)
@@ -426,7 +523,9 @@ class StreamingStatistics:
         count = self.moments.count
         u = np.sqrt(self.moments.variance())
         mean = np.where(count > 0, self.moments.mean, np.nan)
-        if self._stored:
+        if self._stored and kind == "symmetric":
+            low, high = self._run_endpoints(count.reshape(-1), probability)
+        elif self._stored:
             low, high = self._endpoints(self._columns, 0, self._count,
                                         count.reshape(-1), kind, probability)
         else:
@@ -450,6 +549,40 @@ class StreamingStatistics:
 
 #: The reference of an output that is not circular (the kernels take an array).
 _NO_REFERENCE = np.zeros(0)
+
+
+class _RunBrackets:
+    """The run's brackets of the symmetric endpoints, per element (filled by
+    :func:`uq.engine.statkernels.batch_pass`): the run's (``brackets``, (elements, 4),
+    set at its first sub-batch),
+    the values counted below them (``below``, (elements, 2)), the values kept inside
+    (``values``, (elements, 2, room); ``kept`` counts them, on past the room: an
+    overflow), the state of each element, and the trials counted (``counted``; -1 once
+    values went by without being counted). ~1-5 % of the values fall inside (the
+    brackets span 4 standard deviations of a sample rank either side of it): the room
+    is an eighth of the stored values (grown where needed), so at most an eighth more
+    memory than the store."""
+
+    #: Room for the kept values, as a fraction of the trials, and at least.
+    ROOM_FRACTION, MIN_ROOM = 0.125, 64
+
+    def __init__(self, size, expected):
+        self.brackets = np.full((size, 4), np.nan)
+        self.state = np.zeros(size, dtype=np.int64)
+        self.below = np.zeros((size, 2), dtype=np.int64)
+        self.kept = np.zeros((size, 2), dtype=np.int64)
+        self.values = np.empty((size, 2, int(self.ROOM_FRACTION * expected) + self.MIN_ROOM))
+        self.counted = 0
+
+    def make_room(self, m):
+        """Room for m more trials' kept values (grown by doubling; an overflow is
+        detected, and exact anyway)."""
+        need = int(self.kept.max(initial=0) + self.ROOM_FRACTION * m) + self.MIN_ROOM
+        if need > self.values.shape[2]:
+            grown = np.empty(self.values.shape[:2] + (max(need, 2 * self.values.shape[2]),))
+            used = min(int(self.kept.max()), self.values.shape[2])
+            grown[:, :, :used] = self.values[:, :, :used]
+            self.values = grown
 
 
 class _Tail:
