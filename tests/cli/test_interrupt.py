@@ -128,3 +128,29 @@ def test_an_interrupt_raised_inside_a_callback_is_not_lost():
             for _ in range(1000):                    # the redelivered signal lands here
                 time.sleep(0.001)
     assert sys.unraisablehook is before                  # restored after the block
+
+
+def test_dask_is_silenced_before_the_stop_is_raised():
+    """Ctrl-C during a distributed run: dask's and its event loop's loggers are quiet
+    before KeyboardInterrupt reaches any code (the loop thread logs the cancel's failure
+    at once), and the earlier handlers are back afterwards."""
+    import logging
+    import os
+    import pytest
+    from uq.cli.run import DASK_LOGGERS, _quiet_at_stop
+    levels = {name: logging.getLogger(name).level for name in DASK_LOGGERS}
+    before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
+    for name in DASK_LOGGERS:
+        logging.getLogger(name).setLevel(logging.NOTSET)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            with _quiet_at_stop():
+                os.kill(os.getpid(), signal.SIGINT)
+                for _ in range(10 ** 6):        # the handler runs between bytecodes
+                    pass
+        assert all(logging.getLogger(name).level == logging.CRITICAL
+                   for name in DASK_LOGGERS)
+        assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
+    finally:
+        for name, level in levels.items():
+            logging.getLogger(name).setLevel(level)

@@ -159,17 +159,62 @@ def dask_client(args):
     from uq.pipeline.cluster import local_cluster
     logging.getLogger("distributed").setLevel(logging.ERROR)
     # SIGINT ignored while the workers start: they inherit it, so Ctrl-C reaches uq alone
-    with local_cluster(args.workers, starting=_ignoring_sigint) as client:
+    with local_cluster(args.workers, starting=_ignoring_sigint) as client, \
+            _quiet_at_stop():
         try:
             yield client
         except BaseException:
-            # stopped (Ctrl-C, SIGTERM) or failed: closing the client forgets the chunks
-            # still pending, and the scheduler, in this process, logs a gather of one of
-            # them then in flight as an error ("Couldn't gather keys ... 'forgotten'",
-            # seen on a loaded machine); the user gets the stop's one message, or the
-            # exception itself
-            logging.getLogger("distributed").setLevel(logging.CRITICAL)
+            # failed: closing the client forgets the chunks still pending, and the
+            # scheduler, in this process, logs a gather of one of them then in flight as an
+            # error ("Couldn't gather keys ... 'forgotten'", seen on a loaded machine); the
+            # user gets the exception itself
+            _silence_dask()
             raise
+
+
+#: The loggers of the event loop the local cluster runs in this process.
+DASK_LOGGERS = ("distributed", "tornado.application", "tornado.general", "asyncio")
+
+
+def _silence_dask():
+    """Only critical records from dask's and its event loop's loggers from now on."""
+    for name in DASK_LOGGERS:
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
+@contextlib.contextmanager
+def _quiet_at_stop():
+    """Silence dask's loggers when SIGINT or SIGTERM arrives, before the stop's exception
+    is raised. At Ctrl-C the main thread's wait in ``distributed.utils.sync`` schedules a
+    cancel on the cluster's event loop thread, which can fail there at once and log an
+    error with a traceback ("tornado.application - ERROR - Exception in callback
+    ... sync.<locals>.cancel", seen on a loaded machine) before any ``except`` of ours
+    runs; silencing in the signal handler comes first. The earlier handlers are then
+    called as before (Python's KeyboardInterrupt, :func:`uq.cli.common.stop_on_sigterm`'s
+    Terminated) and restored at the end. Main thread only."""
+    import threading
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
+
+    def stopping(number, frame):
+        _silence_dask()
+        handler = previous[number]
+        if callable(handler):
+            handler(number, frame)
+        elif number == signal.SIGINT and handler == signal.SIG_DFL:
+            raise KeyboardInterrupt
+        elif handler == signal.SIG_DFL:             # the default action: end the process
+            signal.signal(number, signal.SIG_DFL)
+            os.kill(os.getpid(), number)
+    for number in previous:
+        signal.signal(number, stopping)
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
 
 
 @contextlib.contextmanager

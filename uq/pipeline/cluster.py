@@ -35,5 +35,24 @@ def local_cluster(workers, starting=contextlib.nullcontext, **options):
         with starting():
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
                                    processes=True, dashboard_address=":0", **options)
-        with cluster, Client(cluster, set_as_default=False) as client:
-            yield client
+        with cluster:
+            client = Client(cluster, set_as_default=False)
+            try:
+                yield client
+            except BaseException:
+                _close_after_stop(client)
+                raise
+            client.close()
+
+
+def _close_after_stop(client):
+    """Close `client` after the block stopped (Ctrl-C, SIGTERM, a failure): the stop's
+    own exception is what the user is told. A close that fails (on a loaded machine it
+    can time out while the scheduler is busy cancelling) leaves the client "closing", and
+    its ``__del__`` would close it again at garbage collection and print that failure
+    with a traceback ("Exception ignored in: Client.__del__"); it is marked closed
+    instead (the cluster's own close follows, and the process is ending)."""
+    try:
+        client.close()
+    except Exception:
+        client.status = "closed"
