@@ -439,7 +439,8 @@ def mann_box(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
     grid : BoxGrid
         The box (periodic in x, y, z).
     alpha_epsilon : float
-        alpha eps^(2/3) [m4/3 s-2], which sets the variance.
+        alpha eps^(2/3) [m4/3 s-2], which sets the variance (the box is linear in its
+        square root).
     length_scale, anisotropy : float
         Mann's L [m] and Gamma [1].
     rng : numpy.random.Generator
@@ -447,16 +448,76 @@ def mann_box(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
     xp : module
         numpy, or cupy (:func:`array_namespace`).
     slab_cells : int
-        Cells of the spectral factor evaluated at a time (memory; the box does not
-        depend on it).
+        Cells transformed at a time (memory; the box does not depend on it).
     workers : int or None
         Threads of scipy's FFT (numpy only).
 
     Returns
     -------
     TurbulenceBox
-        ``velocity`` (3, nx, ny, nz) [m s-1] on ``xp``'s device.
+        ``velocity`` (3, nx, ny, nz) [m s-1] on ``xp``'s device; on the host each
+        component is C-contiguous, the three held in the memory of their half spectra
+        (:func:`_mann_box_host`).
     """
+    if xp is np:
+        return _mann_box_host(grid, alpha_epsilon, length_scale, anisotropy, rng,
+                              slab_cells, workers)
+    return mann_box_reference(grid, alpha_epsilon, length_scale, anisotropy, rng, xp,
+                              slab_cells, workers)
+
+
+def _mann_box_host(grid, alpha_epsilon, length_scale, anisotropy, rng, slab_cells, workers):
+    """:func:`mann_box` on the host in the memory of the three half spectra alone.
+
+    The same field as :func:`mann_box_reference` to rounding (the same random numbers,
+    drawn slab by slab along x in the same C order; the 3-D real FFT taken as a 2-D one
+    per slab and a 1-D one along x; the factor applied by the compiled
+    :func:`uq.physics.turbulencekernels.mann_colour`), in about half its memory and a
+    third of its time: each component's half spectrum (nx, ny, nz // 2 + 1) complex
+    holds, after the inverse transform, that component's real field (nx, ny, nz) at its
+    start (slab i's output goes where slabs <= i were read from).
+    """
+    from uq.physics.turbulencekernels import mann_colour
+    (nx, ny, nz), half = grid.shape, grid.shape[2] // 2 + 1
+    spectra = np.empty((3, nx, ny, half), dtype=complex)
+    slabs = _x_slabs(grid, slab_cells)
+    for c in range(3):
+        for slab in slabs:              # C order: component, then x, y, z (white_noise)
+            noise = rng.standard_normal((slab.stop - slab.start, ny, nz))
+            spectra[c, slab] = scipy.fft.rfft2(noise, workers=workers)
+        _in_place(scipy.fft.fft, spectra[c], workers)
+    k1, k2, k3 = (k.ravel() for k in box_wavenumbers(grid))
+    scale = np.sqrt((2.0 * np.pi) ** 3 / np.prod(grid.spacing))    # sqrt(N dk)
+    cells, factors = cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy)
+    index = (slice(None),) + tuple(cells.T)
+    noise_cells = spectra[index]                                    # (3, n): a copy
+    mann_colour(spectra[0], spectra[1], spectra[2], k1, k2, k3, alpha_epsilon, length_scale,
+                anisotropy, scale, float(_TABLE[0][0]), float(_TABLE[0][1] - _TABLE[0][0]),
+                np.ascontiguousarray(_TABLE[1]))                    # u_k = i C n
+    # near the k1 axis: u_k = C_avg n, C_avg even, so u_-k = u_k^* (module docstring)
+    spectra[index] = scale * np.einsum("ijn,jn->in", factors, noise_cells)
+    size = nx * ny * nz
+    for c in range(3):
+        _in_place(scipy.fft.ifft, spectra[c], workers)
+        field = spectra[c].reshape(-1).view(np.float64)[:size].reshape(nx, ny, nz)
+        for slab in slabs:
+            field[slab] = scipy.fft.irfft2(spectra[c, slab], s=(ny, nz), workers=workers)
+    velocity = spectra.reshape(3, -1).view(np.float64)[:, :size].reshape(3, nx, ny, nz)
+    return TurbulenceBox(grid=grid, velocity=velocity)
+
+
+def _in_place(transform, array, workers):
+    """``array <- transform(array, axis=0)``, in its own memory."""
+    out = transform(array, axis=0, overwrite_x=True, workers=workers)
+    if out.ctypes.data != array.ctypes.data:      # (scipy writes in place; if not, copy)
+        array[...] = out
+
+
+def mann_box_reference(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
+                       slab_cells=constants.BOX_SLAB_CELLS, workers=None):
+    """:func:`mann_box` in array code (numpy or CuPy) throughout: the reference the
+    host's compiled path is tested against, and the GPU's path. Parameters as
+    :func:`mann_box`."""
     fft = _fft(xp)
     kwargs = {"workers": workers} if xp is np else {}
     axes = (1, 2, 3)
