@@ -62,7 +62,7 @@ def record_spectra_data(dataset, settings):
     scenes = [settings]
     if settings.get("motion") and settings["correction"] != "none":
         scenes.append(records.at_correction(settings, "none"))
-    print(f"uq: {dataset.attrs.get('title', 'this result')} has no stored record spectra "
+    print(f"uq: {settings['name']} has no stored record spectra "
           f"(written before uq stored them): drawing its {settings['record']['count']} "
           f"records again for {len(scenes)} scene(s); run the scenario again to store them",
           file=sys.stderr, flush=True)
