@@ -43,7 +43,8 @@ from uq.physics.lidarspectral import lidar_variances, probe_transfer_for
 from uq.physics.spectraltensor import KaimalSpectra, mann_tensor_for_intensity
 from uq.pipeline import probesection
 from uq.constants import KAIMAL_LENGTH_FACTOR as LENGTH_FACTORS_KAIMAL
-from uq.constants import RECORD_BOX_SLAB_CELLS, UNIT_RECORD_CACHE_BYTES
+from uq.constants import (RECORD_BOX_SLAB_CELLS, RECORD_SPECTRA_BYTES,
+                          UNIT_RECORD_CACHE_BYTES)
 from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
 
 #: Attributes of the record-mode variables.
@@ -209,7 +210,7 @@ def turbulence_box(settings, geometry, rng, motion_margin=0.0):
     Kaimal: NaN, not computed: its box misses the frequencies below 1 / (its length /
     U), which a record's high-pass partly keeps). The box is :func:`unit_box` times
     :func:`field_scale`."""
-    box, kept = unit_box(settings, geometry, rng, motion_margin)
+    box, kept = unit_box(settings, geometry, rng, motion_margin, window=False)
     box.velocity[...] *= field_scale(settings)
     return box, kept
 
@@ -224,10 +225,13 @@ def field_scale(settings):
     return turbulence["intensity"] * speed
 
 
-def unit_box(settings, geometry, rng, motion_margin=0.0):
+def unit_box(settings, geometry, rng, motion_margin=0.0, window=True):
     """:func:`turbulence_box` of unit :func:`field_scale` (the same random numbers; the
     box of any intensity is this one times its scale), and the variance of u it keeps of
-    the model's point variance [1]."""
+    the model's point variance [1]. With `window` a Mann box holds only the (y, z) lines
+    that the probe points (and the reference point) read
+    (:func:`uq.physics.turbulencebox.mann_box_window`), its half spectra in parts of at
+    most :data:`~uq.constants.RECORD_SPECTRA_BYTES`."""
     from uq.physics import turbulencebox
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
     if turbulence["model"] == "mann":
@@ -236,9 +240,17 @@ def unit_box(settings, geometry, rng, motion_margin=0.0):
         model = turbulence_model(turbulence, speed)      # (kept first: not beside the box)
         kept = _unit_box_variance(grid, turbulence["length_scale"], turbulence["anisotropy"]) \
             * model.alpha_epsilon / (turbulence["intensity"] * speed) ** 2
-        box = turbulencebox.mann_box(grid, 1.0, turbulence["length_scale"],
-                                     turbulence["anisotropy"], rng,
-                                     slab_cells=RECORD_BOX_SLAB_CELLS)
+        if not window:
+            return turbulencebox.mann_box(grid, 1.0, turbulence["length_scale"],
+                                          turbulence["anisotropy"], rng,
+                                          slab_cells=RECORD_BOX_SLAB_CELLS), float(kept)
+        points = np.vstack([np.asarray(geometry.probe_points()).reshape(-1, 3), np.zeros(3)])
+        nx, ny, nz = grid.shape
+        parts = math.ceil(3 * nx * ny * (nz // 2 + 1) * 16 / RECORD_SPECTRA_BYTES)
+        box = turbulencebox.mann_box_window(
+            grid, 1.0, turbulence["length_scale"], turbulence["anisotropy"], rng,
+            turbulencebox.box_window(grid, points, motion_margin), parts,
+            slab_cells=RECORD_BOX_SLAB_CELLS)
         return box, float(kept)
     scale = turbulence["length_scale"] / LENGTH_FACTORS_KAIMAL
     grid = turbulencebox.box_for(geometry, scale, "kaimal", motion_margin=motion_margin)
