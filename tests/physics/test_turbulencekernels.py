@@ -59,13 +59,14 @@ def test_box_window_holds_the_points_and_their_corners():
 
 
 def _scan_and_box(periodic=True):
-    geometry = conical_scan([60.0, 100.0], vertical=True, beam_duration=0.5, record=20.0,
-                            offsets=np.linspace(-10.0, 10.0, 5))
+    # (a Kaimal box, not periodic in y and z, of one gate: a small coherent (y, z) grid)
+    geometry = conical_scan([60.0, 100.0] if periodic else [60.0], vertical=periodic,
+                            beam_duration=0.5, record=20.0, offsets=np.linspace(-10.0, 10.0, 5))
     model = "mann" if periodic else "kaimal"
-    grid = tb.box_for(geometry, LENGTH if periodic else 4.0, model, motion_margin=2.0)
+    grid = tb.box_for(geometry, LENGTH, model, motion_margin=2.0)
     rng = np.random.default_rng(2)
     box = tb.mann_box(grid, ALPHA_EPSILON, LENGTH, GAMMA, rng) if periodic else \
-        tb.kaimal_box(grid, 1.0, 10.0, 4.0, rng)
+        tb.kaimal_box(grid, 1.0, 10.0, LENGTH, rng)
     return geometry, box
 
 
