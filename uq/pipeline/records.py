@@ -474,7 +474,8 @@ def record_spectra_series(settings, scene, errors, unit, scale, n_scans, rng, co
 def at_correction(settings, correction):
     """The validated settings with another ``correction``."""
     from uq.pipeline.scenario import load_scenario
-    return load_scenario({**copy.deepcopy(settings), "correction": correction}).settings
+    return load_scenario({**copy.deepcopy(settings), "correction": correction,
+                          "sweep": {}}).settings
 
 
 def spectra_variables(scenes, seed, compiled=True, moving=False):
@@ -498,7 +499,7 @@ def at_rest(settings):
     level lidar at rest: its reconstruction), the INS's errors without its sampling
     (nothing moves between its readings)."""
     from uq.pipeline.scenario import load_scenario
-    raw = copy.deepcopy(settings)
+    raw = {**copy.deepcopy(settings), "sweep": {}}       # (this scene alone)
     raw.pop("motion", None)
     raw["correction"] = "full"
     for key in ("rate", "interpolation", "clock_offset"):
