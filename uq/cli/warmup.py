@@ -20,6 +20,7 @@ def command(args):
     import numba
     import uq.engine.statkernels  # noqa: F401  (explicit signatures: compiled on import)
     from uq.physics import fusedmotionkernels  # (the same)
+    from uq.physics import turbulencekernels  # noqa: F401  (record mode's: the same)
     from uq.physics import fusedkernels
     for number in (float, complex):
         for name in fusedkernels.KERNEL_NAMES:
