@@ -55,17 +55,19 @@ def file_settings(dataset):
 def record_spectra_data(dataset, settings):
     """The records' spectra of a result: the variables the run stored
     (:data:`uq.pipeline.records.SPECTRA_ATTRIBUTES`), or, for a result written before
-    the runs stored them, the file's scene's records drawn again (one line on stderr
-    says so): the scenario's correction and, where the platform moves, ``none``."""
+    the runs stored them (or of ``sampling.method: none``), the file's scene's records
+    drawn now as a run draws them (one line on stderr says so): the scenario's
+    correction and, where the platform moves, ``none``."""
     if "record_psd_wind_speed" in dataset:
         return dataset
     scenes = [settings]
     if settings.get("motion") and settings["correction"] != "none":
         scenes.append(records.at_correction(settings, "none"))
-    print(f"uq: {settings['name']} has no stored record spectra "
-          f"(written before uq stored them): drawing its {settings['record']['count']} "
-          f"records again for {len(scenes)} scene(s); run the scenario again to store them",
-          file=sys.stderr, flush=True)
+    why = ("written before uq stored them" if "turbulence_intensity_mc_mean" in dataset
+           else "its run drew no Monte Carlo records")
+    print(f"uq: {settings['name']} has no stored record spectra ({why}): drawing "
+          f"{settings['record']['count']} records for {len(scenes)} scene(s) now; a run "
+          f"with Monte Carlo records stores them", file=sys.stderr, flush=True)
     variables = records.spectra_variables(scenes, int(dataset.attrs.get("seed", 0)),
                                           moving=bool(settings.get("motion")))
     corrections = [scene["correction"] for scene in scenes]
