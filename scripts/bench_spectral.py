@@ -7,27 +7,16 @@ ratio of the DBS's time to that of the point variance alone (the tensor's cost).
 Run: ``python scripts/bench_spectral.py``."""
 import time
 
-import numpy as np
-
 from uq.physics.lidarspectral import mann_lidar_variances, probe_transfer_for
 from uq.physics.probe import ContinuousWaveProbe, PulsedProbe
-from uq.physics.scangeometry import ScanGeometry
+from uq.physics.scangeometry import conical_scan
 from uq.physics.spectraltensor import mann_tensor_for_intensity, point_variances
 
 
-def conical(n_beams, heights, vertical, beam_duration, half_cone=30.0):
-    phi, heights = np.radians(half_cone), np.asarray(heights, float)
-    az = 2 * np.pi * np.arange(n_beams) / n_beams
-    d = np.stack([np.sin(phi) * np.cos(az), np.sin(phi) * np.sin(az),
-                  np.full(n_beams, np.cos(phi))], -1)
-    if vertical:
-        d = np.vstack([d, [0.0, 0.0, 1.0]])
-    slant = heights[None, :] / d[:, 2:3]
-    centres = np.array([0.0, 0.0, -heights[0]]) + slant[..., None] * d[:, None, :]
-    n = len(d)
-    return ScanGeometry(d, centres, (np.arange(n) + 0.5) * beam_duration, beam_duration,
-                        n * beam_duration, np.zeros(1), np.ones((len(heights), 1)),
-                        np.tile(np.linalg.pinv(d)[None], (len(heights), 1, 1)), 10.0, 600.0)
+def conical(n_beams, heights, vertical, beam_duration):
+    """The scan (:func:`uq.physics.scangeometry.conical_scan`, shared with the tests)."""
+    return conical_scan(heights, n_beams=n_beams, vertical=vertical,
+                        beam_duration=beam_duration)
 
 
 def cpu(function):

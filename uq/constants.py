@@ -505,6 +505,23 @@ BOX_DEFAULT_CELLS_PER_LENGTH = 8.0
 #: chunk's memory near 50 MB; records do not depend on it.
 SAMPLING_CHUNK_POINTS = 2**18
 
+#: Bytes of unit-field records a run keeps for reuse (uq.pipeline.records.unit_record)
+#: [1]: a record's turbulence along the beams for a field of unit scale, reused by every
+#: scene that draws the same record from the same box (a sweep of turbulence.intensity
+#: or of the correction); a record of a 50-beam VAD over 10 min at 4 gates is ~1 MB,
+#: so 64 MB keeps every record of any shipped scenario. Results do not depend on it.
+UNIT_RECORD_CACHE_BYTES = 2**26
+#: Cells of a record's box transformed, or of its factor's variance summed, at a time
+#: [1]: 2^18 keeps each slab's temporaries near 4 MB (the box's half spectra, ~24 bytes
+#: a cell, are the record's memory); boxes do not depend on it.
+RECORD_BOX_SLAB_CELLS = 2**18
+#: Most bytes of a record box's half spectra held at a time [1] (records.unit_box): a
+#: ten-minute box at L / 8 (~1500 x 96 x 96 cells) has ~340 MB of them, which a run's
+#: ~300 MB of code and libraries would take above 600 MB; in parts of at most 256 MB
+#: (two for the shipped scenarios) it stays below, at the cost of drawing the noise and
+#: taking its 2-D transforms once more per part (~0.8 s a box). Boxes do not depend on it.
+RECORD_SPECTRA_BYTES = 2**28
+
 #: Cell averaging of the Mann tensor near the k1 axis (turbulencebox.cell_averaged_factors)
 #: [1]: cells with |k1| <= CELL_AVERAGE_K1 max(dk2, dk3), beyond which the tensor varies
 #: across a cell on scales >= the cell (point values suffice; the variance's change from

@@ -69,3 +69,39 @@ def test_summary_reports_record_mode():
     assert "turbulence intensity over a record [%]: true 9.5" in lines
     assert "  apparent @100 m: spectral 8.57, Monte Carlo 8.35 (95 % of records 7.54 to " \
            "9.44); spectral validated 0/1" in lines
+
+
+SMALL = {"name": "small", "wind": {"speed": 10.0, "direction": 180.0, "reference_height": 100.0},
+         "lidar": {"height": 0.0, "ranges": [60.0, 100.0], "half_cone": 30.0,
+                   "scan": {"beam_duration": 0.5},
+                   "errors": {"radial_velocity": {"dist": "normal", "u": 0.05}}},
+         "turbulence": {"intensity": 0.1}, "record": {"duration": 30, "count": 3},
+         "sampling": {"n": 64, "seed": 7}, "outputs": ["wind_speed"],
+         "sweep": {"turbulence.intensity": [0.05, 0.1]}}
+
+
+def test_spectra_figure_reads_what_the_run_stored_and_an_older_file_draws_it_again(capsys):
+    # the figure takes the stored mean periodograms at the file's scene (intensity 0.1);
+    # a result without them (written before runs stored them) draws the same records
+    # again from its seed, says so on stderr, and gets the same spectra (the same code
+    # and random streams: bit for bit)
+    import matplotlib.pyplot as plt
+    from uq.pipeline.runner import run
+    ds = run({**SMALL, "turbulence": {"intensity": 0.1}})
+    settings = recordfigures.file_settings(ds)
+    stored = recordfigures.spectra_lines(recordfigures.record_spectra_data(ds, settings),
+                                         settings)
+    np.testing.assert_array_equal(stored[1], ds["record_psd_u_true"].sel(
+        turbulence_intensity=0.1).values)
+    assert list(stored[2]) == ["lidar, fixed"]
+    assert capsys.readouterr().err == ""
+    older = ds.drop_vars([name for name in ds.variables if name.startswith("record_")])
+    again = recordfigures.spectra_lines(recordfigures.record_spectra_data(older, settings),
+                                        settings)
+    assert "no stored record spectra" in capsys.readouterr().err
+    for one, two in zip(stored, again):
+        if isinstance(one, dict):
+            assert list(one) == list(two)
+            one, two = list(one.values()), list(two.values())
+        np.testing.assert_array_equal(one, two)
+    plt.close(recordfigures.record_spectra(ds))

@@ -13,7 +13,7 @@ from uq.physics.lidarspectral import (cut_lorentzian_transfer, dbs_surge_varianc
                                       record_filter, staring_cw_kaimal_ratio,
                                       vad_surge_variance)
 from uq.physics.probe import ContinuousWaveProbe, PulsedProbe, legendre, pulsed_weight
-from uq.physics.scangeometry import ScanGeometry
+from uq.physics.scangeometry import ScanGeometry, conical_scan
 from uq.physics.spectraltensor import (KaimalSpectra, WavenumberGrid,
                                        mann_tensor_for_intensity)
 
@@ -21,24 +21,10 @@ SPEED = 10.0
 SATHE_PROBE = PulsedProbe(18.75, 24.75)        # Sathe et al. (2011): WindCube gate, pulse
 
 
-def dbs_geometry(heights, half_cone=30.0, beam_duration=0.001, n_beams=4, vertical=False,
-                 record=600.0, offsets=np.zeros(1), weights=None):
-    """A fixed, level DBS, beam 0 along the wind (azimuth 0 = +x), beams counter-clockwise;
-    the reference point at the first height; reconstruction the pseudo-inverse."""
-    phi, heights = np.radians(half_cone), np.atleast_1d(np.asarray(heights, float))
-    az = np.radians(np.arange(n_beams) * 360.0 / n_beams)
-    d = np.stack([np.sin(phi) * np.cos(az), np.sin(phi) * np.sin(az),
-                  np.full(n_beams, np.cos(phi))], -1)
-    if vertical:
-        d = np.vstack([d, [0.0, 0.0, 1.0]])
-    slant = heights[None, :] / d[:, 2:3]
-    centres = np.array([0.0, 0.0, -heights[0]]) + slant[..., None] * d[:, None, :]
-    n = len(d)
-    weights = (np.ones((len(heights), np.size(offsets))) / np.size(offsets)
-               if weights is None else weights)
-    return ScanGeometry(d, centres, (np.arange(n) + 0.5) * beam_duration, beam_duration,
-                        n * beam_duration, np.asarray(offsets, float), weights,
-                        np.tile(np.linalg.pinv(d)[None], (len(heights), 1, 1)), SPEED, record)
+def dbs_geometry(heights, **options):
+    """A fixed, level DBS (:func:`uq.physics.scangeometry.conical_scan`) in a wind of
+    :data:`SPEED`."""
+    return conical_scan(heights, speed=SPEED, **options)
 
 
 @pytest.fixture(scope="module")

@@ -43,3 +43,16 @@ def test_geometry_validates_shapes():
         _geometry(reconstruction=np.eye(3))
     with pytest.raises(ValueError, match="unit"):
         _geometry(directions=2 * np.eye(3))
+
+
+def test_conical_scan_of_the_tests_and_benchmarks():
+    # a 4-beam DBS and its vertical beam at 30 deg: beam 0 along +x, the gates at the
+    # given heights above the lidar, the reference point at the first one, the
+    # reconstruction the directions' pseudo-inverse (so it returns a uniform wind)
+    from uq.physics.scangeometry import conical_scan
+    g = conical_scan([100.0, 150.0], vertical=True, beam_duration=1.0)
+    np.testing.assert_allclose(g.directions[0], [0.5, 0.0, np.sqrt(3) / 2], atol=1e-15)
+    np.testing.assert_allclose(g.gate_centres[:, :, 2], [[0.0, 50.0]] * 5, atol=1e-12)
+    assert g.scan_period == 5.0 and g.times[-1] == 4.5 and g.speed == 10.0
+    wind = np.array([3.0, -1.0, 0.5])
+    np.testing.assert_allclose(g.reconstruction[1] @ (g.directions @ wind), wind, atol=1e-12)

@@ -138,3 +138,98 @@ def test_sweeps_of_scene_values_and_of_the_intensity():
                                rtol=1e-6)          # the 4-beam DBS's symmetry
     assert abs(float(ti.isel(turbulence_intensity=1).sel(wind_direction=45.0)
                      / ti.isel(turbulence_intensity=1).sel(wind_direction=0.0)) - 1) > 1e-3
+
+
+# --- unit records and the records' spectra (issue 26) ----------------------------------------
+
+SMALL = {"wind": {"speed": 10.0, "direction": 180.0, "reference_height": 100.0},
+         "lidar": {"height": 0.0, "ranges": [60.0, 100.0], "half_cone": 30.0,
+                   "scan": {"beam_duration": 0.5},
+                   "errors": {"radial_velocity": {"dist": "normal", "u": 0.05}}},
+         "turbulence": {"intensity": 0.1}, "record": {"duration": 30, "count": 3},
+         "sampling": {"n": 64, "seed": 7}, "outputs": ["wind_speed"]}
+
+
+def _record(settings, record=0, spectra=False):
+    from uq.pipeline import records
+    from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
+    geometry = scan_geometry(settings)
+    return records.monte_carlo_record(settings, geometry, scans_per_record(settings),
+                                      records.record_generator(7, record), True,
+                                      records.rest_generator(7, record) if spectra else None)
+
+
+def test_a_reused_unit_record_is_the_one_drawn_again():
+    # the same record from an empty cache and from the cache (the second call reuses the
+    # first's box): identical bits, and the generator left where the box's draw leaves
+    # it (the scan errors drawn after the box are the same)
+    from uq.pipeline import records
+    from uq.pipeline.scenario import load_scenario
+    settings = load_scenario(SMALL).settings
+    records._UNIT_RECORDS.clear()
+    fresh = _record(settings)
+    assert len(records._UNIT_RECORDS) == 1
+    again = _record(settings)
+    records._UNIT_RECORDS.clear()
+    drawn = _record(settings)
+    for one, two, three in zip(fresh, again, drawn):
+        np.testing.assert_array_equal(one, two)
+        np.testing.assert_array_equal(one, three)
+
+
+def test_the_field_scales_with_the_intensity():
+    # Mann's field is linear in sqrt(alpha eps^(2/3)), which goes as the intensity: a
+    # record at twice the intensity (the same unit box, reused) has twice the field's u'
+    # at the reference point, to rounding (1e-12 relative of u': float64 products)
+    from uq.pipeline import records
+    from uq.pipeline.scenario import load_scenario
+    low = load_scenario(SMALL).settings
+    high = load_scenario({**SMALL, "turbulence": {"intensity": 0.2}}).settings
+    assert records.field_scale(high) == pytest.approx(2 * records.field_scale(low), rel=1e-14)
+    one, two = _record(low), _record(high)
+    np.testing.assert_allclose(two[1] - 10.0, 2 * (one[1] - 10.0), rtol=1e-12, atol=0)
+    assert two[2] == pytest.approx(one[2], rel=1e-14)          # the box keeps the same share
+
+
+def test_same_results_from_an_empty_and_a_warm_cache_and_any_chunking():
+    # a sweep of the intensity and of the correction reuses each record's box across its
+    # scenes; the run from an empty cache, again from the warm one, and its scenes run
+    # one by one give the same numbers bit for bit
+    from uq.pipeline import records
+    sweep = {**SMALL, "sweep": {"turbulence.intensity": [0.05, 0.1],
+                                "correction": ["none", "full"]}}
+    records._UNIT_RECORDS.clear()
+    cold = run(sweep)
+    warm = run(sweep)
+    records._UNIT_RECORDS.clear()
+    alone = run({**SMALL, "turbulence": {"intensity": 0.1}, "correction": "none"})
+    for name in ("turbulence_intensity_mc_mean", "wind_speed_record_bias",
+                 "record_psd_wind_speed", "record_psd_u_true"):
+        np.testing.assert_array_equal(cold[name].values, warm[name].values)
+        np.testing.assert_array_equal(
+            cold[name].sel(turbulence_intensity=0.1, correction="none").values,
+            alone[name].values)
+
+
+def test_stored_spectra_hold_the_records_variance():
+    # Parseval: the one-sided periodogram summed over its frequencies (df = 1 / (N T_s))
+    # is the record's variance about its mean (1/N), so the stored mean spectrum sums to
+    # the mean over the records of that variance (float64 sums: 1e-12)
+    from uq.pipeline import records
+    from uq.pipeline.scenario import load_scenario
+    ds = run(SMALL)
+    frequency = ds["record_frequency"]
+    assert frequency.attrs["units"] == "Hz"
+    for name in ("record_psd_u_true", "record_psd_wind_speed", "record_psd_radial_velocity"):
+        assert ds[name].attrs["units"] == "m2 s-2 Hz-1" and ds[name].attrs["long_name"]
+        assert "record_frequency" in ds[name].dims
+    assert "record_psd_wind_speed_at_rest" not in ds            # no motion
+    settings = load_scenario(SMALL).settings
+    series = [_record(settings, r) for r in range(3)]
+    step = float(frequency[1] - frequency[0])
+    expected = np.mean([vh.var(axis=0) for vh, *_ in series], axis=0)
+    np.testing.assert_allclose(ds["record_psd_wind_speed"].sum("record_frequency") * step,
+                               expected, rtol=1e-12)
+    expected = np.mean([reference.var() for _, reference, *_ in series])
+    assert float(ds["record_psd_u_true"].sum() * step) == pytest.approx(expected, rel=1e-12)
+    assert records.spectrum_axis(settings) == (2.0, 15)

@@ -21,6 +21,7 @@ def command(args):
     import uq.engine.statkernels  # noqa: F401  (explicit signatures: compiled on import)
     import uq.engine.passkernels  # noqa: F401  (the same: long runs' one-pass batches)
     from uq.physics import fusedmotionkernels  # (the same)
+    from uq.physics import turbulencekernels  # noqa: F401  (record mode's: the same)
     from uq.physics import fusedkernels
     for number in (float, complex):
         for name in fusedkernels.KERNEL_NAMES:

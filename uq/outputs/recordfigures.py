@@ -1,10 +1,12 @@
 """Figures of a record-mode run (a ``turbulence`` section): the spectra of one record, the
 variance budget of the apparent turbulence intensity, and the apparent against the true TI.
 
-The spectra and the budget are drawn again from the scenario the result carries (its
-``scenario`` attribute, the scene as written in the file: swept keys at their file values):
-one record of the Monte Carlo path (one box) for the spectra, the spectral path with its
-contributions switched off one at a time for the budget. Both take seconds.
+The spectra are those the run stored (the mean periodograms of its records,
+:data:`uq.pipeline.records.SPECTRA_ATTRIBUTES`), at the scene as written in the file (the
+``scenario`` attribute: swept keys at their file values; every swept correction a line);
+a result written before runs stored them draws the file's scene's records again, and
+says so. The budget is the spectral path of that scene with its contributions switched
+off one at a time (about a second).
 
 Budget (variance of the record's Vh, [m2 s-2]; the bars add linearly to the total):
 
@@ -19,20 +21,18 @@ Budget (variance of the record's Vh, [m2 s-2]; the bars add linearly to the tota
 """
 import copy
 import dataclasses
+import sys
 
 import matplotlib.pyplot as plt
 import numpy as np
+import xarray as xr
 import yaml
-from scipy import signal
 
 from uq.physics.lidarspectral import lidar_variances, probe_transfer_for
-from uq.pipeline.records import (monte_carlo_record, record_generator, turbulence_model)
+from uq.pipeline import records
+from uq.pipeline.records import turbulence_model
 from uq.pipeline.scenario import load_scenario
-from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
-
-#: Records whose periodograms the spectra average [1]: 4 halve the scatter of one
-#: periodogram's ordinates (to 1/sqrt(4)) at the record's full frequency resolution.
-SPECTRUM_RECORDS = 4
+from uq.pipeline.turbulencesection import scan_geometry
 
 
 def record_plan(dataset):
@@ -52,44 +52,57 @@ def file_settings(dataset):
     return load_scenario(raw).settings
 
 
-def _variant(settings, **changes):
-    """Settings with top-level sections replaced (None removes one), validated."""
-    raw = copy.deepcopy(settings)
-    for key, value in changes.items():
-        if value is None:
-            raw.pop(key, None)
-        else:
-            raw[key] = value
-    return load_scenario(raw).settings
+def record_spectra_data(dataset, settings):
+    """The records' spectra of a result: the variables the run stored
+    (:data:`uq.pipeline.records.SPECTRA_ATTRIBUTES`), or, for a result written before
+    the runs stored them (or of ``sampling.method: none``), the file's scene's records
+    drawn now as a run draws them (one line on stderr says so): the scenario's
+    correction and, where the platform moves, ``none``."""
+    if "record_psd_wind_speed" in dataset:
+        return dataset
+    scenes = [settings]
+    if settings.get("motion") and settings["correction"] != "none":
+        scenes.append(records.at_correction(settings, "none"))
+    why = ("written before uq stored them" if "turbulence_intensity_mc_mean" in dataset
+           else "its run drew no Monte Carlo records")
+    print(f"uq: {settings['name']} has no stored record spectra ({why}): drawing "
+          f"{settings['record']['count']} records for {len(scenes)} scene(s) now; a run "
+          f"with Monte Carlo records stores them", file=sys.stderr, flush=True)
+    variables = records.spectra_variables(scenes, int(dataset.attrs.get("seed", 0)),
+                                          moving=bool(settings.get("motion")))
+    corrections = [scene["correction"] for scene in scenes]
+    data = {name: (tuple("correction" if d == "scene" else d for d in dims), values)
+            for name, (dims, values) in variables.items() if name != "record_frequency"}
+    return xr.Dataset(data, coords={"correction": corrections,
+                                    "record_frequency": variables["record_frequency"][1]})
 
 
-def record_series(settings, seed=0, records=SPECTRUM_RECORDS):
-    """Records of the field's u at the reference point, and of the lidar's Vh at the
-    first gate and the radial velocity of its first beam there (corrected as the
-    correction believes), once a scan, for the lidar fixed, moving uncorrected and moving
-    corrected (the scenario's correction); the same boxes for all. Returns (scan period
-    [s], {name: (records, n_scans) Vh or u}, {name: (records, n_scans) radial})."""
-    geometry = scan_geometry(settings)
-    n_scans = scans_per_record(settings)
-    still = copy.deepcopy(settings["ins"])
-    for key in ("rate", "interpolation", "clock_offset"):      # (nothing to sample at rest)
-        still.pop(key, None)
-    variants = {"lidar, fixed": _variant(settings, motion=None, correction="full", ins=still)}
-    if settings.get("motion"):
-        for correction in dict.fromkeys(("none", settings["correction"])):
-            variants[f"lidar, moving, correction {correction}"] = _variant(
-                settings, correction=correction)
-    speeds, radials = {"true u at the reference point": []}, {}
-    for name, variant in variants.items():
-        for r in range(records):
-            vh, reference, _, radial = monte_carlo_record(
-                variant, geometry, n_scans, record_generator(seed, r), radial=True)
-            if name == "lidar, fixed":
-                speeds["true u at the reference point"].append(reference)
-            speeds.setdefault(name, []).append(vh[:, 0])
-            radials.setdefault(name, []).append(radial[:, 0, 0])
-    return (geometry.scan_period, {k: np.array(v) for k, v in speeds.items()},
-            {k: np.array(v) for k, v in radials.items()})
+def spectra_lines(data, settings):
+    """(frequency [Hz], true u's PSD, {label: Vh's PSD}, {label: radial PSD}) at the
+    first gate of the file's scene (every swept correction a line; the lidar at rest
+    where the platform moves) [m2 s-2 Hz-1]."""
+    names = [name for name in records.SPECTRA_ATTRIBUTES if name in data]
+    data = file_scene(data[names], settings, keep=("correction", "range", "record_frequency"))
+    if "range" in data.dims:
+        data = data.isel(range=0)
+    moving = bool(settings.get("motion"))
+    corrections = list(data["correction"].values) if "correction" in data.dims \
+        else [settings["correction"]]
+
+    def at(name, correction):
+        values = data[name]
+        return (values.sel(correction=correction) if "correction" in values.dims
+                else values).values
+    speeds, radials = {}, {}
+    if moving and "record_psd_wind_speed_at_rest" in data:
+        speeds["lidar, fixed"] = at("record_psd_wind_speed_at_rest", corrections[0])
+        radials["lidar, fixed"] = at("record_psd_radial_velocity_at_rest", corrections[0])
+    for correction in corrections:
+        label = f"lidar, moving, correction {correction}" if moving else "lidar, fixed"
+        speeds[label] = at("record_psd_wind_speed", correction)
+        radials[label] = at("record_psd_radial_velocity", correction)
+    return (data["record_frequency"].values, at("record_psd_u_true", corrections[0]),
+            speeds, radials)
 
 
 def motion_peak(settings):
@@ -113,23 +126,26 @@ def aliased(frequency, sampling):
 def record_spectra(dataset):
     """PSD of the radial velocity of one beam and of the Vh a lidar reports, once a scan,
     fixed and moving, with and without correction, against the true u at the reference
-    point (sampled once a scan too), averaged over :data:`SPECTRUM_RECORDS` records; the
-    -5/3 slope, and the motion's peak where the scan's sampling aliases it (a DBS samples
-    each beam once a scan: the wave motion folds below 1 / (2 T_s))."""
+    point (sampled once a scan too), the mean over the run's records of each record's
+    periodogram, as the run stored it (:func:`record_spectra_data`); the -5/3 slope, and
+    the motion's peak where the scan's sampling aliases it (a DBS samples each beam once
+    a scan: the wave motion folds below 1 / (2 T_s))."""
     settings = file_settings(dataset)
-    period, speeds, radials = record_series(settings, int(dataset.attrs.get("seed", 0)))
+    frequency, true, speeds, radials = spectra_lines(record_spectra_data(dataset, settings),
+                                                     settings)
+    period = records.spectrum_axis(settings)[0]
     figure, axes = plt.subplots(1, 2, figsize=(11.0, 4.4), constrained_layout=True,
                                 sharey=True)
+    speeds = {"true u at the reference point": true, **speeds}
     colours = {name: f"C{k}" for k, name in enumerate(speeds)}
     titles = (f"radial velocity of beam 0 (azimuth {settings['lidar']['azimuths'][0]:g})",
               "horizontal wind speed Vh")
+    f = frequency[1:]
     for ax, series, title in zip(axes, (radials, speeds), titles):
-        for name, values in series.items():
-            f, psd = signal.periodogram(values - values.mean(axis=1, keepdims=True),
-                                        fs=1.0 / period, axis=1)
-            ax.loglog(f[1:], psd.mean(axis=0)[1:], color=colours[name],
+        for name, psd in series.items():
+            ax.loglog(f, psd[1:], color=colours[name],
                       lw=2.2 if name.startswith("true") else 1.2, label=name)
-        _slope(ax, f[1:], psd.mean(axis=0)[1:])
+        _slope(ax, f, true[1:])
         _mark_motion(ax, settings, period)
         ax.set_xlabel(f"frequency [Hz] (scans of {period:.3g} s)")
         ax.set_title(title, fontsize=9)
@@ -137,7 +153,7 @@ def record_spectra(dataset):
     axes[0].set_ylabel("PSD [m$^2$ s$^{-2}$ Hz$^{-1}$]")
     axes[1].legend(fontsize=7, loc="lower left")
     figure.suptitle(f"{dataset.attrs.get('title', '')}: gate {settings['lidar']['ranges'][0]:g}"
-                    f" m, mean of {SPECTRUM_RECORDS} records", fontsize=9)
+                    f" m, mean of {settings['record']['count']} records", fontsize=9)
     return figure
 
 
@@ -207,10 +223,11 @@ def error_contributions(dataset, settings):
     return names, [groups[n] for n in names]
 
 
-def file_scene(variable, settings):
-    """`variable` at the scene of the file's values of the swept keys (the nearest swept
-    value; the first where the key is not a number)."""
-    for dim in [d for d in variable.dims if d not in ("input", "range", "beam")]:
+def file_scene(variable, settings, keep=("input", "range", "beam")):
+    """`variable` (a DataArray or Dataset) at the scene of the file's values of the swept
+    keys (the nearest swept value; the first where the key is not a number); the
+    dimensions in `keep` are kept whole."""
+    for dim in [d for d in variable.dims if d not in keep]:
         node = settings
         for part in dim.split("_", 1):
             node = node.get(part, {}) if isinstance(node, dict) else {}

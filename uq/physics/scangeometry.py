@@ -148,3 +148,53 @@ class ScanGeometry:
         along = np.asarray(self.probe_offsets)[None, None, :, None]
         return (np.asarray(self.gate_centres)[:, :, None, :]
                 + along * np.asarray(self.directions)[:, None, None, :])
+
+
+def conical_scan(heights, half_cone=30.0, beam_duration=0.001, n_beams=4, vertical=False,
+                 record=600.0, offsets=(0.0,), weights=None, speed=10.0):
+    """A fixed, level conical scan (a DBS, or a VAD of many beams) from the ground.
+
+    Beam 0 along the wind (azimuth 0 = +x), the beams counter-clockwise at equal steps,
+    then the vertical beam (`vertical`); the reference point at the first height; the
+    beams one after another, each `beam_duration` [s] long and averaged over it; the
+    reconstruction the pseudo-inverse of the directions at every gate.
+
+    Parameters
+    ----------
+    heights : float or sequence of float
+        Gate heights above the lidar [m].
+    half_cone : float
+        Angle of the slanted beams from the vertical [deg].
+    beam_duration : float
+        Dwell of each beam [s].
+    n_beams : int
+        Slanted beams.
+    vertical : bool
+        Whether a vertical beam follows them.
+    record : float
+        Record duration [s] (``inf``: no high-pass).
+    offsets : sequence of float
+        Probe nodes along the beam from the gate centre [m] (one at 0: a point probe).
+    weights : array, shape (n_gates, n_nodes), optional
+        Their weights (default equal, summing to 1).
+    speed : float
+        Mean wind speed [m s-1].
+
+    Returns
+    -------
+    ScanGeometry
+    """
+    phi, heights = np.radians(half_cone), np.atleast_1d(np.asarray(heights, float))
+    azimuths = np.radians(np.arange(n_beams) * 360.0 / n_beams)
+    d = np.stack([np.sin(phi) * np.cos(azimuths), np.sin(phi) * np.sin(azimuths),
+                  np.full(n_beams, np.cos(phi))], -1)
+    if vertical:
+        d = np.vstack([d, [0.0, 0.0, 1.0]])
+    slant = heights[None, :] / d[:, 2:3]
+    centres = np.array([0.0, 0.0, -heights[0]]) + slant[..., None] * d[:, None, :]
+    n = len(d)
+    weights = (np.ones((len(heights), np.size(offsets))) / np.size(offsets)
+               if weights is None else weights)
+    return ScanGeometry(d, centres, (np.arange(n) + 0.5) * beam_duration, beam_duration,
+                        n * beam_duration, np.asarray(offsets, float), weights,
+                        np.tile(np.linalg.pinv(d)[None], (len(heights), 1, 1)), speed, record)

@@ -439,7 +439,8 @@ def mann_box(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
     grid : BoxGrid
         The box (periodic in x, y, z).
     alpha_epsilon : float
-        alpha eps^(2/3) [m4/3 s-2], which sets the variance.
+        alpha eps^(2/3) [m4/3 s-2], which sets the variance (the box is linear in its
+        square root).
     length_scale, anisotropy : float
         Mann's L [m] and Gamma [1].
     rng : numpy.random.Generator
@@ -447,16 +448,159 @@ def mann_box(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
     xp : module
         numpy, or cupy (:func:`array_namespace`).
     slab_cells : int
-        Cells of the spectral factor evaluated at a time (memory; the box does not
-        depend on it).
+        Cells transformed at a time (memory; the box does not depend on it).
     workers : int or None
         Threads of scipy's FFT (numpy only).
 
     Returns
     -------
     TurbulenceBox
-        ``velocity`` (3, nx, ny, nz) [m s-1] on ``xp``'s device.
+        ``velocity`` (3, nx, ny, nz) [m s-1] on ``xp``'s device; on the host each
+        component is C-contiguous, the three held in the memory of their half spectra
+        (:func:`_mann_box_host`).
     """
+    if xp is np:
+        return _mann_box_host(grid, alpha_epsilon, length_scale, anisotropy, rng,
+                              slab_cells, workers)
+    return mann_box_reference(grid, alpha_epsilon, length_scale, anisotropy, rng, xp,
+                              slab_cells, workers)
+
+
+def _mann_box_host(grid, alpha_epsilon, length_scale, anisotropy, rng, slab_cells, workers):
+    """:func:`mann_box` on the host in the memory of the three half spectra alone.
+
+    The same field as :func:`mann_box_reference` to rounding (the same random numbers,
+    drawn slab by slab along x in the same C order; the 3-D real FFT taken as a 2-D one
+    per slab and a 1-D one along x; the factor applied by the compiled
+    :func:`uq.physics.turbulencekernels.mann_colour`), in about half its memory and a
+    third of its time: each component's half spectrum (nx, ny, nz // 2 + 1) complex
+    holds, after the inverse transform, that component's real field (nx, ny, nz) at its
+    start (slab i's output goes where slabs <= i were read from).
+    """
+    from uq.physics.turbulencekernels import mann_colour
+    (nx, ny, nz), half = grid.shape, grid.shape[2] // 2 + 1
+    spectra = np.empty((3, nx, ny, half), dtype=complex)
+    slabs = _x_slabs(grid, slab_cells)
+    for c in range(3):
+        for slab in slabs:              # C order: component, then x, y, z (white_noise)
+            noise = rng.standard_normal((slab.stop - slab.start, ny, nz))
+            spectra[c, slab] = scipy.fft.rfft2(noise, workers=workers)
+        _in_place(scipy.fft.fft, spectra[c], workers)
+    k1, k2, k3 = (k.ravel() for k in box_wavenumbers(grid))
+    scale = np.sqrt((2.0 * np.pi) ** 3 / np.prod(grid.spacing))    # sqrt(N dk)
+    cells, factors = cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy)
+    index = (slice(None),) + tuple(cells.T)
+    noise_cells = spectra[index]                                    # (3, n): a copy
+    mann_colour(spectra[0], spectra[1], spectra[2], k1, k2, k3, alpha_epsilon, length_scale,
+                anisotropy, scale, float(_TABLE[0][0]), float(_TABLE[0][1] - _TABLE[0][0]),
+                np.ascontiguousarray(_TABLE[1]))                    # u_k = i C n
+    # near the k1 axis: u_k = C_avg n, C_avg even, so u_-k = u_k^* (module docstring)
+    spectra[index] = scale * np.einsum("ijn,jn->in", factors, noise_cells)
+    size = nx * ny * nz
+    for c in range(3):
+        _in_place(scipy.fft.ifft, spectra[c], workers)
+        field = spectra[c].reshape(-1).view(np.float64)[:size].reshape(nx, ny, nz)
+        for slab in slabs:
+            field[slab] = scipy.fft.irfft2(spectra[c, slab], s=(ny, nz), workers=workers)
+    velocity = spectra.reshape(3, -1).view(np.float64)[:, :size].reshape(3, nx, ny, nz)
+    return TurbulenceBox(grid=grid, velocity=velocity)
+
+
+def mann_box_window(grid, alpha_epsilon, length_scale, anisotropy, rng, window, parts=1,
+                    slab_cells=constants.BOX_SLAB_CELLS):
+    """The field of :func:`mann_box` on a window of its (y, z) cells, in the memory of
+    1 / `parts` of its half spectra (on the host).
+
+    The same random numbers and the same field as :func:`mann_box` to rounding (the
+    transforms are linear: the half spectrum's z wavenumbers are taken in `parts` parts,
+    each drawn from the same noise again, coloured, transformed back and added); only
+    the window's (y, z) lines are transformed back along z and kept. `rng` is left where
+    one draw of the box leaves it.
+
+    Parameters
+    ----------
+    grid, alpha_epsilon, length_scale, anisotropy, rng, slab_cells
+        As :func:`mann_box`.
+    window : ((int, int), (int, int))
+        The cells [j0, j1) along y and [m0, m1) along z kept (each at least 2 wide).
+    parts : int
+        Parts of the half spectrum held at a time: the memory of the spectra is divided
+        by it, the noise is drawn and its 2-D transforms taken that many times.
+
+    Returns
+    -------
+    TurbulenceBox
+        On the window: ``grid`` of shape (nx, j1 - j0, m1 - m0) with its origin moved to
+        cell (0, j0, m0), periodic along x only (``periodic_yz`` False: a point outside
+        the window is refused, not wrapped).
+    """
+    from uq.physics.turbulencekernels import mann_colour
+    (nx, ny, nz), half = grid.shape, grid.shape[2] // 2 + 1
+    (j0, j1), (m0, m1) = window
+    slabs = _x_slabs(grid, slab_cells)
+    k1, k2, k3 = (np.ascontiguousarray(k.ravel()) for k in box_wavenumbers(grid))
+    scale = np.sqrt((2.0 * np.pi) ** 3 / np.prod(grid.spacing))    # sqrt(N dk)
+    cells, factors = cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy)
+    table = (float(_TABLE[0][0]), float(_TABLE[0][1] - _TABLE[0][0]),
+             np.ascontiguousarray(_TABLE[1]))
+    velocity = np.zeros((3, nx, j1 - j0, m1 - m0))
+    start = rng.bit_generator.state
+    edges = np.linspace(0, half, max(1, min(parts, half)) + 1).round().astype(int)
+    for a, b in zip(edges[:-1], edges[1:]):
+        rng.bit_generator.state = start
+        spectra = np.empty((3, nx, ny, b - a), dtype=complex)
+        for c in range(3):
+            for slab in slabs:          # C order: component, then x, y, z (white_noise)
+                noise = rng.standard_normal((slab.stop - slab.start, ny, nz))
+                spectra[c, slab] = scipy.fft.rfft2(noise)[..., a:b]
+            _in_place(scipy.fft.fft, spectra[c], None)
+        here = (cells[:, 2] >= a) & (cells[:, 2] < b)
+        index = (slice(None), cells[here, 0], cells[here, 1], cells[here, 2] - a)
+        noise_cells = spectra[index]                                # (3, n): a copy
+        mann_colour(spectra[0], spectra[1], spectra[2], k1, k2, np.ascontiguousarray(k3[a:b]),
+                    alpha_epsilon, length_scale, anisotropy, scale, *table)   # u_k = i C n
+        # near the k1 axis: u_k = C_avg n, C_avg even, so u_-k = u_k^* (module docstring)
+        spectra[index] = scale * np.einsum("ijn,jn->in", factors[:, :, here], noise_cells)
+        for c in range(3):
+            _in_place(scipy.fft.ifft, spectra[c], None)
+            for slab in slabs:
+                rows = scipy.fft.ifft(spectra[c, slab], axis=1)[:, j0:j1]
+                padded = np.zeros(rows.shape[:2] + (half,), dtype=complex)
+                padded[..., a:b] = rows
+                velocity[c, slab] += scipy.fft.irfft(padded, n=nz, axis=2)[..., m0:m1]
+        del spectra
+    (dx, dy, dz), origin = grid.spacing, grid.origin
+    window_grid = BoxGrid(shape=(nx, j1 - j0, m1 - m0), spacing=grid.spacing,
+                          origin=(origin[0], origin[1] + j0 * dy, origin[2] + m0 * dz),
+                          periodic_yz=False)
+    return TurbulenceBox(grid=window_grid, velocity=velocity)
+
+
+def box_window(grid, points, margin=0.0):
+    """The (y, z) cells of `grid` that hold `points` (..., 3) [m] each moved by up to
+    `margin` [m], with the corners trilinear interpolation reads: ((j0, j1), (m0, m1))."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    out = []
+    for axis in (1, 2):
+        low = (points[:, axis].min() - margin - grid.origin[axis]) / grid.spacing[axis]
+        high = (points[:, axis].max() + margin - grid.origin[axis]) / grid.spacing[axis]
+        first = max(0, int(np.floor(low)) - 1)
+        out.append((first, min(grid.shape[axis], max(int(np.floor(high)) + 2, first + 2))))
+    return tuple(out)
+
+
+def _in_place(transform, array, workers):
+    """``array <- transform(array, axis=0)``, in its own memory."""
+    out = transform(array, axis=0, overwrite_x=True, workers=workers)
+    if out.ctypes.data != array.ctypes.data:      # (scipy writes in place; if not, copy)
+        array[...] = out
+
+
+def mann_box_reference(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np,
+                       slab_cells=constants.BOX_SLAB_CELLS, workers=None):
+    """:func:`mann_box` in array code (numpy or CuPy) throughout: the reference the
+    host's compiled path is tested against, and the GPU's path. Parameters as
+    :func:`mann_box`."""
     fft = _fft(xp)
     kwargs = {"workers": workers} if xp is np else {}
     axes = (1, 2, 3)

@@ -164,11 +164,42 @@ def record_radial_velocities(box, geometry, n_scans, displacements=None, directi
         lidar = lidar_position(geometry) if position is None else np.asarray(position, float)
         ranges = gate_ranges(geometry, lidar)
     dwell = dwell_offsets(geometry, min(box.grid.spacing))
+    if xp is np:
+        return _compiled_scans(box, geometry, n_scans, true_dirs, moved, lidar, ranges,
+                               dwell, start_time)
     per_scan = geometry.n_beams * geometry.n_gates * np.size(geometry.probe_offsets) * dwell.size
     step = max(1, SAMPLING_CHUNK_POINTS // per_scan)
     parts = [_scans(box, geometry, s, min(s + step, n_scans), true_dirs, moved, lidar, ranges,
                     dwell, start_time, xp) for s in range(0, n_scans, step)]
     return xp.concatenate(parts, axis=0)
+
+
+def _compiled_scans(box, geometry, n_scans, directions, moved, lidar, ranges, dwell, start):
+    """:func:`record_radial_velocities` on the host by the compiled
+    :func:`uq.physics.turbulencekernels.radial_samples` (the same points, times and
+    sums as :func:`_scans`, without its temporaries; nodes of zero weight skipped)."""
+    from uq.physics.turbulencekernels import radial_samples
+    grid, offsets = box.grid, np.asarray(geometry.probe_offsets, dtype=float)
+    shape = (geometry.n_beams, geometry.n_gates, offsets.size)
+    if ranges is None:                  # nominal directions: move the nominal points
+        fixed, anchor, along = geometry.probe_points(), moved, np.zeros(shape)
+    else:
+        fixed = np.zeros(shape + (3,))
+        anchor = lidar + moved
+        along = ranges[:, :, None] + offsets[None, None, :]
+    times = (start + np.arange(n_scans)[:, None] * geometry.scan_period
+             + np.asarray(geometry.times)[None, :])                     # (S, B)
+    out = np.empty((n_scans, geometry.n_beams, geometry.n_gates))
+    def c(array):                       # the kernel's types: float64, C order, writable
+        return np.require(array, np.float64, ("C", "W"))
+    outside = radial_samples(
+        *(c(box.velocity[k]) for k in range(3)), c(grid.origin), c(grid.spacing),
+        bool(grid.periodic_yz), c(fixed), c(anchor), c(directions), c(along), c(times),
+        c(dwell), c(geometry.probe_weights), float(geometry.speed), out)
+    if outside:
+        raise ValueError(f"{outside} probe point(s) leave the turbulence box along y or z: "
+                         "size it with box_for")
+    return out
 
 
 def _scans(box, geometry, first, last, directions, moved, lidar, ranges, dwell, start, xp):

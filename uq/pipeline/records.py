@@ -28,15 +28,23 @@ Unless ``sampling.method`` is ``none``, ``record.count`` Monte Carlo records per
 give the distribution of the apparent TI and of the record mean
 (:func:`monte_carlo_variables`).
 """
+import collections
 import copy
+import dataclasses
+import functools
+import hashlib
 import math
+import threading
 
 import numpy as np
+from scipy import signal
 
 from uq.physics.lidarspectral import lidar_variances, probe_transfer_for
 from uq.physics.spectraltensor import KaimalSpectra, mann_tensor_for_intensity
 from uq.pipeline import probesection
 from uq.constants import KAIMAL_LENGTH_FACTOR as LENGTH_FACTORS_KAIMAL
+from uq.constants import (RECORD_BOX_SLAB_CELLS, RECORD_SPECTRA_BYTES,
+                          UNIT_RECORD_CACHE_BYTES)
 from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
 
 #: Attributes of the record-mode variables.
@@ -135,10 +143,12 @@ def scene_settings(scenario, fields):
     return out
 
 
-def record_variables(scenario, fields, dataset, seed=0, compiled=True):
+def record_variables(scenario, fields, dataset, seed=0, compiled=True, spectra_of=None):
     """The record-mode variables of a chunk's scenes (dimension ``scene``, and ``range``):
     `fields` as :func:`scene_settings`; `dataset` the chunk's per-scan results; the
-    Monte Carlo records (unless ``sampling.method`` is ``none``) from `seed`."""
+    Monte Carlo records (unless ``sampling.method`` is ``none``) from `seed`; with
+    `spectra_of` (the validated settings of the run's file, the same for every chunk)
+    also the records' spectra on its frequencies (:data:`SPECTRA_ATTRIBUTES`)."""
     scenes = scene_settings(scenario, fields)
     n_gates = len(scenario.settings["lidar"]["ranges"])
     lidar, true = np.full((len(scenes), n_gates), np.nan), np.full(len(scenes), np.nan)
@@ -158,8 +168,10 @@ def record_variables(scenario, fields, dataset, seed=0, compiled=True):
         "turbulence_intensity_u_ratio": (("scene", "range"), lidar / true[:, None]),
     }
     if scenario.sampling["method"] != "none":
-        out.update(monte_carlo_variables(scenes, truth, seed, compiled,
-                                         out["turbulence_intensity_spectral"][1]))
+        out.update(monte_carlo_variables(
+            scenes, truth, seed, compiled, out["turbulence_intensity_spectral"][1],
+            spectrum_axis(spectra_of) if spectra_of else None,
+            bool(spectra_of and spectra_of.get("motion"))))
     return out
 
 
@@ -196,23 +208,164 @@ def turbulence_box(settings, geometry, rng, motion_margin=0.0):
     (:func:`uq.physics.turbulencebox.box_for`), and the variance of u it keeps of the
     model's point variance [1] (Mann: its discrete wavenumbers, ``box_variance``;
     Kaimal: NaN, not computed: its box misses the frequencies below 1 / (its length /
-    U), which a record's high-pass partly keeps)."""
+    U), which a record's high-pass partly keeps). The box is :func:`unit_box` times
+    :func:`field_scale`."""
+    box, kept = unit_box(settings, geometry, rng, motion_margin, window=False)
+    box.velocity[...] *= field_scale(settings)
+    return box, kept
+
+
+def field_scale(settings):
+    """What the unit field of :func:`unit_box` is multiplied by: the square root of Mann's
+    alpha eps^(2/3) [m2/3 s-1] (the field is linear in it, Mann 1998 Sec. 3), or the
+    Kaimal field's sigma_u = intensity x speed [m s-1]."""
+    turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
+    if turbulence["model"] == "mann":
+        return math.sqrt(turbulence_model(turbulence, speed).alpha_epsilon)
+    return turbulence["intensity"] * speed
+
+
+def unit_box(settings, geometry, rng, motion_margin=0.0, window=True):
+    """:func:`turbulence_box` of unit :func:`field_scale` (the same random numbers; the
+    box of any intensity is this one times its scale), and the variance of u it keeps of
+    the model's point variance [1]. With `window` a Mann box holds only the (y, z) lines
+    that the probe points (and the reference point) read
+    (:func:`uq.physics.turbulencebox.mann_box_window`), its half spectra in parts of at
+    most :data:`~uq.constants.RECORD_SPECTRA_BYTES`."""
     from uq.physics import turbulencebox
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
-    model = turbulence_model(turbulence, speed)
     if turbulence["model"] == "mann":
         grid = turbulencebox.box_for(geometry, turbulence["length_scale"], "mann",
                                      motion_margin=motion_margin)
-        box = turbulencebox.mann_box(grid, model.alpha_epsilon, model.length_scale,
-                                     model.anisotropy, rng)
-        kept = turbulencebox.box_variance(grid, model.alpha_epsilon, model.length_scale,
-                                          model.anisotropy)[0] / (turbulence["intensity"]
-                                                                  * speed) ** 2
+        model = turbulence_model(turbulence, speed)      # (kept first: not beside the box)
+        kept = _unit_box_variance(grid, turbulence["length_scale"], turbulence["anisotropy"]) \
+            * model.alpha_epsilon / (turbulence["intensity"] * speed) ** 2
+        if not window:
+            return turbulencebox.mann_box(grid, 1.0, turbulence["length_scale"],
+                                          turbulence["anisotropy"], rng,
+                                          slab_cells=RECORD_BOX_SLAB_CELLS), float(kept)
+        points = np.vstack([np.asarray(geometry.probe_points()).reshape(-1, 3), np.zeros(3)])
+        nx, ny, nz = grid.shape
+        parts = math.ceil(3 * nx * ny * (nz // 2 + 1) * 16 / RECORD_SPECTRA_BYTES)
+        box = turbulencebox.mann_box_window(
+            grid, 1.0, turbulence["length_scale"], turbulence["anisotropy"], rng,
+            turbulencebox.box_window(grid, points, motion_margin), parts,
+            slab_cells=RECORD_BOX_SLAB_CELLS)
         return box, float(kept)
     scale = turbulence["length_scale"] / LENGTH_FACTORS_KAIMAL
     grid = turbulencebox.box_for(geometry, scale, "kaimal", motion_margin=motion_margin)
-    return turbulencebox.kaimal_box(grid, turbulence["intensity"] * speed, speed, scale,
-                                    rng), np.nan
+    return turbulencebox.kaimal_box(grid, 1.0, speed, scale, rng), np.nan
+
+
+@functools.lru_cache(maxsize=8)
+def _unit_box_variance(grid, length_scale, anisotropy):
+    """The u-variance of a Mann box of unit alpha eps^(2/3) [m2 s-2 per m4/3 s-2]
+    (``box_variance``: a function of the grid and the model alone, kept per run)."""
+    from uq.physics import turbulencebox
+    return float(turbulencebox.box_variance(grid, 1.0, length_scale, anisotropy,
+                                            slab_cells=RECORD_BOX_SLAB_CELLS)[0])
+
+
+@dataclasses.dataclass(frozen=True)
+class UnitRecord:
+    """The turbulence of one record for a field of unit scale (:func:`unit_record`).
+
+    Attributes
+    ----------
+    radial : ndarray, shape (n_scans, n_beams, n_gates)
+        The turbulence's radial velocity of each beam and gate [m s-1 per unit scale],
+        at the beams' true (moving) positions.
+    reference : ndarray, shape (n_scans, 3)
+        The field at the reference point once a scan [m s-1 per unit scale].
+    at_rest : ndarray or None
+        ``radial`` at the nominal positions (the lidar at rest), where asked for.
+    kept : float
+        u-variance fraction the box keeps [1].
+    state : dict
+        The record generator's state after the box's draw.
+    """
+
+    radial: np.ndarray
+    reference: np.ndarray
+    at_rest: object
+    kept: float
+    state: dict
+
+    @property
+    def nbytes(self):
+        return sum(a.nbytes for a in (self.radial, self.reference, self.at_rest)
+                   if a is not None)
+
+
+_UNIT_RECORDS = collections.OrderedDict()
+_UNIT_RECORDS_LOCK = threading.Lock()
+
+
+def unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest=False):
+    """The turbulence of one record, for a field of unit :func:`field_scale`, drawn from
+    `rng` as :func:`unit_box` draws it (`rng` is left where the box's draw leaves it).
+
+    The field is linear in its scale, so every scene that draws the same box (the same
+    generator state, grid, length scale, anisotropy) and samples it at the same points
+    (geometry, motion) shares it: a sweep of ``turbulence.intensity`` or of the
+    correction generates each record's box once. Such records are kept for reuse
+    (:data:`~uq.constants.UNIT_RECORD_CACHE_BYTES`, the least recently used dropped
+    first); a record is the same whether generated or reused, so results do not depend
+    on which scenes a process ran before, nor on the chunking.
+
+    Parameters
+    ----------
+    moving, margin
+        :func:`moving_probes`' keyword arguments and margin [m].
+    at_rest : bool
+        Also sample the box at the nominal positions (:attr:`UnitRecord.at_rest`).
+    """
+    key = _unit_key(settings, geometry, n_scans, rng, moving, margin, at_rest)
+    with _UNIT_RECORDS_LOCK:
+        found = _UNIT_RECORDS.get(key)
+        if found is not None:
+            _UNIT_RECORDS.move_to_end(key)
+    if found is None:
+        found = _draw_unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest)
+        _keep(key, found)
+    rng.bit_generator.state = found.state
+    return found
+
+
+def _draw_unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest):
+    """:func:`unit_record` generated: the box, sampled, then freed."""
+    from uq.physics import turbulencesampling
+    box, kept = unit_box(settings, geometry, rng, margin)
+    radial = np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans,
+                                                                    **moving))
+    times = turbulencesampling.scan_times(geometry, n_scans)
+    reference = np.asarray(turbulencesampling.reference_series(box, geometry.speed, times))
+    rest = np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans)) \
+        if at_rest else None
+    return UnitRecord(radial, reference, rest, kept, rng.bit_generator.state)
+
+
+def _unit_key(settings, geometry, n_scans, rng, moving, margin, at_rest):
+    """What a unit record depends on, as a hashable key."""
+    turbulence = settings["turbulence"]
+    digest = hashlib.sha256()
+    for value in (*(getattr(geometry, f.name) for f in dataclasses.fields(geometry)),
+                  *(moving[name] for name in sorted(moving))):
+        array = np.ascontiguousarray(value, dtype=float)
+        digest.update(repr(array.shape).encode())
+        digest.update(array.tobytes())
+    return (repr(rng.bit_generator.state), turbulence["model"], turbulence["length_scale"],
+            turbulence["anisotropy"], n_scans, float(margin), bool(at_rest),
+            digest.hexdigest())
+
+
+def _keep(key, record):
+    """Keep a unit record, dropping the least recently used beyond the byte limit."""
+    with _UNIT_RECORDS_LOCK:
+        _UNIT_RECORDS[key] = record
+        total = sum(r.nbytes for r in _UNIT_RECORDS.values())
+        while total > UNIT_RECORD_CACHE_BYTES and len(_UNIT_RECORDS) > 1:
+            total -= _UNIT_RECORDS.popitem(last=False)[1].nbytes
 
 
 def coherent_phases(scene, n_scans, scan_period, rng):
@@ -249,11 +402,10 @@ def scan_errors(settings, scene, n_scans, rng):
     return values
 
 
-def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True, radial=False):
+def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True, spectra=None):
     """One record: the per-scan horizontal speed [m s-1] at each gate (n_scans, n_gates),
     the field's u at the reference point once a scan (n_scans,) [m s-1] (mean speed
-    included) and the u-variance fraction the box keeps [1]; with `radial` also the
-    corrected radial velocities (n_scans, n_beams, n_gates) [m s-1] (a fourth item).
+    included) and the u-variance fraction the box keeps [1].
 
     The turbulence's radial velocity along each beam at its beam time
     (:func:`uq.physics.turbulencesampling.record_radial_velocities`) enters the
@@ -265,31 +417,94 @@ def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True, radial=F
     attitude, at the middle of its dwell, with the same phases as the measurement
     model's); the box is widened by the largest displacement of a probe point. Without
     motion, at the nominal points (the random streams are then drawn as before: the
-    phases draw nothing).
+    phases draw nothing). The box is the unit box of :func:`unit_record` times
+    :func:`field_scale`.
+
+    With `spectra` (a generator: :func:`rest_generator`) a fourth item, the series the
+    record spectra are taken of (:func:`record_spectra_series`).
     """
-    from uq.physics import turbulencesampling
     from uq.physics.measurement import measurement_model
     from uq.pipeline.modelsetup import scene_from_settings
     scene = probe_volume_resolved(scene_from_settings(settings))
     scene, phases = coherent_phases(scene, n_scans, geometry.scan_period, rng)
     moving, margin = moving_probes(settings, scene, phases, geometry)
-    box, kept = turbulence_box(settings, geometry, rng, margin)
-    seen = np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans,
-                                                                  **moving))
-    times = turbulencesampling.scan_times(geometry, n_scans)
-    reference = np.asarray(turbulencesampling.reference_series(box, geometry.speed, times))
-    del box
+    unit = unit_record(settings, geometry, n_scans, rng, moving, margin,
+                       at_rest=spectra is not None and phases is not None)
+    scale = field_scale(settings)
     errors = scan_errors(settings, scene, n_scans, rng)
-    errors["lidar_radial_velocity"] = errors.get("lidar_radial_velocity", 0.0) + seen
+    errors["lidar_radial_velocity"] = errors.get("lidar_radial_velocity", 0.0) \
+        + scale * unit.radial
     if phases is not None:
         errors["motion_phases"] = phases
-    outputs = ("wind_speed", "radial_velocity") if radial else ("wind_speed",)
-    result = measurement_model(scene, outputs, compiled=compiled, **errors)
+    result = measurement_model(scene, ("wind_speed",), compiled=compiled, **errors)
     speed = np.real(result["wind_speed"]).reshape(n_scans, -1)
-    found = (speed, geometry.speed + reference[:, 0], kept)
-    if radial:
-        found += (np.real(result["radial_velocity"]).reshape(n_scans, scene.n_beams, -1),)
+    found = (speed, geometry.speed + scale * unit.reference[:, 0], unit.kept)
+    if spectra is not None:
+        found += (record_spectra_series(settings, scene, errors, unit, scale, n_scans,
+                                        spectra, compiled),)
     return found
+
+
+def record_spectra_series(settings, scene, errors, unit, scale, n_scans, rng, compiled):
+    """The series of a record whose spectra the run keeps (:data:`SPECTRA_ATTRIBUTES`),
+    each (n_scans, n_gates) once a scan: the corrected radial velocity of beam 0 (the
+    same trials as the record's Vh) and, where the platform moves, the Vh and radial
+    velocity of the lidar at rest (:func:`at_rest`) in the same box, its own errors
+    drawn from `rng`."""
+    from uq.physics.measurement import measurement_model
+    from uq.pipeline.modelsetup import scene_from_settings
+    radial = measurement_model(scene, ("radial_velocity",), compiled=compiled, **errors)
+    series = {"radial_velocity": np.real(radial["radial_velocity"]).reshape(
+        n_scans, scene.n_beams, -1)[:, 0]}
+    if unit.at_rest is None:
+        return series
+    rest = at_rest(settings)
+    still = probe_volume_resolved(scene_from_settings(rest))
+    draws = scan_errors(rest, still, n_scans, rng)
+    draws["lidar_radial_velocity"] = draws.get("lidar_radial_velocity", 0.0) \
+        + scale * unit.at_rest
+    result = measurement_model(still, ("wind_speed", "radial_velocity"), compiled=compiled,
+                               **draws)
+    series["wind_speed_at_rest"] = np.real(result["wind_speed"]).reshape(n_scans, -1)
+    series["radial_velocity_at_rest"] = np.real(result["radial_velocity"]).reshape(
+        n_scans, still.n_beams, -1)[:, 0]
+    return series
+
+
+def at_correction(settings, correction):
+    """The validated settings with another ``correction``."""
+    from uq.pipeline.scenario import load_scenario
+    return load_scenario({**copy.deepcopy(settings), "correction": correction,
+                          "sweep": {}}).settings
+
+
+def spectra_variables(scenes, seed, compiled=True, moving=False):
+    """The records' spectra alone (:class:`RecordSpectra`'s variables, dimension
+    ``scene``) of validated `scenes` of one scan, their records drawn from `seed` as a
+    run draws them: for a result written before runs stored them."""
+    spectra = RecordSpectra(spectrum_axis(scenes[0]), len(scenes),
+                            len(scenes[0]["lidar"]["ranges"]))
+    for i, settings in enumerate(scenes):
+        geometry, count = scan_geometry(settings), settings["record"]["count"]
+        for r in range(count):
+            found = monte_carlo_record(settings, geometry, spectra.n_scans,
+                                       record_generator(seed, r), compiled,
+                                       rest_generator(seed, r))
+            spectra.add(i, {"wind_speed": found[0], "u_true": found[1], **found[3]}, count)
+    return spectra.variables(moving)
+
+
+def at_rest(settings):
+    """The validated settings of the lidar at rest: no motion, the full correction (of a
+    level lidar at rest: its reconstruction), the INS's errors without its sampling
+    (nothing moves between its readings)."""
+    from uq.pipeline.scenario import load_scenario
+    raw = {**copy.deepcopy(settings), "sweep": {}}       # (this scene alone)
+    raw.pop("motion", None)
+    raw["correction"] = "full"
+    for key in ("rate", "interpolation", "clock_offset"):
+        raw.get("ins", {}).pop(key, None)
+    return load_scenario(raw).settings
 
 
 def moving_probes(settings, scene, phases, geometry):
@@ -317,7 +532,7 @@ def probe_volume_resolved(scene):
     return probe.resolve(scene)
 
 
-def monte_carlo_variables(scenes, truth, seed, compiled, spectral):
+def monte_carlo_variables(scenes, truth, seed, compiled, spectral, axis=None, moving=False):
     """The Monte Carlo records of each scene (``record.count`` records, the same random
     streams for every scene), reduced per record as a lidar's software reduces it (the
     record's mean and sample standard deviation of Vh), then over the records.
@@ -333,6 +548,11 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral):
     of that mean (clause 8 in spirit: the spectral path is validated where |z| <= 2,
     ``turbulence_intensity_spectral_valid``); ``turbulence_intensity_box_kept``: the
     u-variance the box keeps of the model's (where the two paths part by design).
+
+    With `axis` (:func:`spectrum_axis`: the run's scan period [s] and scans per record)
+    also the records' mean spectra (:data:`SPECTRA_ATTRIBUTES`) on its frequencies, NaN
+    for a scene whose records are of other scans; with `moving` (the run's file has
+    motion) also those of the lidar at rest.
     """
     records = [scene["record"] for scene in scenes]
     count = records[0]["count"]
@@ -341,21 +561,26 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral):
     true_ti = np.full((len(scenes), count), np.nan)
     error = np.full((len(scenes), count, n_gates), np.nan)
     kept = np.full(len(scenes), np.nan)
+    spectra = RecordSpectra(axis, len(scenes), n_gates) if axis else None
     for i, settings in enumerate(scenes):
         if not settings["wind"]["speed"] > 0:
             continue
         geometry = scan_geometry(settings)
         n_scans = scans_per_record(settings)
+        wanted = spectra is not None and spectra.fits(geometry.scan_period, n_scans)
         for r in range(count):
-            vh, reference, kept[i] = monte_carlo_record(settings, geometry, n_scans,
-                                                        record_generator(seed, r), compiled)
+            found = monte_carlo_record(settings, geometry, n_scans, record_generator(seed, r),
+                                       compiled, rest_generator(seed, r) if wanted else None)
+            vh, reference, kept[i] = found[:3]
             apparent[i, r] = vh.std(axis=0, ddof=1) / vh.mean(axis=0)
             true_ti[i, r] = reference.std(ddof=1) / reference.mean()
             error[i, r] = vh.mean(axis=0) - truth[i] - (reference.mean() - settings["wind"]["speed"])
+            if wanted:
+                spectra.add(i, {"wind_speed": vh, "u_true": reference, **found[3]}, count)
     squares = apparent ** 2
     z = (spectral ** 2 - squares.mean(axis=1)) / (squares.std(axis=1, ddof=1) / np.sqrt(count))
     low, high = np.quantile(apparent, [0.025, 0.975], axis=1)
-    return {
+    out = {
         "turbulence_intensity_mc_mean": (("scene", "range"), apparent.mean(axis=1)),
         "turbulence_intensity_mc_u": (("scene", "range"), apparent.std(axis=1, ddof=1)),
         "turbulence_intensity_mc_low": (("scene", "range"), low),
@@ -367,3 +592,89 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral):
         "wind_speed_record_bias": (("scene", "range"), error.mean(axis=1)),
         "wind_speed_record_u": (("scene", "range"), error.std(axis=1, ddof=1)),
     }
+    if spectra is not None:
+        out.update(spectra.variables(moving))
+    return out
+
+
+# --- The records' spectra -------------------------------------------------------------------
+
+#: Spawn key of the random streams of the lidar at rest in the records' spectra (apart
+#: from the records' own, :data:`RECORD_STREAM`, so that they draw what they drew).
+REST_STREAM = 25
+#: The spectra a record-mode run keeps (the mean over its records of each record's
+#: periodogram, once a scan), for ``uq plot`` and ``uq report`` (:mod:`uq.outputs.
+#: recordfigures`): name -> (series of :func:`record_spectra_series`, dimensions after
+#: the scene's, attributes). The ``*_at_rest`` ones only where the platform moves.
+SPECTRA_ATTRIBUTES = {
+    "record_psd_u_true": ("u_true", ("record_frequency",), {
+        "units": "m2 s-2 Hz-1", "long_name": "power spectral density of the field's u at "
+        "the reference point sampled once a scan, mean over the records of each record's "
+        "periodogram (one-sided, record mean removed)"}),
+    "record_psd_wind_speed": ("wind_speed", ("range", "record_frequency"), {
+        "units": "m2 s-2 Hz-1", "long_name": "power spectral density of the horizontal "
+        "wind speed the lidar reports once a scan, mean over the records of each record's "
+        "periodogram (one-sided, record mean removed)"}),
+    "record_psd_radial_velocity": ("radial_velocity", ("range", "record_frequency"), {
+        "units": "m2 s-2 Hz-1", "long_name": "power spectral density of the corrected "
+        "radial velocity of beam 0 once a scan, mean over the records of each record's "
+        "periodogram (one-sided, record mean removed)"}),
+    "record_psd_wind_speed_at_rest": ("wind_speed_at_rest", ("range", "record_frequency"), {
+        "units": "m2 s-2 Hz-1", "long_name": "power spectral density of the horizontal "
+        "wind speed once a scan of the same lidar at rest (no motion, full correction) "
+        "in the same fields, mean over the records (one-sided, record mean removed)"}),
+    "record_psd_radial_velocity_at_rest": (
+        "radial_velocity_at_rest", ("range", "record_frequency"), {
+            "units": "m2 s-2 Hz-1", "long_name": "power spectral density of the radial "
+            "velocity of beam 0 once a scan of the same lidar at rest in the same fields, "
+            "mean over the records (one-sided, record mean removed)"}),
+}
+#: Attributes of the spectra's frequency coordinate.
+FREQUENCY_ATTRIBUTES = {"units": "Hz", "long_name": "frequency of the records' spectra "
+                        "(the record's scans: 0 to half the scan rate)"}
+
+
+def rest_generator(seed, record):
+    """The generator of the errors of the lidar at rest in record `record`'s spectra."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(REST_STREAM,
+                                                                         record)))
+
+
+def spectrum_axis(settings):
+    """(scan period [s], scans per record) of validated `settings`: the frequencies of a
+    run's record spectra (the file's scene's; a scene of other scans has none)."""
+    return scan_geometry(settings).scan_period, scans_per_record(settings)
+
+
+class RecordSpectra:
+    """The mean periodograms of each scene's records on one frequency axis."""
+
+    def __init__(self, axis, n_scenes, n_gates):
+        self.period, self.n_scans = axis
+        self.frequency = np.fft.rfftfreq(self.n_scans, self.period)
+        shapes = {"u_true": (n_scenes, self.frequency.size)}
+        self.sums = {name: np.full(shapes.get(series, (n_scenes, n_gates,
+                                                      self.frequency.size)), np.nan)
+                     for name, (series, _, _) in SPECTRA_ATTRIBUTES.items()}
+
+    def fits(self, period, n_scans):
+        """Whether a scene's records are on this axis."""
+        return n_scans == self.n_scans and n_scans > 1 and math.isclose(period, self.period)
+
+    def add(self, scene, series, count):
+        """Add 1/count of a record's periodograms (`series`: name -> (n_scans, ...))."""
+        for name, (key, _, _) in SPECTRA_ATTRIBUTES.items():
+            if key not in series:
+                continue
+            _, density = signal.periodogram(series[key], fs=1.0 / self.period, axis=0)
+            part = np.moveaxis(density, 0, -1) / count
+            total = self.sums[name][scene]
+            self.sums[name][scene] = np.where(np.isnan(total), part, total + part)
+
+    def variables(self, moving):
+        """The variables (scene first) and the frequency coordinate."""
+        out = {"record_frequency": (("record_frequency",), self.frequency)}
+        for name, (_, dims, _) in SPECTRA_ATTRIBUTES.items():
+            if moving or not name.endswith("_at_rest"):
+                out[name] = (("scene",) + dims, self.sums[name])
+        return out

@@ -130,6 +130,7 @@ def chunk_task(scenario, plan, chunk, seed, compiled=True, digest=None):
 def run_chunk(scenario, plan, chunk, seed, compiled=True):
     """Results of one chunk of scenes: a Dataset with a ``scene`` dimension (`compiled`:
     the compiled model where it applies, else the numpy model throughout)."""
+    spectra_of = scenario.settings             # (the file's scene: the records' spectra)
     if plan.group_keys:
         scenario = scenario.with_values(group_assignments(scenario, plan, chunk.group))
     base = scene_from_settings(scenario.settings)
@@ -138,7 +139,8 @@ def run_chunk(scenario, plan, chunk, seed, compiled=True):
     if "turbulence" in scenario.settings and "wind_speed_true" in dataset:
         # record mode: the spectral path per scene
         dataset = dataset.assign(records.record_variables(
-            scenario, records.chunk_fields(scenario, plan, chunk), dataset, seed, compiled))
+            scenario, records.chunk_fields(scenario, plan, chunk), dataset, seed, compiled,
+            spectra_of))
     return dataset
 
 
@@ -392,6 +394,8 @@ def _annotate(ds, scenario):
             ds.variables[name].attrs.update(DERIVED_ATTRIBUTES[name])
         elif name in records.RECORD_ATTRIBUTES:
             ds.variables[name].attrs.update(records.RECORD_ATTRIBUTES[name])
+        elif name in records.SPECTRA_ATTRIBUTES:
+            ds.variables[name].attrs.update(records.SPECTRA_ATTRIBUTES[name][2])
         elif quantity:
             ds.variables[name].attrs.update(
                 variable_attributes(quantity, name[len(quantity) + 1:]))
@@ -409,6 +413,8 @@ def _annotate(ds, scenario):
     for name, attrs in COORDINATES.items():
         if name in ds.coords:
             ds.variables[name].attrs.update(attrs)
+    if "record_frequency" in ds.coords:
+        ds.variables["record_frequency"].attrs.update(records.FREQUENCY_ATTRIBUTES)
     for key, _ in scenario.sweep:
         ds.variables[key.replace(".", "_")].attrs.update(swept_key_attributes(key))
     for follower, leader in scenario.links:
