@@ -425,6 +425,28 @@ def test_a_nacelle_lidar_agrees_with_numpy(azimuths, model, per_beam, rng):
     assert np.isfinite(compiled["wind_speed"]).all()               # the check can fail
 
 
+@pytest.mark.parametrize("azimuths", [FOUR, TWO, [0, 120, 240]])
+@pytest.mark.parametrize("model", ["none", "full"])
+def test_a_nacelle_scan_with_the_truth_common_to_its_trials_agrees_with_numpy(azimuths,
+                                                                            model, rng):
+    """Without geometry errors the truth is the scene's: a scan's reading is one linear
+    map of the radial velocities, ``none``'s (the configured heading) once per scene with
+    its image of the truth, a trial adding its noise's (fusedkernels._reading_operator);
+    with and without radial noise, three gates, a batch of two scenes."""
+    base = nacelle_scene(azimuths, model)
+    batch = dataclasses.replace(base, wind_speed=np.array([6.0, 12.0]))
+    sources = ("lidar_radial_velocity",) + (("ins_pitch", "ins_heading") if model == "full"
+                                            else ())
+    outputs = nacelle_outputs(azimuths)
+    for chosen in (sources, sources[1:]):
+        err = errors(rng, 50, base, chosen)
+        assert fused.applicable(batch, outputs, err)
+        compiled, plain = both(batch, outputs, **err)
+        assert_nacelle_same(compiled, plain)
+        assert np.isfinite(compiled["wind_speed"]).all()           # the check can fail
+        assert np.ptp(compiled["wind_speed"][:, 0]) > 0 or not chosen   # trials differ
+
+
 @pytest.mark.parametrize("tilt", [90.0, 60.0])
 def test_a_batch_of_nacelle_scenes_with_their_own_draws_agrees_with_numpy(tilt, rng):
     """A batch (2 x 3: wind speed, direction, shear) with independent draws per scene and
