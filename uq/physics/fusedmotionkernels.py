@@ -881,12 +881,14 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
         if not _reading(consts, pairs, amplitudes, components, read_table, stamps, mid, phases,
                         turned, errors, has, start, count, states[0], work):
             _read_rows(consts, states[0], work, count)
-    normal[:, :count] = 0.0
     heading_varies = consts[_MOVES_YAW] > 0 or has[0]
     # a tilted mount (rows of `normal` beyond the least squares'): its reconstruction
     # (:func:`mounted_wind`) keeps each beam's measured radial velocity and, point-wise,
     # its believed beam, the velocity along it and the lidar's believed lift
     stored = 6 + 3 * n_gates if normal.shape[0] > 6 + 3 * n_gates else 0
+    kept = 5 * n_beams + n_beams * n_gates if stored else 0
+    normal[:6 + 3 * n_gates, :count] = 0.0          # the sums; not the kept rows (each is
+    normal[6 + 3 * n_gates + kept:, :count] = 0.0   # written before it is read)
     for b in range(n_beams):
         if model == POINTWISE:          # this beam's own reading: the beam and velocity it implies
             state = states[b if at_nodes else 0]
