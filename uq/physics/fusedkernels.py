@@ -373,26 +373,39 @@ def _solve3(m, rhs):
     rhs[0] = (rhs[0] - m[0, 1] * rhs[1] - m[0, 2] * rhs[2]) / m[0, 0]
 
 
-@_helper
-def _pointwise_least_squares(normal, corrected, n_beams, matrix, rhs, zero):
-    """The point-wise least squares of one gate [2]: the wind u [m s-1] of the normal
-    equations ``B^T B u = B^T c`` of the believed earth-frame beams B (rows of normal,
-    (b, 3)) and the corrected radial velocities c (b,) [m s-1], solved by
-    :func:`_solve3`; returns (north, east, up). ``matrix`` (3, 3), ``rhs`` (3,) scratch.
-    One helper for the upward and the tilted mounts' point-wise kernels; a call that LLVM
-    inlines (the same machine code as written out in the loop: 2^18 point-wise scans took
-    the same CPU time either way, issue 25)."""
+#: :func:`_solve3` inlined by numba into :func:`_pointwise_solve` (called from a helper
+#: that numba inlines, LLVM no longer inlined it: the upward point-wise kernel 4-8 %
+#: slower).
+_solve3_inlined = njit(inline="always")(_solve3.py_func)
+
+
+@njit(inline="always")
+def _normal_matrix(normal, n_beams, gram, zero):
+    """``B^T B`` (3, 3) of the believed earth-frame beams B (rows of normal, (b, 3)) into
+    gram: the point-wise least squares' matrix [2], one per reading (every gate's)."""
     for k in range(3):
-        total = zero
-        for b in range(n_beams):
-            total += normal[b, k] * corrected[b]
-        rhs[k] = total
         for m in range(3):
             total = zero
             for b in range(n_beams):
                 total += normal[b, k] * normal[b, m]
-            matrix[k, m] = total
-    _solve3(matrix, rhs)
+            gram[k, m] = total
+
+
+@njit(inline="always")
+def _pointwise_solve(gram, matrix, rhs):
+    """The point-wise least squares of one gate [2]: the wind u [m s-1] of the normal
+    equations ``B^T B u = B^T c`` with B^T B in gram (:func:`_normal_matrix`) and
+    ``B^T c`` in rhs (3,) [m s-1] (c the corrected radial velocities), by :func:`_solve3`
+    on a copy (matrix, (3, 3)); returns (north, east, up).
+
+    :func:`_normal_matrix` and this are the upward and the tilted mounts' point-wise
+    kernels' one least squares, inlined by numba (``B^T c`` summed by the caller, with c
+    in registers: through an array, or a helper called per gate, the upward kernel took
+    4-50 % more CPU time; issue 25)."""
+    for k in range(3):
+        for m in range(3):
+            matrix[k, m] = gram[k, m]
+    _solve3_inlined(matrix, rhs)
     return rhs[0], rhs[1], rhs[2]
 
 
@@ -518,9 +531,9 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
     units = np.empty((n_beams, 3))
     normal = np.full((n_beams, 3), zero)             # point-wise: believed earth beams
     along = np.full(n_beams, zero)                   # ... the ship velocity along them
-    corrected = np.full(n_beams, zero)               # ... the corrected radial velocities
     mean = np.full(6, zero)                          # ... and the mean reading (tilt2d)
     matrix = np.full((3, 3), zero)
+    gram = np.full((3, 3), zero)                     # B^T B of a reading
     rhs = np.full(3, zero)
     one = zero + 1.0
     mean_rot = _rotation(FULL, one, zero, one, zero, one, zero, 1.0, 0.0)
@@ -665,16 +678,20 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                         radial[s, b, g, i] = measured + along[b]
             if not (want_speed or want_direction or want_vertical):
                 continue
+            _normal_matrix(normal, n_beams, gram, zero)   # the least squares' B^T B
             if model == TILT2D:                      # tilt2d: the mean reading (Eq. 13 [1])
                 mean_rot, mean_ship = _tilt2d_mean(heading_error, pitch_error, roll_error,
                                                    cog_error, sog_error, base, sog0, i, s,
                                                    zero, mean, cos_nominal, sin_nominal)
             for g in range(n_gates):
-                for b in range(n_beams):
-                    corrected[b] = (truth[b, g] + noise[noise_i, noise_s, b * n_gates + g]
-                                    if has_noise else truth[b, g]) + along[b]
-                north, east, up = _pointwise_least_squares(normal, corrected, n_beams, matrix,
-                                                           rhs, zero)
+                for k in range(3):
+                    total = zero
+                    for b in range(n_beams):
+                        total += normal[b, k] * (
+                            (truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] if has_noise
+                             else truth[b, g]) + along[b])
+                    rhs[k] = total
+                north, east, up = _pointwise_solve(gram, matrix, rhs)
                 if model == TILT2D:
                     north, east, up = _tilt2d_project(mean_rot, mean_ship, north, east, up)
                 if want_speed:
@@ -861,6 +878,7 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
     corrected = np.full(n_beams, zero)               # c_k of one gate
     mean = np.full(6, zero)
     matrix = np.full((3, 3), zero)
+    gram = np.full((3, 3), zero)                     # B^T B of a reading
     rhs = np.full(3, zero)
     one = zero + 1.0
     rot = _rotation(FULL, one, zero, one, zero, one, zero, 1.0, 0.0)
@@ -982,6 +1000,8 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
                                 for g in range(n_gates):
                                     gate_height[s, g, t0:t1] = heights[g]
                             break
+            if not linear:                      # the point-wise least squares' B^T B
+                _normal_matrix(normal, n_beams, gram, zero)
             if pointwise and model == TILT2D and n_beams > 2:   # the mean reading, Eq. 13 [1]
                 mean_rot, mean_ship = _tilt2d_mean(heading_error, pitch_error, roll_error,
                                                    cog_error, sog_error, base, sog0, i, s,
@@ -1012,8 +1032,12 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
                         if want_radial:
                             radial[s, b, g, i] = corrected[b]
                 if not linear:                  # point-wise least squares [2]
-                    north, east, up = _pointwise_least_squares(normal, corrected, n_beams,
-                                                               matrix, rhs, zero)
+                    for k in range(3):
+                        total = zero
+                        for b in range(n_beams):
+                            total += normal[b, k] * corrected[b]
+                        rhs[k] = total
+                    north, east, up = _pointwise_solve(gram, matrix, rhs)
                     if model == TILT2D:
                         north, east, up = _tilt2d_project(mean_rot, mean_ship, north, east,
                                                           up)
