@@ -768,8 +768,9 @@ def _keep_row(work, source, normal, row, count):
 def _store_reading(consts, state, work, normal, row, count, heading_varies, source):
     """A point-wise reading of a tilted mount into normal[row ..]: the believed beam
     (rows _BEAM), the velocity along it (_ALONG) and, for the shear exponent's believed
-    heights, the lidar's lift ``[(R_read - R_static) r]_up`` through the lever arm r
-    (:func:`uq.physics.timeresolved._lever_arm_lift`; 0 without one)."""
+    heights alone (HEAD mounted 2), the lidar's lift ``[(R_read - R_static) r]_up``
+    through the lever arm r (:func:`uq.physics.timeresolved._lever_arm_lift`; 0 without
+    one)."""
     for j in range(count):                  # (a loop, not four slices: their views
         normal[row, j] = work[_BEAM, j]     # cost more than the copy of a block)
         normal[row + 1, j] = work[_BEAM + 1, j]
