@@ -757,14 +757,6 @@ def _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, sour
 
 
 @_helper
-def _keep_row(work, source, normal, row, count):
-    """normal[row, :count] = work[source, :count], a tilted mount's kept row (a loop: a
-    slice's views cost more than the copy of a block's trials)."""
-    for j in range(count):
-        normal[row, j] = work[source, j]
-
-
-@_helper
 def _store_reading(consts, state, work, normal, row, count, heading_varies, source):
     """A point-wise reading of a tilted mount into normal[row ..]: the believed beam
     (rows _BEAM), the velocity along it (_ALONG) and, for the shear exponent's believed
@@ -887,9 +879,8 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
     # (:func:`mounted_wind`) keeps each beam's measured radial velocity and, point-wise,
     # its believed beam, the velocity along it and the lidar's believed lift
     stored = 6 + 3 * n_gates if normal.shape[0] > 6 + 3 * n_gates else 0
-    kept = 5 * n_beams + n_beams * n_gates if stored else 0
-    normal[:6 + 3 * n_gates, :count] = 0.0          # the sums; not the kept rows (each is
-    normal[6 + 3 * n_gates + kept:, :count] = 0.0   # written before it is read)
+    normal[:6 + 3 * n_gates, :count] = 0.0          # the sums, not a tilted mount's kept
+    #                                                 rows (each is written before read)
     for b in range(n_beams):
         if model == POINTWISE:          # this beam's own reading: the beam and velocity it implies
             state = states[b if at_nodes else 0]
@@ -921,8 +912,8 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                 for j in range(count):
                     work[_MEASURED, j] += noise[0, beam, gate]
             if stored:                  # a tilted mount's: the measured radial velocity
-                _keep_row(work, _MEASURED, normal, stored + 5 * n_beams + b * n_gates + g,
-                          count)
+                normal[stored + 5 * n_beams + b * n_gates + g, :count] = \
+                    work[_MEASURED, :count]
             if model == POINTWISE:
                 for j in range(count):
                     corrected = work[_MEASURED, j] + work[_ALONG, j]
