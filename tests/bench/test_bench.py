@@ -124,3 +124,17 @@ def test_the_nacelle_figure_compares_like_with_like(caplog):
     assert all(nacelle > 0 and dbs > 0 for nacelle, dbs in times.values())
     declined = [r.getMessage() for r in caplog.records if "does not take" in r.getMessage()]
     assert declined and all("complex" in message for message in declined)
+
+
+def test_the_nacelle_models_alone_run_compiled(caplog):
+    """``nacelle_models``: the measurement model alone of the nacelle lidar and of the DBS,
+    static and in motion, each the compiled one (no fall-back said at INFO)."""
+    import logging
+    from uq.bench import targets
+    from uq.physics import modelinputs
+    modelinputs._LOGGED.clear()
+    with caplog.at_level(logging.INFO, logger="uq.physics.modelinputs"):
+        times = targets.nacelle_models(2**10, repeats=1)
+    assert set(times) == {"static", "motion"}
+    assert all(nacelle > 0 and dbs > 0 for nacelle, dbs in times.values())
+    assert not [r for r in caplog.records if "does not take" in r.getMessage()]

@@ -6,6 +6,7 @@ correlation (one reading per scan or per beam), independent draws per scene and
 complex-step evaluation (the GUM Jacobian) checks both.
 """
 import dataclasses
+import itertools
 
 import numpy as np
 import pytest
@@ -423,6 +424,29 @@ def test_a_nacelle_lidar_agrees_with_numpy(azimuths, model, per_beam, rng):
     compiled, plain = both(scene, outputs, **err)
     assert_nacelle_same(compiled, plain)
     assert np.isfinite(compiled["wind_speed"]).all()               # the check can fail
+
+
+@pytest.mark.parametrize("azimuths", [FOUR, TWO, [0, 120, 240]])
+@pytest.mark.parametrize("model", ["none", "full"])
+def test_a_nacelle_scan_with_the_truth_common_to_its_trials_agrees_with_numpy(azimuths,
+                                                                            model, rng):
+    """Without geometry errors the truth is the scene's: a scan's reading is one linear
+    map of the radial velocities, ``none``'s (the configured heading) once per scene with
+    its image of the truth, a trial adding its noise's (fusedkernels._reading_operator;
+    without the radial velocities and the shear exponent, in rows over the trials:
+    _folded_trials); with and without radial noise, three gates, a batch of two scenes."""
+    base = nacelle_scene(azimuths, model)
+    batch = dataclasses.replace(base, wind_speed=np.array([6.0, 12.0]))
+    sources = ("lidar_radial_velocity",) + (("ins_pitch", "ins_heading") if model == "full"
+                                            else ())
+    for chosen, outputs in itertools.product(
+            (sources, sources[1:]), (nacelle_outputs(azimuths), WIND + ("gate_height",))):
+        err = errors(rng, 50, base, chosen)
+        assert fused.applicable(batch, outputs, err)
+        compiled, plain = both(batch, outputs, **err)
+        assert_nacelle_same(compiled, plain)
+        assert np.isfinite(compiled["wind_speed"]).all()           # the check can fail
+        assert np.ptp(compiled["wind_speed"][:, 0]) > 0 or not chosen   # trials differ
 
 
 @pytest.mark.parametrize("tilt", [90.0, 60.0])

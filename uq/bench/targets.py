@@ -28,6 +28,10 @@ The probe's figure (issue 26) is a whole ``uq.run`` of ``floating_lidar_full`` w
 WindCube-like pulsed probe against the same run at a point, n trials each; the model's
 own ratio (the measurement model alone, the same draws) is reported beside it.
 
+The nacelle figures (issue 25) are whole ``uq.run`` calls; the measurement model's own
+ratios (``nacelle_static_model_over_dbs``, ``nacelle_motion_model_over_dbs``: the model
+alone on the same draws, :func:`nacelle_models`) are reported beside them.
+
 The draw floor of a run is measured by replaying the engine's own draws: the run is
 made once with :func:`uq.engine.propagate.normal_scores` recorded (the shape of every
 block it draws), then the same blocks are drawn again with numpy's Generator alone.
@@ -305,6 +309,32 @@ def nacelle_scans(n=2**17, repeats=3):
     return times
 
 
+def nacelle_models(n=2**17, repeats=5):
+    """CPU time [s] of the measurement model alone (the compiled one, as ``uq.run`` calls
+    it, the same draws) of the 4-beam nacelle lidar and the DBS of :func:`nacelle_scans`:
+    {kind: (nacelle, dbs)} for "static" and "motion" (the whole run's ratio also counts
+    the draws and the pipeline, the same for both)."""
+    from uq.physics.measurement import measurement_model
+    from uq.pipeline.modelsetup import error_inputs, scene_from_settings
+    from uq.engine.inputs import input_set
+    azimuths = {"lidar.azimuths": [0.0, 90.0, 180.0, 270.0]}
+    times = {}
+    for kind, changes in (("static", {"ship.pitch": 2.0}), ("motion", NACELLE_MOTION)):
+        calls = []
+        for mount in (NACELLE["lidar.mount"], {"tilt": 0.0}):
+            scenario = _scans(n, **{**NACELLE, "lidar.mount": mount}, **changes, **azimuths)
+            scene = scene_from_settings(scenario.settings)
+            inputs = input_set(error_inputs(scenario.settings, scene.n_beams,
+                                            len(scene.ranges)))
+            errors = inputs.values(np.random.default_rng(1).standard_normal(
+                (n, inputs.dimension)))
+            errors.update(inputs.constants)
+            calls.append(lambda scene=scene, errors=errors: measurement_model(
+                scene, tuple(NACELLE["outputs"]), **errors))
+        times[kind] = tuple(median_cpu_time(call, repeats) for call in calls)
+    return times
+
+
 def probe_against_point(n=2**16, repeats=5):
     """(seconds of ``uq.run`` of ``floating_lidar_full`` with a pulsed probe, of the same
     at a point; seconds of its measurement model alone with the probe, at a point) at n
@@ -406,6 +436,10 @@ def measure(quick=False, progress=None, scale=1):
                         f"{name}_over_dbs": nacelle_s / dbs_s})
         say(f"{n} nacelle scans, {beams} beams, {kind}: {nacelle_s:.3f} s of CPU, a 4-beam "
             f"DBS {dbs_s:.3f} s")
+    for kind, (nacelle_s, dbs_s) in nacelle_models(n).items():
+        figures[f"nacelle_{kind}_model_over_dbs"] = nacelle_s / dbs_s
+        say(f"{n} nacelle scans, 4 beams, {kind}, the measurement model alone: "
+            f"{nacelle_s:.4f} s of CPU, a 4-beam DBS {dbs_s:.4f} s")
     per_scene, floor = sweep_monte_carlo(trials(MC_DRAWS))
     figures.update(sweep_mc_s_per_scene=per_scene, sweep_draw_floor_s_per_scene=floor,
                    sweep_mc_over_draw_floor=per_scene / floor)

@@ -39,7 +39,7 @@ import math
 import numpy as np
 from numba import njit, types
 
-from uq.constants import SMALL_ANGLE
+from uq.constants import HYPOT_SAFE_MAX, HYPOT_SAFE_MIN, SMALL_ANGLE
 from uq.physics.kernelbase import (DEG as _DEG, FULL, NONE, TILT2D, YAW, hypot as _hypot,
                                    taylor_cos_sin)
 
@@ -373,6 +373,42 @@ def _solve3(m, rhs):
     rhs[0] = (rhs[0] - m[0, 1] * rhs[1] - m[0, 2] * rhs[2]) / m[0, 0]
 
 
+#: :func:`_solve3` inlined by numba into :func:`_pointwise_solve` (called from a helper
+#: that numba inlines, LLVM no longer inlined it: the upward point-wise kernel 4-8 %
+#: slower).
+_solve3_inlined = njit(inline="always")(_solve3.py_func)
+
+
+@njit(inline="always")
+def _normal_matrix(normal, n_beams, gram, zero):
+    """``B^T B`` (3, 3) of the believed earth-frame beams B (rows of normal, (b, 3)) into
+    gram: the point-wise least squares' matrix [2], one per reading (every gate's)."""
+    for k in range(3):
+        for m in range(3):
+            total = zero
+            for b in range(n_beams):
+                total += normal[b, k] * normal[b, m]
+            gram[k, m] = total
+
+
+@njit(inline="always")
+def _pointwise_solve(gram, matrix, rhs):
+    """The point-wise least squares of one gate [2]: the wind u [m s-1] of the normal
+    equations ``B^T B u = B^T c`` with B^T B in gram (:func:`_normal_matrix`) and
+    ``B^T c`` in rhs (3,) [m s-1] (c the corrected radial velocities), by :func:`_solve3`
+    on a copy (matrix, (3, 3)); returns (north, east, up).
+
+    :func:`_normal_matrix` and this are the upward and the tilted mounts' point-wise
+    kernels' one least squares, inlined by numba (``B^T c`` summed by the caller, with c
+    in registers: through an array, or a helper called per gate, the upward kernel took
+    4-50 % more CPU time; issue 25)."""
+    for k in range(3):
+        for m in range(3):
+            matrix[k, m] = gram[k, m]
+    _solve3_inlined(matrix, rhs)
+    return rhs[0], rhs[1], rhs[2]
+
+
 @_helper
 def _mean_reading(error, base, i, s, zero):
     """The mean over the beams' readings of an INS angle, base + error [rad]."""
@@ -497,6 +533,7 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
     along = np.full(n_beams, zero)                   # ... the ship velocity along them
     mean = np.full(6, zero)                          # ... and the mean reading (tilt2d)
     matrix = np.full((3, 3), zero)
+    gram = np.full((3, 3), zero)                     # B^T B of a reading
     rhs = np.full(3, zero)
     one = zero + 1.0
     mean_rot = _rotation(FULL, one, zero, one, zero, one, zero, 1.0, 0.0)
@@ -641,6 +678,7 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                         radial[s, b, g, i] = measured + along[b]
             if not (want_speed or want_direction or want_vertical):
                 continue
+            _normal_matrix(normal, n_beams, gram, zero)   # the least squares' B^T B
             if model == TILT2D:                      # tilt2d: the mean reading (Eq. 13 [1])
                 mean_rot, mean_ship = _tilt2d_mean(heading_error, pitch_error, roll_error,
                                                    cog_error, sog_error, base, sog0, i, s,
@@ -653,13 +691,7 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                             (truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] if has_noise
                              else truth[b, g]) + along[b])
                     rhs[k] = total
-                    for m in range(3):
-                        total = zero
-                        for b in range(n_beams):
-                            total += normal[b, k] * normal[b, m]
-                        matrix[k, m] = total
-                _solve3(matrix, rhs)
-                north, east, up = rhs[0], rhs[1], rhs[2]
+                north, east, up = _pointwise_solve(gram, matrix, rhs)
                 if model == TILT2D:
                     north, east, up = _tilt2d_project(mean_rot, mean_ship, north, east, up)
                 if want_speed:
@@ -706,6 +738,98 @@ def _inverse2(a00, a01, a10, a11):
 
 
 @_helper
+def _reading_operator(n_beams, model, level_a, level_b, operator, normal, along, rot, ship,
+                      inverse, zero, reading, offset):
+    """A tilted mount's wind of one reading as a linear map of the measured radial
+    velocities v (b,) [m s-1]: ``(north, east, up) = reading v + offset``, into reading
+    (3, b) and offset (3,) [m s-1] (:func:`_wind_mounted`'s reconstruction, the same
+    equations folded into one operator, so that a trial costs a 3 x b product as the
+    upward lidar's Eq. 13 [1]; within a few ulp of evaluating them in turn).
+
+    2 beams: ``(B_h^T B_h)^-1 B_h^T (v + along)`` with `inverse` that 2 x 2 inverse, w = 0.
+    Else Eq. 13 [1]: the reading's rotation `rot` (row-major) of the configured beams'
+    ``A^+ v`` (`operator`, (3, b)), horizontal (all three for ``full``), plus the ship
+    velocity `ship` removed; with the level pair (beams level_a, level_b >= 0) the
+    hub-height wind ``u_h = N^-1 (c_pair - n_pair,up w)`` (`inverse` = N^-1 of the pair's
+    believed horizontal parts) with ``c = v + along`` and w that of Eq. 13.
+    """
+    if n_beams == 2:
+        for b in range(2):
+            reading[0, b] = inverse[0] * normal[b, 0] + inverse[1] * normal[b, 1]
+            reading[1, b] = inverse[2] * normal[b, 0] + inverse[3] * normal[b, 1]
+            reading[2, b] = zero
+        for k in range(2):
+            offset[k] = reading[k, 0] * along[0] + reading[k, 1] * along[1]
+        offset[2] = zero
+        return
+    full = model == FULL
+    for b in range(n_beams):                           # Eq. 13 [1]: R A^+ v
+        o0, o1, o2 = operator[0, b], operator[1, b], operator[2, b]
+        reading[0, b] = rot[0] * o0 + rot[1] * o1 + (rot[2] * o2 if full else zero)
+        reading[1, b] = rot[3] * o0 + rot[4] * o1 + (rot[5] * o2 if full else zero)
+        reading[2, b] = rot[6] * o0 + rot[7] * o1 + rot[8] * o2 if full else o2 + zero
+    offset[0], offset[1] = ship[0] + zero, ship[1] + zero
+    offset[2] = ship[2] + zero if full else zero
+    if level_a < 0:
+        return
+    up_a, up_b = normal[level_a, 2], normal[level_b, 2]
+    for b in range(n_beams):                           # N^-1 (e_pair - n_pair,up w row)
+        pair_a = (1.0 if b == level_a else 0.0) - up_a * reading[2, b]
+        pair_b = (1.0 if b == level_b else 0.0) - up_b * reading[2, b]
+        reading[0, b] = inverse[0] * pair_a + inverse[1] * pair_b
+        reading[1, b] = inverse[2] * pair_a + inverse[3] * pair_b
+    pair_a = along[level_a] - up_a * offset[2]
+    pair_b = along[level_b] - up_b * offset[2]
+    offset[0] = inverse[0] * pair_a + inverse[1] * pair_b
+    offset[1] = inverse[2] * pair_a + inverse[3] * pair_b
+
+
+@_helper
+def _folded_trials(folded, reading, noise, has_noise, s, noise_s, t0, t1, n_beams, n_gates,
+                   want_speed, want_vertical, want_direction, rows, speed, vertical,
+                   from_north, from_east):
+    """The outputs of trials [t0, t1) of scene s whose wind at gate g is ``folded[:, g] +
+    reading e_g`` (e_g the trial's radial noise at the gate, (b,)): ``none``'s tilted
+    mount with the truth common to the trials (:func:`_wind_mounted`). Loops over the
+    trials innermost on the rows (3, t1 - t0) of scratch, without calls (SIMD), the sums
+    in the order of the trial-by-trial loop (the same numbers)."""
+    count = t1 - t0
+    for g in range(n_gates):
+        for k in range(3):
+            value = folded[k, g]
+            for j in range(count):
+                rows[k, j] = value
+        for b in range(n_beams * has_noise):
+            m0, m1, m2 = reading[0, b], reading[1, b], reading[2, b]
+            column = b * n_gates + g
+            if noise.shape[0] > 1:
+                for j in range(count):
+                    value = noise[t0 + j, noise_s, column]
+                    rows[0, j] += m0 * value
+                    rows[1, j] += m1 * value
+                    rows[2, j] += m2 * value
+            else:
+                value = noise[0, noise_s, column]
+                for j in range(count):
+                    rows[0, j] += m0 * value
+                    rows[1, j] += m1 * value
+                    rows[2, j] += m2 * value
+        if want_speed:
+            for j in range(count):
+                speed[s, g, t0 + j] = np.sqrt(rows[0, j] * rows[0, j] + rows[1, j] * rows[1, j])
+            for j in range(count):                      # where the squares could over- or
+                if not HYPOT_SAFE_MIN < speed[s, g, t0 + j].real < HYPOT_SAFE_MAX:  # underflow
+                    speed[s, g, t0 + j] = _hypot(rows[0, j], rows[1, j])
+        if want_vertical:
+            for j in range(count):
+                vertical[s, g, t0 + j] = rows[2, j]
+        if want_direction:
+            for j in range(count):
+                from_north[s, g, t0 + j] = -rows[0, j]
+                from_east[s, g, t0 + j] = -rows[1, j]
+
+
+@_helper
 def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profile,
                   height_error, s0, s1, t0, t1, per_scene, per_trial, speed, vertical,
                   from_north, from_east, radial, gate_height, shear_out, pointwise):
@@ -720,7 +844,14 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
     horizontal wind ``b_k,h . u_h = c_k - b_k,up w`` of those two beams. The shear
     exponent ``ln(U_up / U_down) / ln(z_up / z_down)``, ``U_k = c_k / (b_k,h . e)`` at the
     believed heights ``z_k = lidar height + slant b_k,up`` (NaN where a ratio is not
-    positive). A scan-wise reading is the point-wise code with one reading for all beams.
+    positive).
+
+    The scan's reading and the 2-beam least squares are linear in the measured radial
+    velocities v: their equations are folded into one operator per reading
+    (:func:`_reading_operator`), so that a trial costs a 3 x b product, as the upward
+    lidar's Eq. 13 [1]; ``none``'s reading (the configured heading) is the scene's, and
+    with the truth common to the trials its image is taken once per scene, a trial then
+    adding the operator's product with its noise alone (as :func:`_wind`'s ``A^+``).
     """
     n_beams, n_gates, model = structure[0], structure[2], structure[3]
     if model != NONE and model != YAW and model != TILT2D and model != FULL:
@@ -736,8 +867,9 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
     truth = np.full((n_beams, n_gates), zero)
     heights = np.full(n_gates, zero)
     count = t1 - t0
-    cos_read = np.full((4, n_beams, count), zero)
-    sin_read = np.full((4, n_beams, count), zero)
+    reads = 1 if model == NONE else count            # (none reads no INS)
+    cos_read = np.full((4, n_beams, reads), zero)
+    sin_read = np.full((4, n_beams, reads), zero)
     base = np.empty(4)
     operator = np.empty((3, n_beams))
     units = np.empty((n_beams, 3))
@@ -746,6 +878,7 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
     corrected = np.full(n_beams, zero)               # c_k of one gate
     mean = np.full(6, zero)
     matrix = np.full((3, 3), zero)
+    gram = np.full((3, 3), zero)                     # B^T B of a reading
     rhs = np.full(3, zero)
     one = zero + 1.0
     rot = _rotation(FULL, one, zero, one, zero, one, zero, 1.0, 0.0)
@@ -753,8 +886,16 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
     mean_ship = (zero, zero)
     ship = (zero, zero, zero)
     inverse = (zero, zero, zero, zero)
-    lidar_frame = n_beams > 2 and not pointwise        # the scan's A^+ v: its rows needed
-    lidar_horizontal = lidar_frame and (model == FULL or level_a < 0)
+    # the scan's reading, or two beams': the wind is one linear map of the measured radial
+    # velocities v (:func:`_reading_operator`), once per reading (none's: per scene)
+    linear = n_beams == 2 or not pointwise
+    reading = np.full((3, n_beams), zero)
+    offset = np.full(3, zero)
+    folded = np.full((3, n_gates), zero)             # none's map of the scene's truth
+    # ... whose trials then differ by their noise alone: rows over the trials
+    rows_only = linear and model == NONE and not per_trial and not want_radial \
+        and not want_shear
+    rows = np.full((3, t1 - t0 if rows_only else 1), zero)
     for s in range(s0, s1):
         speed_ref, w = table[s, _SPEED], table[s, _VERTICAL]
         to_north = -table[s, _COS + _T_DIRECTION]       # wind "from": it blows to -e
@@ -771,15 +912,17 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
         base[0], base[1], base[2], base[3] = table[s, _HEADING], table[s, _PITCH], \
             table[s, _ROLL], cog0
         tr0 = (s - s0) * count if per_scene else 0
-        _readings(heading_error, 0, base[0], cos_nominal, sin_nominal, s, t0, count, tr0,
-                  cos_trig, sin_trig, cos_read, sin_read)
-        _readings(pitch_error, 1, base[1], table[s, _COS + _T_PITCH],
-                  table[s, _SIN + _T_PITCH], s, t0, count, tr0, cos_trig, sin_trig,
-                  cos_read, sin_read)
-        _readings(roll_error, 2, base[2], table[s, _COS + _T_ROLL], table[s, _SIN + _T_ROLL],
-                  s, t0, count, tr0, cos_trig, sin_trig, cos_read, sin_read)
-        _readings(cog_error, 3, cog0, table[s, _COS + _T_COG], table[s, _SIN + _T_COG], s,
-                  t0, count, tr0, cos_trig, sin_trig, cos_read, sin_read)
+        if model != NONE:
+            _readings(heading_error, 0, base[0], cos_nominal, sin_nominal, s, t0, count, tr0,
+                      cos_trig, sin_trig, cos_read, sin_read)
+            _readings(pitch_error, 1, base[1], table[s, _COS + _T_PITCH],
+                      table[s, _SIN + _T_PITCH], s, t0, count, tr0, cos_trig, sin_trig,
+                      cos_read, sin_read)
+            _readings(roll_error, 2, base[2], table[s, _COS + _T_ROLL],
+                      table[s, _SIN + _T_ROLL], s, t0, count, tr0, cos_trig, sin_trig,
+                      cos_read, sin_read)
+            _readings(cog_error, 3, cog0, table[s, _COS + _T_COG], table[s, _SIN + _T_COG],
+                      s, t0, count, tr0, cos_trig, sin_trig, cos_read, sin_read)
         if not per_trial:
             _true_radials(beams, profile, s, speed_ref, w, to_north, to_east, true_ship,
                           n_beams, n_gates, truth)
@@ -838,60 +981,73 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
                 elif level_a >= 0:              # the level pair's horizontal parts
                     inverse = _inverse2(normal[level_a, 0], normal[level_a, 1],
                                         normal[level_b, 0], normal[level_b, 1])
+                if linear:                      # the reading's wind: one linear map of v
+                    _reading_operator(n_beams, model, level_a, level_b, operator, normal,
+                                      along, rot, ship, inverse, zero, reading, offset)
+                    if model == NONE and not per_trial:     # ... and of the scene's truth
+                        for g in range(n_gates):
+                            for k in range(3):
+                                total = offset[k]
+                                for b in range(n_beams):
+                                    total += reading[k, b] * truth[b, g]
+                                folded[k, g] = total
+                        if rows_only:           # every trial of the scene at once
+                            _folded_trials(folded, reading, noise, has_noise, s, noise_s,
+                                           t0, t1, n_beams, n_gates, want_speed,
+                                           want_vertical, want_direction, rows, speed,
+                                           vertical, from_north, from_east)
+                            if want_height:
+                                for g in range(n_gates):
+                                    gate_height[s, g, t0:t1] = heights[g]
+                            break
+            if not linear:                      # the point-wise least squares' B^T B
+                _normal_matrix(normal, n_beams, gram, zero)
             if pointwise and model == TILT2D and n_beams > 2:   # the mean reading, Eq. 13 [1]
                 mean_rot, mean_ship = _tilt2d_mean(heading_error, pitch_error, roll_error,
                                                    cog_error, sog_error, base, sog0, i, s,
                                                    zero, mean, cos_nominal, sin_nominal)
             for g in range(n_gates):
-                x = y = z = zero
-                for b in range(n_beams):
-                    measured = truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] \
-                        if has_noise else truth[b, g]
-                    corrected[b] = measured + along[b]
-                    if want_radial:
-                        radial[s, b, g, i] = corrected[b]
-                    if lidar_frame:                       # A^+ v (Eq. 13 [1])
-                        z += operator[2, b] * measured
-                        if lidar_horizontal:
-                            x += operator[0, b] * measured
-                            y += operator[1, b] * measured
-                if n_beams == 2:                # w = 0: the horizontal least squares
-                    r0 = normal[0, 0] * corrected[0] + normal[1, 0] * corrected[1]
-                    r1 = normal[0, 1] * corrected[0] + normal[1, 1] * corrected[1]
-                    north = inverse[0] * r0 + inverse[1] * r1
-                    east = inverse[2] * r0 + inverse[3] * r1
-                    up = zero
-                elif not pointwise:             # Eq. 13 [1] with the scan's reading
-                    up = rot[6] * x + rot[7] * y + rot[8] * z + ship[2] if model == FULL \
-                        else z
-                    north = east = zero
-                    if level_a < 0:             # (else the level pair's, below)
-                        north = rot[0] * x + rot[1] * y + ship[0]
-                        east = rot[3] * x + rot[4] * y + ship[1]
-                        if model == FULL:
-                            north += rot[2] * z
-                            east += rot[5] * z
-                else:                           # point-wise least squares [2]
+                north = east = up = zero
+                if linear and model == NONE and not per_trial:  # the truth's part: folded
+                    north, east, up = folded[0, g], folded[1, g], folded[2, g]
+                    if has_noise:
+                        for b in range(n_beams):
+                            value = noise[noise_i, noise_s, b * n_gates + g]
+                            north += reading[0, b] * value
+                            east += reading[1, b] * value
+                            up += reading[2, b] * value
+                elif linear:                    # (north, east, up) = reading v + offset
+                    north, east, up = offset[0], offset[1], offset[2]
+                    for b in range(n_beams):
+                        value = truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] \
+                            if has_noise else truth[b, g]
+                        north += reading[0, b] * value
+                        east += reading[1, b] * value
+                        up += reading[2, b] * value
+                if want_radial or want_shear or not linear:     # c_k = v_k + b_k . s
+                    for b in range(n_beams):
+                        measured = truth[b, g] + noise[noise_i, noise_s, b * n_gates + g] \
+                            if has_noise else truth[b, g]
+                        corrected[b] = measured + along[b]
+                        if want_radial:
+                            radial[s, b, g, i] = corrected[b]
+                if not linear:                  # point-wise least squares [2]
                     for k in range(3):
                         total = zero
                         for b in range(n_beams):
                             total += normal[b, k] * corrected[b]
                         rhs[k] = total
-                        for m in range(3):
-                            total = zero
-                            for b in range(n_beams):
-                                total += normal[b, k] * normal[b, m]
-                            matrix[k, m] = total
-                    _solve3(matrix, rhs)
-                    north, east, up = rhs[0], rhs[1], rhs[2]
+                    north, east, up = _pointwise_solve(gram, matrix, rhs)
                     if model == TILT2D:
                         north, east, up = _tilt2d_project(mean_rot, mean_ship, north, east,
                                                           up)
-                if level_a >= 0:                # the hub-height wind of the level beams
-                    r0 = corrected[level_a] - normal[level_a, 2] * up
-                    r1 = corrected[level_b] - normal[level_b, 2] * up
-                    north = inverse[0] * r0 + inverse[1] * r1
-                    east = inverse[2] * r0 + inverse[3] * r1
+                    if level_a >= 0:            # the hub-height wind of the level beams
+                        r0 = corrected[level_a] - normal[level_a, 2] * up
+                        r1 = corrected[level_b] - normal[level_b, 2] * up
+                        north = inverse[0] * r0 + inverse[1] * r1
+                        east = inverse[2] * r0 + inverse[3] * r1
+                if n_beams == 2:                # w = 0 (not 0 x a NaN)
+                    up = zero
                 if want_speed:
                     speed[s, g, i] = _hypot(north, east)
                 if want_vertical:

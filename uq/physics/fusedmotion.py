@@ -344,6 +344,7 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     if layout is not None and layout[-1]:   # the shear exponent: the believed lift too
         consts = consts.copy()
         consts[kernels.HEAD.index("mounted")] = 2.0
+    mounted = kernels.compiled_mounted_wind() if layout is not None else None
     n_beams, n_gates = plan.slant.shape
     n_nodes = len(plan.weights)
     ins, has, noise = _reconstruction_inputs(errors, n)
@@ -390,10 +391,10 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
                             plan.weights, ins, has, noise, start, count, work, c, turned,
                             states, parts, ratio, normal, out)
         if layout is not None:                      # a tilted mount's reconstruction
-            kernels.compiled_mounted_wind()(consts, layout, plan.beams, plan.slant, work,
-                                            normal, count, out,
-                                            shear_out if shear_out is not None else speed)
-        kernels.wind_speed(out, count, speed, vertical)
+            mounted(consts, layout, plan.beams, plan.slant, work, normal, count, out,
+                    shear_out if shear_out is not None else speed, speed, vertical)
+        else:
+            kernels.wind_speed(out, count, speed, vertical)
         stop = start + count
         if "wind_speed" in into:
             into["wind_speed"][start:stop] = speed[:, :count].T
@@ -414,10 +415,10 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
                                 plan.weights, *second, start, count, work, c, turned,
                                 states, parts, ratio, normal, out)
             if layout is not None:                  # (the shear row is stored already)
-                kernels.compiled_mounted_wind()(consts, layout, plan.beams, plan.slant, work,
-                                                normal, count, out,
-                                                shear_out if shear_out is not None else speed)
-            kernels.wind_speed(out, count, speed, vertical)
+                mounted(consts, layout, plan.beams, plan.slant, work, normal, count, out,
+                        shear_out if shear_out is not None else speed, speed, vertical)
+            else:
+                kernels.wind_speed(out, count, speed, vertical)
             into[HELD_WIND_SPEED][start:stop] = speed[:, :count].T
 
 

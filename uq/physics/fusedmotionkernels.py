@@ -760,13 +760,18 @@ def _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, sour
 def _store_reading(consts, state, work, normal, row, count, heading_varies, source):
     """A point-wise reading of a tilted mount into normal[row ..]: the believed beam
     (rows _BEAM), the velocity along it (_ALONG) and, for the shear exponent's believed
-    heights, the lidar's lift ``[(R_read - R_static) r]_up`` through the lever arm r
-    (:func:`uq.physics.timeresolved._lever_arm_lift`; 0 without one)."""
-    for i in range(3):
-        normal[row + i, :count] = work[_BEAM + i, :count]
-    normal[row + 3, :count] = work[_ALONG, :count]
+    heights alone (HEAD mounted 2), the lidar's lift ``[(R_read - R_static) r]_up``
+    through the lever arm r (:func:`uq.physics.timeresolved._lever_arm_lift`; 0 without
+    one)."""
+    for j in range(count):                  # (a loop, not four slices: their views
+        normal[row, j] = work[_BEAM, j]     # cost more than the copy of a block)
+        normal[row + 1, j] = work[_BEAM + 1, j]
+        normal[row + 2, j] = work[_BEAM + 2, j]
+        normal[row + 3, j] = work[_ALONG, j]
+    if consts[_MOUNTED] < 2:                # the lift is the shear's alone (HEAD mounted 2)
+        return
     normal[row + 4, :count] = 0.0
-    if consts[_HAS_ARM] > 0 and consts[_MOUNTED] > 1:   # (HEAD mounted 2: the shear's)
+    if consts[_HAS_ARM] > 0:
         _pointwise_rows(consts, state, work, consts[_ARM_BOW], consts[_ARM_STARBOARD],
                         consts[_ARM_UP], count, heading_varies, source)
         for j in range(count):              # the reading's rotation of the arm
@@ -869,12 +874,13 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
         if not _reading(consts, pairs, amplitudes, components, read_table, stamps, mid, phases,
                         turned, errors, has, start, count, states[0], work):
             _read_rows(consts, states[0], work, count)
-    normal[:, :count] = 0.0
     heading_varies = consts[_MOVES_YAW] > 0 or has[0]
     # a tilted mount (rows of `normal` beyond the least squares'): its reconstruction
     # (:func:`mounted_wind`) keeps each beam's measured radial velocity and, point-wise,
     # its believed beam, the velocity along it and the lidar's believed lift
     stored = 6 + 3 * n_gates if normal.shape[0] > 6 + 3 * n_gates else 0
+    normal[:6 + 3 * n_gates, :count] = 0.0          # the sums, not a tilted mount's kept
+    #                                                 rows (each is written before read)
     for b in range(n_beams):
         if model == POINTWISE:          # this beam's own reading: the beam and velocity it implies
             state = states[b if at_nodes else 0]
@@ -947,7 +953,8 @@ def wind_speed(out, count, speed, vertical):
 MOUNTED_LAYOUT = ("level_first", "level_second", "upper", "lower", "want_shear")
 
 
-def mounted_wind(consts, layout, beams, slant, work, normal, count, out, shear):
+def mounted_wind(consts, layout, beams, slant, work, normal, count, out, shear, speed,
+                 vertical):
     """A tilted (nacelle) mount's wind of trials [0, count), after :func:`reconstruct`
     (whose `normal` then holds the measured radial velocities and, point-wise, each
     beam's believed beam, velocity along it and lift; its `work` the scan's reading).
@@ -960,7 +967,9 @@ def mounted_wind(consts, layout, beams, slant, work, normal, count, out, shear):
     b_k,up w`` with the w of `out` (:mod:`uq.physics.nacelle`); other layouts keep
     `out`. Writes out[:, g, j] and, wanted, ``shear[g, j] = ln(U_up / U_down) / ln(z_up /
     z_down)``, ``U_k = c_k / (b_k,h . e)`` at the believed heights ``z_k = lidar height +
-    lift_k + slant b_k,up`` (NaN where a ratio is not positive). Loops over the trials
+    lift_k + slant b_k,up`` (NaN where a ratio is not positive); then the speed and the
+    vertical wind as :func:`wind_speed` (in this call: one call less per block, whose
+    Python and dispatch cost ~1.5 us, as much as the pass itself). Loops over the trials
     innermost (SIMD); the 2 x 2 inverses in work's rows _MATRIX1 (free after
     :func:`reconstruct`).
     """
@@ -982,7 +991,8 @@ def mounted_wind(consts, layout, beams, slant, work, normal, count, out, shear):
                 normal[row, j], normal[row + 1, j], normal[row + 2, j] = bx, by, bz
                 normal[row + 3, j] = bx * work[_READ_VELOCITY, j] + \
                     by * work[_READ_VELOCITY + 1, j] + bz * vu
-                normal[row + 4, j] = 0.0
+            if layout[4] > 0:               # the scan's reading lifts no beam
+                normal[row + 4, :count] = 0.0
     first = stored + 5 * (0 if n_beams == 2 else level_a)
     second = stored + 5 * (1 if n_beams == 2 else level_b)
     inverse = _MATRIX1
@@ -1021,6 +1031,7 @@ def mounted_wind(consts, layout, beams, slant, work, normal, count, out, shear):
                         measured + lower * n_gates + g, stored + 5 * upper,
                         stored + 5 * lower, slant[upper, g], slant[lower, g], out, g, count,
                         shear)
+    wind_speed(out, count, speed, vertical)
 
 
 @_helper
@@ -1064,4 +1075,4 @@ def _shear_exponent(north, east, upper_north, upper_east, lower_north, lower_eas
 def compiled_mounted_wind():
     """:func:`mounted_wind` compiled on first use (a tilted mount's run alone pays it)."""
     return _kernel(f"void({_CV}, int64[::1], {_CM}, {_CM}, {_CM}, {_CM}, int64, {_CT}, "
-                   f"{_CM})")(mounted_wind)
+                   f"{_CM}, {_CM}, {_CM})")(mounted_wind)
