@@ -108,9 +108,11 @@ def measurement_model(scene, outputs, scene_draws=False, held=None, **errors):
     outputs: each (n, *S, n_gates) for a batch of scenes of shape S, evaluated one scene
     after the other; with `scene_draws` each scene takes its own slice of the inputs).
     `held` (inputs -> scalar): the wind speed of the same trials with these inputs
-    replaced, ``wind_speed_held``; where no input of the truth is held
-    (:func:`shares_kinematics`), a second reconstruction per block on the same
-    kinematics, else a second evaluation."""
+    replaced, ``wind_speed_held``; where the radial noise alone is held (an upward lidar,
+    :func:`shares_reading`) a second right-hand side of the same least squares in the
+    same reconstruction, else where no input of the truth is held
+    (:func:`shares_kinematics`) a second reconstruction per block on the same
+    kinematics, else a second evaluation (:data:`HELD_PATHS` counts which)."""
     if scene.probe is not None:             # its node count (the scene itself if chosen)
         scene = probe_volume.resolve(scene)
     shape, gates = scene.shape, len(scene.ranges)
