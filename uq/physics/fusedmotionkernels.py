@@ -733,6 +733,32 @@ def _pointwise(consts, state, work, normal, nx, ny, nz, count, heading_varies, s
 
 
 @_helper
+def _pointwise_from_state(head, state, work, nx, ny, nz, count):
+    """:func:`_pointwise_at` from the truth's state without a lever arm, written out in
+    one loop of locals (the same operations in the same order: bit for bit its result),
+    which LLVM makes SIMD code where the inlined helper stayed scalar: the bench's
+    point-wise scan 93 -> 40 ns per trial in :func:`reconstruct` (issue 26)."""
+    level_c, level_s = head[_LEVEL_COS], head[_LEVEL_SIN]
+    ship_n, ship_e, ship_u = head[_SHIP_NORTH], head[_SHIP_EAST], head[_SHIP_UP]
+    course_c, course_s = head[_COURSE_COS], head[_COURSE_SIN]
+    for j in range(count):
+        ch, sh = state[_TRIG, j], state[_TRIG + 1, j]
+        cp, sp = state[_TRIG + 2, j], state[_TRIG + 3, j]
+        cr, sr = state[_TRIG + 4, j], state[_TRIG + 5, j]
+        surge, sway = state[_RATE_ROW + 3, j], state[_RATE_ROW + 4, j]
+        vn = ship_n + (level_c * surge - level_s * sway)          # _ins_velocity
+        ve = ship_e + (level_s * surge + level_c * sway)
+        vu = ship_u + state[_RATE_ROW + 5, j]
+        sog = work[_SOG, j]                                       # _velocity_errors
+        vn, ve = vn + sog * course_c, ve + sog * course_s
+        ce, se = work[_COG, j], work[_COG + 1, j]
+        vn, ve, vu = ce * vn - se * ve, se * vn + ce * ve, vu + work[_HEAVE, j]
+        bx, by, bz = rotate(ch, sh, cp, sp, cr, sr, nx, ny, nz)
+        work[_BEAM, j], work[_BEAM + 1, j], work[_BEAM + 2, j] = bx, by, bz
+        work[_ALONG, j] = bx * vn + by * ve + bz * vu
+
+
+@_helper
 def _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, source):
     """:func:`_pointwise_at` for the block's trials: the read rotation of (nx, ny, nz)
     into rows _BEAM, the lidar velocity along it into _ALONG."""
@@ -740,6 +766,8 @@ def _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, sour
     if source == FROM_ROWS:
         for j in range(count):
             _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_ROWS)
+    elif source == FROM_STATE and head[_HAS_ARM] == 0:
+        _pointwise_from_state(head, state, work, nx, ny, nz, count)
     elif source == FROM_STATE:
         for j in range(count):
             _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_STATE)
