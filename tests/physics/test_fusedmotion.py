@@ -153,6 +153,64 @@ def test_the_held_speed_is_a_second_evaluation(changes, names):
                                atol=TOLERANCE)
 
 
+#: Scans whose held speed (radial noise alone held) shares the reading: point-wise at the
+#: truth's nodes, point-wise between the samples of a linear INS (the reading's own
+#: rows), at a dwell average, and one reading per scan through A^+ (none, full).
+SHARED_CASES = {"pointwise, continuous INS": {}, "pointwise, no INS errors": {"ins": None},
+                "pointwise, 10 Hz linear INS": CASES["pointwise, 10 Hz linear INS"],
+                "pointwise, dwell average": CASES["pointwise, dwell average"],
+                "none": CASES["none"], "full": CASES["full (one reading per scan)"]}
+
+
+@pytest.mark.parametrize("per_trial", [False, True], ids=["held at a value", "held noise drawn"])
+@pytest.mark.parametrize("changes", SHARED_CASES.values(), ids=SHARED_CASES.keys())
+def test_held_noise_alone_shares_the_reading(changes, per_trial):
+    """Where `held` replaces the radial noise alone (and holds an absent INS error at its
+    0), the held speed is a second right-hand side on the reading's least-squares factor
+    in the same kernel call (the path counted "shared reading"), and equals, bit for bit,
+    a separate evaluation with the noise replaced: the same operations in the same order
+    on the same numbers (the factor of the same B^T B, the same dwell mean plus the held
+    noise); the numpy model's held speed to the rounding bound TOLERANCE."""
+    settings = load_scenario({"name": "t", **merged(BASE, changes)}).settings
+    scene = scene_from_settings(settings)
+    inputs = error_inputs(settings, scene.n_beams, len(scene.ranges))
+    random = input_set({k: v for k, v in inputs.items() if not isinstance(v, float)})
+    rng = np.random.default_rng(8)
+    errors = random.values(rng.standard_normal((300, random.dimension)))
+    noise = errors["lidar_radial_velocity"]
+    held = {"lidar_radial_velocity": rng.normal(0.0, 0.3, noise.shape) if per_trial
+            else 0.02, "ins_heave": 0.0}                    # (ins_heave is not drawn: 0)
+    assert "ins_heave" not in errors and fusedmotion.shares_reading(held, errors)
+    before = fusedmotion.HELD_PATHS.copy()
+    fast = measurement_model(scene, OUTPUTS, held=held, **errors)
+    taken = fusedmotion.HELD_PATHS - before
+    assert taken == {"shared reading": 1}
+    alone = measurement_model(scene, ("wind_speed",), **{**errors, **held})["wind_speed"]
+    np.testing.assert_array_equal(fast["wind_speed_held"], alone)
+    assert not np.allclose(fast["wind_speed_held"], fast["wind_speed"], rtol=0, atol=1e-6)
+    plain = measurement_model(scene, OUTPUTS, **errors)
+    for q in OUTPUTS:
+        np.testing.assert_array_equal(fast[q], plain[q])
+    slow = measurement_model(scene, OUTPUTS, compiled=False, held=held, **errors)
+    np.testing.assert_allclose(fast["wind_speed_held"], slow["wind_speed_held"], rtol=0,
+                               atol=TOLERANCE)
+
+
+def test_a_held_reading_error_is_a_second_reconstruction():
+    """An INS error held at a value other than the run's (here an absent one held away from
+    0) changes the reading: no shared factor, a second reconstruction."""
+    scene, = _case_scene()
+    errors = _case_errors()
+    held = {"lidar_radial_velocity": 0.0, "ins_heave": 0.05}
+    assert fusedmotion.shares_kinematics(held, errors)
+    assert not fusedmotion.shares_reading(held, errors)
+    before = fusedmotion.HELD_PATHS.copy()
+    fast = measurement_model(scene, ("wind_speed",), held=held, **errors)
+    assert fusedmotion.HELD_PATHS - before == {"second reconstruction": 1}
+    alone = measurement_model(scene, ("wind_speed",), **{**errors, **held})["wind_speed"]
+    np.testing.assert_array_equal(fast["wind_speed_held"], alone)
+
+
 def test_nothing_held_is_the_speed_itself():
     """``held={}`` replaces nothing: the second reconstruction is the first, bit for bit."""
     fast = measurement_model(*_case_scene(), ("wind_speed",), held={}, **_case_errors())

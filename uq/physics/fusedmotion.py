@@ -29,6 +29,7 @@ frame bow, starboard, up; body-to-earth ``Rz(heading) Ry(pitch) Rx(roll)``; the 
 at ``t + delta``, sampled at ``offset + i / rate``; its errors added to the Euler angles,
 ``sog`` along the static course, ``cog`` turning the horizontal velocity).
 """
+import collections
 import dataclasses
 import functools
 import math
@@ -107,9 +108,11 @@ def measurement_model(scene, outputs, scene_draws=False, held=None, **errors):
     outputs: each (n, *S, n_gates) for a batch of scenes of shape S, evaluated one scene
     after the other; with `scene_draws` each scene takes its own slice of the inputs).
     `held` (inputs -> scalar): the wind speed of the same trials with these inputs
-    replaced, ``wind_speed_held``; where no input of the truth is held
-    (:func:`shares_kinematics`), a second reconstruction per block on the same
-    kinematics, else a second evaluation."""
+    replaced, ``wind_speed_held``; where the radial noise alone is held (an upward lidar,
+    :func:`shares_reading`) a second right-hand side of the same least squares in the
+    same reconstruction, else where no input of the truth is held
+    (:func:`shares_kinematics`) a second reconstruction per block on the same
+    kinematics, else a second evaluation (:data:`HELD_PATHS` counts which)."""
     if scene.probe is not None:             # its node count (the scene itself if chosen)
         scene = probe_volume.resolve(scene)
     shape, gates = scene.shape, len(scene.ranges)
@@ -128,6 +131,7 @@ def measurement_model(scene, outputs, scene_draws=False, held=None, **errors):
         if held is None or shares_kinematics(held, mine):
             _evaluate(plan, mine, n, into, scene.probe, layout, held)
         else:
+            HELD_PATHS["second evaluation"] += 1
             second = {"wind_speed": into.pop(HELD_WIND_SPEED)}
             _evaluate(plan, mine, n, into, scene.probe, layout)
             _evaluate(plan, {**mine, **held}, n, second, scene.probe, layout)
@@ -156,6 +160,29 @@ def shares_kinematics(held, errors):
     return all(name not in KINEMATIC_INPUTS or
                (np.ndim(errors.get(name)) == 0 and errors.get(name) == value)
                for name, value in held.items())
+
+
+#: The radial noise: the one input a held evaluation may replace and still share the
+#: reading (:func:`shares_reading`).
+NOISE_INPUT = "lidar_radial_velocity"
+
+
+def shares_reading(held, errors):
+    """Can the evaluation with `held` replacing inputs of `errors` reuse its truth and its
+    INS reading too (the believed beams, the least-squares factor): does `held` replace
+    the radial noise alone, every other held input given in `errors` as that same scalar
+    (or absent there, which is 0, and held at 0)?"""
+    return shares_kinematics(held, errors) and all(
+        name == NOISE_INPUT or name in KINEMATIC_INPUTS or
+        (np.ndim(errors.get(name, 0.0)) == 0 and errors.get(name, 0.0) == value)
+        for name, value in held.items())
+
+
+#: How each scene's held speed was evaluated, counted per :func:`_evaluate` call (for the
+#: tests): "shared reading" (a second right-hand side on the same least-squares factor,
+#: :func:`~uq.physics.fusedmotionkernels.reconstruct`), "second reconstruction" (on the
+#: same truth) or "second evaluation".
+HELD_PATHS = collections.Counter()
 
 
 def _scene_at(scene, index):
@@ -339,7 +366,9 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     mount's `layout`: its reconstruction, :func:`~uq.physics.fusedmotionkernels.
     mounted_wind`); with `held` (inputs of the reconstruction alone -> scalar) the
     speed reconstructed from the same truth with those inputs replaced, into
-    ``into["wind_speed_held"]``."""
+    ``into["wind_speed_held"]``: with the reading shared (:func:`shares_reading`, an
+    upward lidar) in the same reconstruction, as a second right-hand side of its least
+    squares, else by a second reconstruction."""
     consts = plan.consts
     if layout is not None and layout[-1]:   # the shear exponent: the believed lift too
         consts = consts.copy()
@@ -349,6 +378,9 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     n_nodes = len(plan.weights)
     ins, has, noise = _reconstruction_inputs(errors, n)
     second = None if held is None else _reconstruction_inputs({**errors, **held}, n)
+    shared = second is not None and layout is None and shares_reading(held, errors)
+    if second is not None:
+        HELD_PATHS["shared reading" if shared else "second reconstruction"] += 1
     phases = _phase_input(errors.get("motion_phases"), plan.n_phases)
     window = _phase_input(errors.get("motion_window"), plan.n_window)
     geometry = [_column(errors.get(name)) for name in _GEOMETRY]
@@ -362,7 +394,10 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     parts = np.empty((2, n_beams * n_nodes, m))
     ratio = np.empty((n_beams * n_nodes, n_gates, m))
     normal = np.empty((6 + 3 * n_gates + (0 if layout is None else
-                                          5 * n_beams + n_beams * n_gates), m))
+                                          5 * n_beams + n_beams * n_gates)
+                       + (3 * n_gates if shared else 0), m))
+    held_noise = second[2] if shared else noise
+    held_out = np.empty((3, n_gates, m) if shared else (0, 1, 1))
     shear_out = np.empty((n_gates, m)) if layout is not None and layout[-1] else None
     out = np.empty((3, n_gates, m))
     speed, vertical = np.empty((n_gates, m)), np.empty((n_gates, m))
@@ -389,7 +424,7 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
         kernels.reconstruct(consts, plan.pairs, plan.amplitudes, plan.components,
                             plan.read_table, plan.stamps, plan.beams, plan.operator,
                             plan.weights, ins, has, noise, start, count, work, c, turned,
-                            states, parts, ratio, normal, out)
+                            states, parts, ratio, normal, out, held_noise, held_out)
         if layout is not None:                      # a tilted mount's reconstruction
             mounted(consts, layout, plan.beams, plan.slant, work, normal, count, out,
                     shear_out if shear_out is not None else speed, speed, vertical)
@@ -409,17 +444,24 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
                     direction, consts[kernels.HEAD.index("heading")])
         if shear_out is not None and "shear_exponent" in into:
             into["shear_exponent"][start:stop] = shear_out[:, :count].T
-        if second is not None:             # the same truth, the held inputs' reading
+        if shared:                         # the same reading, the held noise's wind
+            kernels.wind_speed(held_out, count, speed, vertical)
+            into[HELD_WIND_SPEED][start:stop] = speed[:, :count].T
+        elif second is not None:           # the same truth, the held inputs' reading
             kernels.reconstruct(consts, plan.pairs, plan.amplitudes, plan.components,
                                 plan.read_table, plan.stamps, plan.beams, plan.operator,
                                 plan.weights, *second, start, count, work, c, turned,
-                                states, parts, ratio, normal, out)
+                                states, parts, ratio, normal, out, noise, _NO_HELD)
             if layout is not None:                  # (the shear row is stored already)
                 mounted(consts, layout, plan.beams, plan.slant, work, normal, count, out,
                         shear_out if shear_out is not None else speed, speed, vertical)
             else:
                 kernels.wind_speed(out, count, speed, vertical)
             into[HELD_WIND_SPEED][start:stop] = speed[:, :count].T
+
+
+#: ``held_out`` of :func:`~uq.physics.fusedmotionkernels.reconstruct` without a held side.
+_NO_HELD = np.empty((0, 1, 1))
 
 
 def _probe_profile(probe, errors, start, count, ratio, beam_up, focus, item_focus,
