@@ -357,7 +357,7 @@ ZEPHIR_TRUNCATION = 0.02
 #: pi / 2 in three parts [rad] for the Cody-Waite argument reduction of the compiled
 #: sine and cosine (:func:`uq.physics.fusedmotionkernels.sincos`): the first two carry
 #: 33 significant bits each, so k times them is exact for |k| < 2^20, and their sum with
-#: the third is pi / 2 to 1e-37 (tested). fdlibm's ``pio2_1``, ``pio2_2``, ``pio2_2t``
+#: the third is pi / 2 to 1.01e-37 (tested). fdlibm's ``pio2_1``, ``pio2_2``, ``pio2_2t``
 #: (Sun Microsystems, e_rem_pio2.c, 1993); Cody, W. J. and Waite, W. (1980). Software
 #: Manual for the Elementary Functions. Prentice-Hall, Ch. 8.
 HALF_PI_PARTS = (float.fromhex("0x1.921fb54400000p+0"), float.fromhex("0x1.0b4611a600000p-34"),

@@ -174,9 +174,10 @@ def sincos_rows(work, angle, sine, cosine, count):
             work[sine, j], work[cosine, j] = math.sin(x), math.cos(x)
 
 
-@_kernel("void(float64[::1], float64[::1])")
+@njit(cache=True, nogil=True, error_model="numpy")
 def sincos_array(x, out):
-    """sin and cos of x into out[:n] and out[n:] (for the tests of :func:`sincos`)."""
+    """sin and cos of x into out[:n] and out[n:] (for the tests of :func:`sincos`;
+    compiled on its first call, not at import: no run pays for it)."""
     n = x.shape[0]
     work = np.empty((3, n))
     work[0] = x
@@ -287,8 +288,9 @@ def _geometry(consts, azimuths, beams, cone_error, misalignment_error, height_er
             for i in range(3):
                 ship_beams[b, i, :count] = beams[b, i]
     else:
-        _geometry_angle(consts[_HALF_CONE], cone_error, start, count, work, _CONE)
-        _geometry_angle(consts[_MISALIGNMENT], misalignment_error, start, count, work, _MIS)
+        cone, mis = np.int64(_CONE), np.int64(_MIS)   # not literals: one compile, not two
+        _geometry_angle(consts[_HALF_CONE], cone_error, start, count, work, cone)
+        _geometry_angle(consts[_MISALIGNMENT], misalignment_error, start, count, work, mis)
         for b in range(n_beams):
             if consts[_MOUNTED] > 0:         # clock positions about a tilted boresight
                 _mounted_beams(consts, azimuths, b, count, work, ship_beams)
@@ -510,11 +512,12 @@ def _slerp_one(work, j, exact):
 
 @_helper
 def _slerp(work, count):
+    series = count < 0                    # False, not a literal: one compile, not two
     for j in range(count):
-        _slerp_one(work, j, False)
+        _slerp_one(work, j, series)
     for j in range(count):                # a large rotation between samples: libm
         if not work[_BIG, j] <= SLERP_SERIES_LIMIT:
-            _slerp_one(work, j, True)
+            _slerp_one(work, j, not series)
 
 
 @_helper
@@ -1004,13 +1007,14 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                     normal[6 + 3 * g, j] += o0 * work[_MEASURED, j]
                     normal[7 + 3 * g, j] += o1 * work[_MEASURED, j]
                     normal[8 + 3 * g, j] += o2 * work[_MEASURED, j]
+    first = np.int64(6)                 # the sums' first row (not a literal: one compile)
     if model == POINTWISE:
         _factor(normal, count)
-        _substitute(normal, 6, n_gates, count, out)
+        _substitute(normal, first, n_gates, count, out)
         if held:                                        # the same factor, the held sides
             _substitute(normal, second, n_gates, count, held_out)
     else:
-        _scan_correction(consts, model, work, normal, 6, n_gates, count, out)
+        _scan_correction(consts, model, work, normal, first, n_gates, count, out)
         if held:
             _scan_correction(consts, model, work, normal, second, n_gates, count, held_out)
 
