@@ -79,15 +79,15 @@ START_SCRIPT = ("import numpy, scipy.stats, xarray, netCDF4, numba, matplotlib.p
                 "import uq.cli.run, uq.pipeline.runner, uq.physics.fused, uq.outputs.plots")
 
 
-def median_time(function, repeats):
-    """Median wall time [s] of `repeats` calls after one warm call (imports, caches,
-    numba's kernels loaded)."""
+def median_time(function, repeats, clock=time.perf_counter):
+    """Median time [s] of `repeats` calls after one warm call (imports, caches, numba's
+    kernels loaded), read from `clock` (default: wall time)."""
     function()
     times = []
     for _ in range(repeats):
-        started = time.perf_counter()
+        started = clock()
         function()
-        times.append(time.perf_counter() - started)
+        times.append(clock() - started)
     return float(np.median(times))
 
 
@@ -271,13 +271,7 @@ def median_cpu_time(function, repeats):
     """Median CPU time [s] of this process (``time.process_time``) over `repeats` calls
     after one warm call: a figure a busy machine does not move (all of the process's
     threads: the engine's drawing thread too)."""
-    function()
-    times = []
-    for _ in range(repeats):
-        started = time.process_time()
-        function()
-        times.append(time.process_time() - started)
-    return float(np.median(times))
+    return median_time(function, repeats, clock=time.process_time)
 
 
 #: The nacelle lidar of the issue's held-out check: 4 beams at clock positions up,
