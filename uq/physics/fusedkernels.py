@@ -337,6 +337,29 @@ def _geometry(table, shapes, structure, geo, s0, s1, t0, t1, per_trial, beams, r
 
 
 @_helper
+def _beam_rotation(model, cos_read, sin_read, j, b, heading_error, pitch_error, roll_error,
+                   cos_nominal, sin_nominal):
+    """:func:`_rotation` of beam b's own INS reading (point-wise: the (cos, sin) of its
+    heading, pitch and roll in cos_read/sin_read[0:3, k, j], k = b where that error is
+    drawn per beam, else 0) for trial column j."""
+    kh = b if heading_error.shape[2] > 1 else 0
+    kp = b if pitch_error.shape[2] > 1 else 0
+    kr = b if roll_error.shape[2] > 1 else 0
+    return _rotation(model, cos_read[0, kh, j], sin_read[0, kh, j], cos_read[1, kp, j],
+                     sin_read[1, kp, j], cos_read[2, kr, j], sin_read[2, kr, j],
+                     cos_nominal, sin_nominal)
+
+
+@_helper
+def _believed_beam(rot, units, b, normal):
+    """normal[b] = rot units[b]: beam b's unit vector (lidar frame) in the earth frame the
+    correction believes (rot row-major, from :func:`_rotation`)."""
+    for k in range(3):
+        normal[b, k] = rot[3 * k] * units[b, 0] + rot[3 * k + 1] * units[b, 1] \
+            + rot[3 * k + 2] * units[b, 2]
+
+
+@_helper
 def _rotation(model, ch, sh, cp, sp, cr, sr, cos_nominal, sin_nominal):
     """Row-major body-to-earth rotation the correction believes: Rz(heading) Ry(pitch)
     Rx(roll) of the INS reading (tilt2d, full), its heading alone (yaw) or the
@@ -653,15 +676,9 @@ def _wind(table, shapes, structure, ins, noise, cos_trig, sin_trig, beams, profi
                     rot = _rotation(NONE, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, cos_nominal,
                                     sin_nominal)
                 else:
-                    kh = b if heading_error.shape[2] > 1 else 0
-                    kp = b if pitch_error.shape[2] > 1 else 0
-                    kr = b if roll_error.shape[2] > 1 else 0
-                    rot = _rotation(model, cos_read[0, kh, j], sin_read[0, kh, j],
-                                    cos_read[1, kp, j], sin_read[1, kp, j], cos_read[2, kr, j],
-                                    sin_read[2, kr, j], cos_nominal, sin_nominal)
-                for k in range(3):
-                    normal[b, k] = rot[3 * k] * units[b, 0] + rot[3 * k + 1] * units[b, 1] \
-                        + rot[3 * k + 2] * units[b, 2]
+                    rot = _beam_rotation(model, cos_read, sin_read, j, b, heading_error, pitch_error,
+                                         roll_error, cos_nominal, sin_nominal)
+                _believed_beam(rot, units, b, normal)
                 if model == NONE:
                     along[b] = zero
                 else:
@@ -955,21 +972,15 @@ def _wind_mounted(table, shapes, structure, ins, noise, cos_trig, sin_trig, beam
                                     sin_nominal)
                     ship = (zero, zero, zero)
                 else:
-                    kh = b if heading_error.shape[2] > 1 else 0
-                    kp = b if pitch_error.shape[2] > 1 else 0
-                    kr = b if roll_error.shape[2] > 1 else 0
-                    rot = _rotation(model, cos_read[0, kh, j], sin_read[0, kh, j],
-                                    cos_read[1, kp, j], sin_read[1, kp, j], cos_read[2, kr, j],
-                                    sin_read[2, kr, j], cos_nominal, sin_nominal)
+                    rot = _beam_rotation(model, cos_read, sin_read, j, b, heading_error, pitch_error,
+                                         roll_error, cos_nominal, sin_nominal)
                     kc = b if cog_error.shape[2] > 1 else 0
                     sog = sog0 + _pick(sog_error, i, s, b)
                     ship = (sog * cos_read[3, kc, j], sog * sin_read[3, kc, j],
                             heave0 + _pick(heave_error, i, s, b) if model == FULL else zero)
                 if model == NONE and i > t0:
                     continue                    # none's believed beams: the scene's
-                for k in range(3):
-                    normal[b, k] = rot[3 * k] * units[b, 0] + rot[3 * k + 1] * units[b, 1] \
-                        + rot[3 * k + 2] * units[b, 2]
+                _believed_beam(rot, units, b, normal)
                 along[b] = normal[b, 0] * ship[0] + normal[b, 1] * ship[1] + \
                     normal[b, 2] * ship[2]
             if not (model == NONE and i > t0):  # the 2 x 2 inverses of the believed beams
