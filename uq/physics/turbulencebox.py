@@ -509,7 +509,8 @@ def _mann_box_host(grid, alpha_epsilon, length_scale, anisotropy, rng, slab_cell
 def mann_box_window(grid, alpha_epsilon, length_scale, anisotropy, rng, window, parts=1,
                     slab_cells=constants.BOX_SLAB_CELLS):
     """The field of :func:`mann_box` on a window of its (y, z) cells, in the memory of
-    1 / `parts` of its half spectra (on the host).
+    1 / `parts` of its half spectra (on the host): the sum of
+    :func:`mann_box_window_parts`.
 
     The same random numbers and the same field as :func:`mann_box` to rounding (the
     transforms are linear: the half spectrum's z wavenumbers are taken in `parts` parts,
@@ -534,16 +535,42 @@ def mann_box_window(grid, alpha_epsilon, length_scale, anisotropy, rng, window, 
         cell (0, j0, m0), periodic along x only (``periodic_yz`` False: a point outside
         the window is refused, not wrapped).
     """
+    velocity = None
+    for part in mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy, rng,
+                                      window, parts, slab_cells):
+        if velocity is None:
+            velocity = np.zeros(part.velocity.shape)
+        velocity += part.velocity
+    return TurbulenceBox(grid=part.grid, velocity=velocity)
+
+
+def mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy, rng, window,
+                          parts=1, slab_cells=constants.BOX_SLAB_CELLS):
+    """The field of :func:`mann_box_window` as `parts` fields whose sum it is, one at a
+    time (a generator): each part's field of the half spectrum's z wavenumbers
+    [a, b) (parameters and the window's grid as :func:`mann_box_window`).
+
+    Each part's field is held in the memory of that part's half spectra (a window's line
+    of slab i, transformed back, is written where slabs <= i were read from, where it
+    fits; else in an array of its own), so that it is valid until the next part is
+    asked for: what the field is sampled for (it is linear) is taken part by part, in
+    the memory of one part's spectra alone. `rng` is left where one draw of the box
+    leaves it once the last part has been taken.
+    """
     from uq.physics.turbulencekernels import mann_colour
     (nx, ny, nz), half = grid.shape, grid.shape[2] // 2 + 1
     (j0, j1), (m0, m1) = window
+    wy, wz = j1 - j0, m1 - m0
     slabs = _x_slabs(grid, slab_cells)
     k1, k2, k3 = (np.ascontiguousarray(k.ravel()) for k in box_wavenumbers(grid))
     scale = np.sqrt((2.0 * np.pi) ** 3 / np.prod(grid.spacing))    # sqrt(N dk)
     cells, factors = cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy)
     table = (float(_TABLE[0][0]), float(_TABLE[0][1] - _TABLE[0][0]),
              np.ascontiguousarray(_TABLE[1]))
-    velocity = np.zeros((3, nx, j1 - j0, m1 - m0))
+    (dx, dy, dz), origin = grid.spacing, grid.origin
+    window_grid = BoxGrid(shape=(nx, wy, wz), spacing=grid.spacing,
+                          origin=(origin[0], origin[1] + j0 * dy, origin[2] + m0 * dz),
+                          periodic_yz=False)
     start = rng.bit_generator.state
     edges = np.linspace(0, half, max(1, min(parts, half)) + 1).round().astype(int)
     for a, b in zip(edges[:-1], edges[1:]):
@@ -561,19 +588,27 @@ def mann_box_window(grid, alpha_epsilon, length_scale, anisotropy, rng, window, 
                     alpha_epsilon, length_scale, anisotropy, scale, *table)   # u_k = i C n
         # near the k1 axis: u_k = C_avg n, C_avg even, so u_-k = u_k^* (module docstring)
         spectra[index] = scale * np.einsum("ijn,jn->in", factors[:, :, here], noise_cells)
+        velocity = _part_field(spectra, (nx, wy, wz))
         for c in range(3):
             _in_place(scipy.fft.ifft, spectra[c], None)
             for slab in slabs:
                 rows = scipy.fft.ifft(spectra[c, slab], axis=1)[:, j0:j1]
                 padded = np.zeros(rows.shape[:2] + (half,), dtype=complex)
                 padded[..., a:b] = rows
-                velocity[c, slab] += scipy.fft.irfft(padded, n=nz, axis=2)[..., m0:m1]
-        del spectra
-    (dx, dy, dz), origin = grid.spacing, grid.origin
-    window_grid = BoxGrid(shape=(nx, j1 - j0, m1 - m0), spacing=grid.spacing,
-                          origin=(origin[0], origin[1] + j0 * dy, origin[2] + m0 * dz),
-                          periodic_yz=False)
-    return TurbulenceBox(grid=window_grid, velocity=velocity)
+                velocity[c, slab] = scipy.fft.irfft(padded, n=nz, axis=2)[..., m0:m1]
+        yield TurbulenceBox(grid=window_grid, velocity=velocity)
+        del spectra, velocity
+
+
+def _part_field(spectra, shape):
+    """Where a part's field of `shape` (nx, ny', nz') goes: each component at the start
+    of its half spectra (3, nx, ny, n) when a slab's field is no longer than its spectra
+    (slab i's field then overwrites only what slabs <= i were read from), else new."""
+    nx, ny, n = spectra.shape[1:]
+    size = int(np.prod(shape))
+    if shape[1] * shape[2] > 2 * ny * n:           # float64 (8 bytes) per complex (16)
+        return np.empty((3,) + tuple(shape))
+    return spectra.reshape(3, -1).view(np.float64)[:, :size].reshape((3,) + tuple(shape))
 
 
 def box_window(grid, points, margin=0.0):

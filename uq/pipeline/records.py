@@ -231,30 +231,56 @@ def unit_box(settings, geometry, rng, motion_margin=0.0, window=True):
     the model's point variance [1]. With `window` a Mann box holds only the (y, z) lines
     that the probe points (and the reference point) read
     (:func:`uq.physics.turbulencebox.mann_box_window`), its half spectra in parts of at
-    most :data:`~uq.constants.RECORD_SPECTRA_BYTES`."""
+    most :data:`~uq.constants.RECORD_SPECTRA_BYTES`: the sum of :func:`unit_box_parts`."""
+    from uq.physics import turbulencebox
+    turbulence = settings["turbulence"]
+    if turbulence["model"] == "mann" and not window:
+        grid = turbulencebox.box_for(geometry, turbulence["length_scale"], "mann",
+                                     motion_margin=motion_margin)
+        kept = _unit_kept(settings, grid)
+        return turbulencebox.mann_box(grid, 1.0, turbulence["length_scale"],
+                                      turbulence["anisotropy"], rng,
+                                      slab_cells=RECORD_BOX_SLAB_CELLS), kept
+    parts, kept = unit_box_parts(settings, geometry, rng, motion_margin)
+    velocity = None
+    for part in parts:                  # (as mann_box_window adds them)
+        if velocity is None:
+            velocity = np.zeros(part.velocity.shape)
+        velocity += part.velocity
+    return turbulencebox.TurbulenceBox(grid=part.grid, velocity=velocity), kept
+
+
+def unit_box_parts(settings, geometry, rng, motion_margin=0.0):
+    """The windowed unit box of :func:`unit_box` as fields whose sum it is, and the
+    variance of u it keeps [1]: a Mann box's parts of its half spectra
+    (:func:`uq.physics.turbulencebox.mann_box_window_parts`, each valid until the next
+    is taken; `rng` is left where the box's draw leaves it once the last is taken), a
+    Kaimal box whole (one part)."""
     from uq.physics import turbulencebox
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
     if turbulence["model"] == "mann":
         grid = turbulencebox.box_for(geometry, turbulence["length_scale"], "mann",
                                      motion_margin=motion_margin)
-        model = turbulence_model(turbulence, speed)      # (kept first: not beside the box)
-        kept = _unit_box_variance(grid, turbulence["length_scale"], turbulence["anisotropy"]) \
-            * model.alpha_epsilon / (turbulence["intensity"] * speed) ** 2
-        if not window:
-            return turbulencebox.mann_box(grid, 1.0, turbulence["length_scale"],
-                                          turbulence["anisotropy"], rng,
-                                          slab_cells=RECORD_BOX_SLAB_CELLS), float(kept)
+        kept = _unit_kept(settings, grid)            # (kept first: not beside the box)
         points = np.vstack([np.asarray(geometry.probe_points()).reshape(-1, 3), np.zeros(3)])
         nx, ny, nz = grid.shape
         parts = math.ceil(3 * nx * ny * (nz // 2 + 1) * 16 / RECORD_SPECTRA_BYTES)
-        box = turbulencebox.mann_box_window(
+        return turbulencebox.mann_box_window_parts(
             grid, 1.0, turbulence["length_scale"], turbulence["anisotropy"], rng,
             turbulencebox.box_window(grid, points, motion_margin), parts,
-            slab_cells=RECORD_BOX_SLAB_CELLS)
-        return box, float(kept)
+            slab_cells=RECORD_BOX_SLAB_CELLS), kept
     scale = turbulence["length_scale"] / LENGTH_FACTORS_KAIMAL
     grid = turbulencebox.box_for(geometry, scale, "kaimal", motion_margin=motion_margin)
-    return turbulencebox.kaimal_box(grid, 1.0, speed, scale, rng), np.nan
+    return [turbulencebox.kaimal_box(grid, 1.0, speed, scale, rng)], np.nan
+
+
+def _unit_kept(settings, grid):
+    """The u-variance fraction a Mann box on `grid` keeps of the model's point
+    variance [1] (:func:`_unit_box_variance`, scaled to the scene's model)."""
+    turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
+    model = turbulence_model(turbulence, speed)
+    return float(_unit_box_variance(grid, turbulence["length_scale"], turbulence["anisotropy"])
+                 * model.alpha_epsilon / (turbulence["intensity"] * speed) ** 2)
 
 
 @functools.lru_cache(maxsize=8)
@@ -333,15 +359,24 @@ def unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest=False)
 
 
 def _draw_unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest):
-    """:func:`unit_record` generated: the box, sampled, then freed."""
+    """:func:`unit_record` generated: the box, sampled, then freed, part by part
+    (:func:`unit_box_parts`: the sampling is linear in the field, so the record is the
+    sum of its parts' samples, in the memory of one part)."""
     from uq.physics import turbulencesampling
-    box, kept = unit_box(settings, geometry, rng, margin)
-    radial = np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans,
-                                                                    **moving))
+    parts, kept = unit_box_parts(settings, geometry, rng, margin)
     times = turbulencesampling.scan_times(geometry, n_scans)
-    reference = np.asarray(turbulencesampling.reference_series(box, geometry.speed, times))
-    rest = np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans)) \
-        if at_rest else None
+    found = None
+    for box in parts:
+        samples = (
+            np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans,
+                                                                   **moving)),
+            np.asarray(turbulencesampling.reference_series(box, geometry.speed, times)),
+            np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans))
+            if at_rest else None)
+        found = samples if found is None else tuple(
+            None if a is None else a + b for a, b in zip(found, samples))
+        del box
+    radial, reference, rest = found
     return UnitRecord(radial, reference, rest, kept, rng.bit_generator.state)
 
 
