@@ -94,3 +94,42 @@ def test_compiled_sampling_refuses_points_outside_a_window():
                                 ((0, 3), (0, 3)))
     with pytest.raises(ValueError, match="leave the turbulence box along y or z"):
         ts.record_radial_velocities(window, geometry, 2)
+
+
+def test_colouring_a_k2_with_its_negative_is_colouring_it_alone():
+    # mann_colour computes the factor's scalars once for k2 and -k2 (zeta_2 odd, the rest
+    # even): the same bits as each computed alone (signs are exact in IEEE arithmetic);
+    # the unpaired k2 (0, and one without its negative) are coloured alone
+    from uq.physics.turbulencekernels import _k2_partners, mann_colour
+    k2 = np.array([0.0, 0.05, 0.1, -0.15, -0.1, -0.05, 0.2])
+    np.testing.assert_array_equal(_k2_partners(k2), [-1, 5, 4, -1, -2, -2, -1])
+    rng = np.random.default_rng(8)
+    noise = [rng.standard_normal((6, k2.size, 5)) + 1j * rng.standard_normal((6, k2.size, 5))
+             for _ in range(3)]
+    table = (float(tb._TABLE[0][0]), float(tb._TABLE[0][1] - tb._TABLE[0][0]),
+             np.ascontiguousarray(tb._TABLE[1]))
+    k1 = np.array([-0.2, -0.1, 0.0, 0.1, 0.2, 0.3])   # with k1 = 0: the zetas' limit
+    k3 = np.linspace(0.0, 0.4, 5)
+    both = [n.copy() for n in noise]
+    mann_colour(*both, k1, k2, k3, ALPHA_EPSILON, LENGTH, GAMMA, 2.0, *table)
+    both = np.stack(both)
+    for j in range(k2.size):
+        single = [np.ascontiguousarray(n[:, j:j + 1]) for n in noise]
+        mann_colour(*single, k1, k2[j:j + 1], k3, ALPHA_EPSILON, LENGTH, GAMMA, 2.0, *table)
+        np.testing.assert_array_equal(np.stack(single)[:, :, 0], both[:, :, j])
+
+
+def test_window_parts_add_up_to_the_window_in_the_spectra_memory():
+    # the parts' fields sum to mann_box_window's field bit for bit (it is their sum), each
+    # part's field lies in that part's half spectra where a slab's field fits there
+    grid = tb.BoxGrid(shape=(48, 14, 13), spacing=(4.2, 4.2, 4.2))
+    whole = tb.mann_box_window(grid, ALPHA_EPSILON, LENGTH, GAMMA, np.random.default_rng(3),
+                               ((2, 11), (3, 9)), 2, slab_cells=100).velocity
+    total = np.zeros_like(whole)
+    for part in tb.mann_box_window_parts(grid, ALPHA_EPSILON, LENGTH, GAMMA,
+                                         np.random.default_rng(3), ((2, 11), (3, 9)), 2,
+                                         slab_cells=100):
+        # 9 x 6 window values per (x, part of 4 or 3 z wavenumbers x 14 y): it fits
+        assert part.velocity.base is not None and part.velocity[0].flags.c_contiguous
+        total += part.velocity
+    np.testing.assert_array_equal(total, whole)

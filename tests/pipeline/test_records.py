@@ -177,6 +177,37 @@ def test_a_reused_unit_record_is_the_one_drawn_again():
         np.testing.assert_array_equal(one, three)
 
 
+def test_a_record_sampled_part_by_part_is_its_whole_box_sampled(monkeypatch):
+    # the record's box in 3 parts of its half spectra (RECORD_SPECTRA_BYTES lowered), each
+    # part's field sampled and the samples summed: the whole window box sampled, to the
+    # rounding of a sum of 3 parts (1e-13 of the largest value: ~1e-16 per operation,
+    # a margin of ~100), with the moving beams' (at rest) and the reference's samples
+    from uq.pipeline import records
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
+    from uq.physics import turbulencesampling as ts
+    from uq.physics.turbulencebox import box_for
+    settings = load_scenario(SMALL).settings
+    geometry, n_scans = scan_geometry(settings), scans_per_record(settings)
+    grid = box_for(geometry, settings["turbulence"]["length_scale"], "mann")
+    half_spectra = 3 * grid.shape[0] * grid.shape[1] * (grid.shape[2] // 2 + 1) * 16
+    monkeypatch.setattr(records, "RECORD_SPECTRA_BYTES", half_spectra // 3 + 1)
+    parts, _ = records.unit_box_parts(settings, geometry, records.record_generator(7, 0))
+    assert len(list(parts)) == 3
+    rng = records.record_generator(7, 0)
+    drawn = records._draw_unit_record(settings, geometry, n_scans, rng, {}, 0.0, True)
+    box, kept = records.unit_box(settings, geometry, records.record_generator(7, 0))
+    whole = (ts.record_radial_velocities(box, geometry, n_scans),
+             ts.reference_series(box, geometry.speed, ts.scan_times(geometry, n_scans)))
+    for part_sum, sampled in zip((drawn.radial, drawn.reference, drawn.at_rest),
+                                 whole + whole[:1]):
+        assert np.max(np.abs(part_sum - sampled)) <= 1e-13 * np.max(np.abs(sampled))
+    assert drawn.kept == kept
+    again = records.record_generator(7, 0)
+    records.unit_box(settings, geometry, again)
+    assert drawn.state == again.bit_generator.state        # where one draw leaves it
+
+
 def test_the_field_scales_with_the_intensity():
     # Mann's field is linear in sqrt(alpha eps^(2/3)), which goes as the intensity: a
     # record at twice the intensity (the same unit box, reused) has twice the field's u'

@@ -70,6 +70,59 @@ def _trilinear_dot(u, v, w, x, y, z, d0, d1, d2):
                 total += (wi * wj * wm) * value
     return total
 
+@njit(cache=True)
+def _k2_partners(k2):
+    """Per k2 index: the index of its negative, where a later one holds it exactly
+    (computed with it); -2 where an earlier one holds its negative (skipped); else -1."""
+    n = k2.size
+    partner = np.full(n, -1, dtype=np.int64)
+    for j in range(n):
+        if partner[j] != -1 or k2[j] == 0.0:
+            continue
+        for other in range(j + 1, n):
+            if partner[other] == -1 and k2[other] == -k2[j]:
+                partner[j], partner[other] = other, -2
+                break
+    return partner
+
+
+@njit(cache=True)
+def _factor_scalars(a, b, c, ksq, energy_scale, length_scale, anisotropy, table_start,
+                    table_step, table_values):
+    """The scalars of C(k) at k = (a, b, c) [rad m-1], ``ksq`` = |k|^2 > 0
+    (``energy_scale`` = alpha eps^(2/3) L^(5/3) [m3 s-2]): beta [1],
+    k30 [rad m-1], zeta_1, zeta_2, the amplitude sqrt(E(k0) / (4 pi)) / k0^2 and the
+    ratio k0^2 / k^2 (Mann 1994 Sec. 3.2-3.3 [1])."""
+    n_nodes = table_values.size
+    # eddy lifetime: log-log table and its asymptotes (turbulencebox)
+    position = (math.log(math.sqrt(ksq) * length_scale) - table_start) / table_step
+    inside = min(max(position, 0.0), n_nodes - 1.0)
+    index = min(max(int(math.floor(inside)), 0), n_nodes - 2)
+    frac = inside - index
+    log_beta = (1.0 - frac) * table_values[index] + frac * table_values[index + 1]
+    log_beta -= min(position, 0.0) * table_step
+    log_beta -= (2.0 / 3.0) * max(position - (n_nodes - 1.0), 0.0) * table_step
+    beta = anisotropy * math.exp(log_beta)
+    k30 = c + beta * a                        # k at the start of the distortion [1]
+    k0sq = a * a + b * b + k30 * k30
+    z1, z2 = _zetas(a, b, c, k30, k0sq, ksq, beta)
+    kl = math.sqrt(k0sq) * length_scale
+    energy = energy_scale * kl ** 4 / (1.0 + kl ** 2) ** VON_KARMAN_EXPONENT  # von Karman [1]
+    return beta, k30, z1, z2, math.sqrt(energy / FOUR_PI) / k0sq, k0sq / ksq
+
+
+@njit(cache=True)
+def _colour_cell(n0, n1, n2, i, j, m, a, b, k30, z1, z2, ratio, factor):
+    """``n[:, i, j, m] <- factor C(k) n[:, i, j, m]`` from the factor's scalars."""
+    x0, x1, x2 = n0[i, j, m], n1[i, j, m], n2[i, j, m]
+    u0 = (b * z1) * x0 + (k30 - a * z1) * x1 + (-b) * x2     # C(k), Sec. 3 [2]
+    u1 = (-k30 + b * z2) * x0 + (-a * z2) * x1 + a * x2
+    u2 = (ratio * b) * x0 + (-ratio * a) * x1
+    n0[i, j, m] = factor * u0
+    n1[i, j, m] = factor * u1
+    n2[i, j, m] = factor * u2
+
+
 _COLOUR_SIGNATURE = ("void(complex128[:, :, ::1], complex128[:, :, ::1], "
                      "complex128[:, :, ::1], float64[::1], float64[::1], float64[::1], "
                      "float64, float64, float64, float64, float64, float64, float64[::1])")
@@ -82,6 +135,11 @@ def mann_colour(n0, n1, n2, k1, k2, k3, alpha_epsilon, length_scale, anisotropy,
     Sec. 3 [2]), with ``C`` of :func:`uq.physics.turbulencebox.mann1998_spectral_factor`
     (eddy lifetime from its table, the k1 = 0 and k1 = k2 = 0 limits of the zetas, zero
     at k = 0).
+
+    The factor's scalars (the eddy lifetime, the zetas, the amplitude) are even in k2
+    but for zeta_2, which is odd: they are computed once for a k2 and its negative
+    where the slab has both (:func:`_k2_partners`), bit for bit what the other would
+    compute (only signs differ, and a sign is exact in IEEE arithmetic).
 
     Parameters
     ----------
@@ -97,12 +155,13 @@ def mann_colour(n0, n1, n2, k1, k2, k3, alpha_epsilon, length_scale, anisotropy,
         The eddy lifetime's table: first node and step of log(kL), log(beta / Gamma) at
         the nodes.
     """
-    n_nodes = table_values.size
-    exponent = VON_KARMAN_EXPONENT
+    partner = _k2_partners(k2)
     energy_scale = alpha_epsilon * length_scale ** (5.0 / 3.0)
     for i in range(n0.shape[0]):
         a = k1[i]
         for j in range(n0.shape[1]):
+            if partner[j] == -2:                    # done with its partner
+                continue
             b = k2[j]
             for m in range(n0.shape[2]):
                 c = k3[m]
@@ -112,30 +171,14 @@ def mann_colour(n0, n1, n2, k1, k2, k3, alpha_epsilon, length_scale, anisotropy,
                     n1[i, j, m] = 0.0
                     n2[i, j, m] = 0.0
                     continue
-                # eddy lifetime: log-log table and its asymptotes (turbulencebox)
-                position = (math.log(math.sqrt(ksq) * length_scale) - table_start) / table_step
-                inside = min(max(position, 0.0), n_nodes - 1.0)
-                index = min(max(int(math.floor(inside)), 0), n_nodes - 2)
-                frac = inside - index
-                log_beta = (1.0 - frac) * table_values[index] + frac * table_values[index + 1]
-                log_beta -= min(position, 0.0) * table_step
-                log_beta -= (2.0 / 3.0) * max(position - (n_nodes - 1.0), 0.0) * table_step
-                beta = anisotropy * math.exp(log_beta)
-                k30 = c + beta * a                    # k at the start of the distortion [1]
-                k0sq = a * a + b * b + k30 * k30
-                z1, z2 = _zetas(a, b, c, k30, k0sq, ksq, beta)
-                kl = math.sqrt(k0sq) * length_scale
-                energy = energy_scale * kl ** 4 / (1.0 + kl ** 2) ** exponent   # von Karman [1]
-                amplitude = math.sqrt(energy / FOUR_PI) / k0sq
-                ratio = k0sq / ksq
-                x0, x1, x2 = n0[i, j, m], n1[i, j, m], n2[i, j, m]
-                u0 = (b * z1) * x0 + (k30 - a * z1) * x1 + (-b) * x2     # C(k), Sec. 3 [2]
-                u1 = (-k30 + b * z2) * x0 + (-a * z2) * x1 + a * x2
-                u2 = (ratio * b) * x0 + (-ratio * a) * x1
+                beta, k30, z1, z2, amplitude, ratio = _factor_scalars(
+                    a, b, c, ksq, energy_scale, length_scale, anisotropy, table_start,
+                    table_step, table_values)
                 factor = 1j * scale * amplitude
-                n0[i, j, m] = factor * u0
-                n1[i, j, m] = factor * u1
-                n2[i, j, m] = factor * u2
+                _colour_cell(n0, n1, n2, i, j, m, a, b, k30, z1, z2, ratio, factor)
+                if partner[j] >= 0:                 # -b: z2 odd, the rest even
+                    _colour_cell(n0, n1, n2, i, partner[j], m, a, -b, k30, z1, -z2, ratio,
+                                 factor)
 
 
 _SAMPLE_SIGNATURE = ("int64(float64[:, :, ::1], float64[:, :, ::1], float64[:, :, ::1], "
