@@ -394,6 +394,36 @@ def _unit_key(settings, geometry, n_scans, rng, moving, margin, at_rest):
             digest.hexdigest())
 
 
+def draw_first_records(scenario, fields, seed, spectra_of=None):
+    """Draw the unit records (:func:`unit_record`) of the chunk's first scene with wind
+    now, as :func:`record_variables` (same arguments) will draw them, into the
+    unit-record cache where its records' loop finds them: called before the chunk's
+    per-scan Monte Carlo, so that the boxes are made before that compiles its kernels
+    (numba keeps ~170 MB of what it compiled: a box made after it peaks that much
+    higher). Results do not depend on it (a record is the same whenever it is drawn).
+    Stops once the records drawn hold half of :data:`~uq.constants.
+    UNIT_RECORD_CACHE_BYTES` (none is dropped before use); draws nothing where the
+    run has no records (``sampling.method`` none, no scene with wind)."""
+    if scenario.sampling["method"] == "none":
+        return
+    scenes = [s for s in scene_settings(scenario, fields) if s["wind"]["speed"] > 0]
+    if not scenes:
+        return
+    settings = scenes[0]
+    geometry, n_scans = scan_geometry(settings), scans_per_record(settings)
+    axis = spectrum_axis(spectra_of) if spectra_of else None
+    spectra = axis is not None and RecordSpectra(axis, 1, 1).fits(geometry.scan_period,
+                                                                  n_scans)
+    held = 0
+    for record in range(settings["record"]["count"]):
+        if held >= UNIT_RECORD_CACHE_BYTES // 2:
+            return
+        rng = record_generator(seed, record)
+        scene, phases, moving, margin = record_motion(settings, geometry, n_scans, rng)
+        held += unit_record(settings, geometry, n_scans, rng, moving, margin,
+                            at_rest=spectra and phases is not None).nbytes
+
+
 def _keep(key, record):
     """Keep a unit record, dropping the least recently used beyond the byte limit."""
     with _UNIT_RECORDS_LOCK:
@@ -459,10 +489,7 @@ def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True, spectra=
     record spectra are taken of (:func:`record_spectra_series`).
     """
     from uq.physics.measurement import measurement_model
-    from uq.pipeline.modelsetup import scene_from_settings
-    scene = probe_volume_resolved(scene_from_settings(settings))
-    scene, phases = coherent_phases(scene, n_scans, geometry.scan_period, rng)
-    moving, margin = moving_probes(settings, scene, phases, geometry)
+    scene, phases, moving, margin = record_motion(settings, geometry, n_scans, rng)
     unit = unit_record(settings, geometry, n_scans, rng, moving, margin,
                        at_rest=spectra is not None and phases is not None)
     scale = field_scale(settings)
@@ -478,6 +505,17 @@ def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True, spectra=
         found += (record_spectra_series(settings, scene, errors, unit, scale, n_scans,
                                         spectra, compiled),)
     return found
+
+
+def record_motion(settings, geometry, n_scans, rng):
+    """What a record's box and its sampling depend on besides the field: the scene (its
+    probe resolved), the record's coherent motion phases (:func:`coherent_phases`, drawn
+    from `rng`), and :func:`moving_probes`' keyword arguments and margin [m]."""
+    from uq.pipeline.modelsetup import scene_from_settings
+    scene = probe_volume_resolved(scene_from_settings(settings))
+    scene, phases = coherent_phases(scene, n_scans, geometry.scan_period, rng)
+    moving, margin = moving_probes(settings, scene, phases, geometry)
+    return scene, phases, moving, margin
 
 
 def record_spectra_series(settings, scene, errors, unit, scale, n_scans, rng, compiled):

@@ -135,6 +135,10 @@ def run_chunk(scenario, plan, chunk, seed, compiled=True):
         scenario = scenario.with_values(group_assignments(scenario, plan, chunk.group))
     base = scene_from_settings(scenario.settings)
     fields = vector_fields(scenario, plan, chunk) or {"wind_speed": np.array([base.wind_speed])}
+    if "turbulence" in scenario.settings and "wind_speed" in model_outputs(scenario.outputs):
+        # record mode: the records' boxes before the per-scan kernels compile (memory)
+        records.draw_first_records(scenario, records.chunk_fields(scenario, plan, chunk),
+                                   seed, spectra_of)
     dataset = run_scene(scenario, batch_scene(base, fields), seed, compiled)
     if "turbulence" in scenario.settings and "wind_speed_true" in dataset:
         # record mode: the spectral path per scene
