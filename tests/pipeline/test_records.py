@@ -208,6 +208,23 @@ def test_a_record_sampled_part_by_part_is_its_whole_box_sampled(monkeypatch):
     assert drawn.state == again.bit_generator.state        # where one draw leaves it
 
 
+def test_a_chunk_draws_its_boxes_before_its_scans_and_each_once(monkeypatch):
+    # draw_first_records draws the first scene's records before the per-scan Monte Carlo
+    # (so that its kernels compile after the boxes: memory), and the records' loop then
+    # reuses them: each of the 3 records' boxes is drawn once for the sweep's 2 scenes
+    from uq.pipeline import records, runner
+    drawn, seen = [], []
+    draw, scans = records._draw_unit_record, runner.run_scene
+    monkeypatch.setattr(records, "_draw_unit_record",
+                        lambda *a, **k: drawn.append(1) or draw(*a, **k))
+    monkeypatch.setattr(runner, "run_scene",
+                        lambda *a, **k: seen.append(len(drawn)) or scans(*a, **k))
+    records._UNIT_RECORDS.clear()
+    run({**SMALL, "sweep": {"turbulence.intensity": [0.05, 0.1]}})
+    records._UNIT_RECORDS.clear()
+    assert seen and set(seen) == {3} and len(drawn) == 3      # (a chunk per scene or one)
+
+
 def test_the_field_scales_with_the_intensity():
     # Mann's field is linear in sqrt(alpha eps^(2/3)), which goes as the intensity: a
     # record at twice the intensity (the same unit box, reused) has twice the field's u'

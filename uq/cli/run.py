@@ -114,17 +114,26 @@ def load_kernels(args, scenario):
     statistics', and the static model's geometry (real arithmetic; the complex kernels
     load when a GUM grid of many scenes first calls them) or the time-resolved model's.
     The wind kernel (scan-wise or point-wise) loads when first called. The first run after an install compiles them into numba's cache; the
-    command's :class:`~uq.cli.compiling.CompileNotice` says so, kernel by kernel."""
+    command's :class:`~uq.cli.compiling.CompileNotice` says so, kernel by kernel. A run
+    that draws turbulence records loads the model's kernels when first called, after its
+    records' boxes are drawn (:func:`uq.pipeline.records.draw_first_records`): numba
+    keeps ~100-170 MB of what it compiles, which a box drawn after it would add to."""
     from uq.pipeline import motionsection
     import uq.engine.statkernels  # noqa: F401  (numba compiles or loads on import)
-    if getattr(args, "model", "compiled") == "numpy":
-        return                                    # no model kernel is called
+    if getattr(args, "model", "compiled") == "numpy" or draws_records(scenario):
+        return                                    # no model kernel is called (yet)
     if motionsection.is_time_resolved(scenario.settings):   # the static model unused
         import uq.physics.fusedmotionkernels  # noqa: F401
         return
     from uq.physics import fusedkernels
     for name in ("ins_trig", "geometry"):         # the complex kernels: a large GUM grid's
         fusedkernels.compiled(float)[name]
+
+
+def draws_records(scenario):
+    """Whether a run of `scenario` draws Monte Carlo turbulence records (record mode
+    with ``sampling.method`` other than none)."""
+    return "turbulence" in scenario.settings and scenario.sampling["method"] != "none"
 
 
 def check_scale_out(args):
