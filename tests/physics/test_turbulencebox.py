@@ -392,3 +392,16 @@ def test_a_too_small_box_loses_variance():
     grid = tb.box_for(_dbs(), 33.6)
     scaled = tb.BoxGrid(grid.shape, tuple(np.array(grid.spacing) / 33.6))
     assert np.all(tb.box_variance(scaled, 1.0, 1.0, GAMMA)[:3] > 0.8 * total[:3])
+
+
+def test_one_von_karman_energy_spectrum():
+    # the box's energy spectrum is the spectral path's (one implementation), bit for bit,
+    # on numpy arrays; and E(k) -> alpha eps^(2/3) L^(5/3) (kL)^4 as kL -> 0 (Sec. 3 [1]):
+    # at kL = 1e-4 the correction (1 + (kL)^2)^(-17/6) is 1 - 2.8e-8
+    from uq.physics.spectraltensor import von_karman_energy
+    k = np.geomspace(1e-4, 10.0, 50)
+    np.testing.assert_array_equal(tb.von_karman_energy_spectrum(k, 0.05, 33.6),
+                                  von_karman_energy(k, 33.6, 0.05))
+    small = 1e-4 / 33.6
+    assert tb.von_karman_energy_spectrum(small, 0.05, 33.6) == pytest.approx(
+        0.05 * 33.6 ** (5.0 / 3.0) * 1e-16, rel=1e-7)

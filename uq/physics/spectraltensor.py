@@ -62,7 +62,8 @@ from uq.constants import (IEC_COHERENCE_DECREMENT, IEC_COHERENCE_LENGTH_FACTOR,
                           IEC_KAIMAL_SIGMA_RATIOS, MANN_ANISOTROPY, MANN_LENGTH_FACTOR,
                           IEC_SCALE_HEIGHT, IEC_SCALE_PARAMETER, IEC_SCALE_SLOPE,
                           SPECTRAL_ANGLE_NODES, SPECTRAL_K1_PER_DECADE, SPECTRAL_K_DECADES,
-                          SPECTRAL_RADIUS_DECADES, SPECTRAL_RADIUS_PER_DECADE)
+                          SPECTRAL_RADIUS_DECADES, SPECTRAL_RADIUS_PER_DECADE,
+                          VON_KARMAN_EXPONENT)
 
 #: Models of the ``turbulence`` section.
 TURBULENCE_MODELS = ("mann", "kaimal")
@@ -83,19 +84,21 @@ def iec_mann_parameters(height):
 
 
 def von_karman_energy(k, length_scale, alpha_epsilon=1.0):
-    """Von Karman energy spectrum E(k) [m3 s-2], Eq. (1) (Eq. 2.6 of [1]).
+    """Von Karman energy spectrum E(k) [m3 s-2], Eq. (1) (Eq. 2.6 of [1]): the one
+    implementation (:func:`uq.physics.turbulencebox.von_karman_energy_spectrum` calls it).
 
     Parameters
     ----------
-    k : array_like
+    k : array_like, or an array of any namespace (numpy, CuPy)
         Wavenumber magnitude [rad m-1].
     length_scale : float
         L [m].
     alpha_epsilon : float
         alpha eps^(2/3) [m^(4/3) s-2].
     """
-    kl = np.asarray(k, dtype=float) * length_scale
-    return alpha_epsilon * length_scale ** (5.0 / 3.0) * kl ** 4 / (1.0 + kl * kl) ** (17.0 / 6.0)
+    kl = (k if hasattr(k, "shape") else np.asarray(k, dtype=float)) * length_scale
+    return (alpha_epsilon * length_scale ** (5.0 / 3.0) * kl ** 4
+            / (1.0 + kl * kl) ** VON_KARMAN_EXPONENT)               # Eq. 2.6 [1]
 
 
 def isotropic_variance_factor():

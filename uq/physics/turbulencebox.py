@@ -27,7 +27,8 @@ item 7 asks for, so the generator is written here in ~100 lines against the nump
 CuPy mirrors (``xp``): the same algorithm as both (Mann 1998 [2], Sec. 3), and its
 spectral factor is written from the paper, independently of the spectral path's tensor, so
 that ``C C^T = Phi`` cross-checks the two (only the exact eddy lifetime, which the table
-below interpolates, and the Kaimal spectra and coherence are the spectral path's own). The same box here: 1.3 s CPU, 0.6 GB peak
+below interpolates, the von Karman energy spectrum and the Kaimal spectra and coherence are the
+spectral path's own). The same box here: 1.3 s CPU, 0.6 GB peak
 (numpy, scipy.fft on one thread); a ten-minute record: :mod:`uq.bench.turbulence`. The
 GPU path (CuPy) is written but was not timed (no GPU in the session that wrote it).
 
@@ -90,7 +91,7 @@ import numpy as np
 import scipy.fft
 
 from uq import constants
-from uq.physics.spectraltensor import KaimalSpectra, mann_eddy_lifetime
+from uq.physics.spectraltensor import KaimalSpectra, mann_eddy_lifetime, von_karman_energy
 
 
 def array_namespace(device="cpu"):
@@ -195,9 +196,7 @@ def von_karman_energy_spectrum(k, alpha_epsilon, length_scale):
     length_scale : float
         L [m].
     """
-    kl = k * length_scale
-    return (alpha_epsilon * length_scale ** (5.0 / 3.0) * kl**4
-            / (1.0 + kl**2) ** constants.VON_KARMAN_EXPONENT)      # von Karman, Sec. 3 [1]
+    return von_karman_energy(k, length_scale, alpha_epsilon)       # von Karman, Sec. 3 [1]
 
 
 def _lifetime_table():
