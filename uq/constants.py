@@ -521,6 +521,11 @@ RECORD_BOX_SLAB_CELLS = 2**18
 #: (two for the shipped scenarios) it stays below, at the cost of drawing the noise and
 #: taking its 2-D transforms once more per part (~0.8 s a box). Boxes do not depend on it.
 RECORD_SPECTRA_BYTES = 2**28
+#: Threads of scipy's FFTs of a record's box [1] (records.unit_box_parts): they share out
+#: independent 1-D transforms, so the box is the same bits on any number; 2 halve the
+#: transforms' wall time on an idle 2-core machine (the x transforms of a ten-minute box
+#: 0.19 -> 0.10 s), where a record-mode run's first run is measured (issue 26).
+RECORD_FFT_WORKERS = 2
 
 #: Cell averaging of the Mann tensor near the k1 axis (turbulencebox.cell_averaged_factors)
 #: [1]: cells with |k1| <= CELL_AVERAGE_K1 max(dk2, dk3), beyond which the tensor varies

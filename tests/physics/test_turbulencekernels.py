@@ -133,3 +133,16 @@ def test_window_parts_add_up_to_the_window_in_the_spectra_memory():
         assert part.velocity.base is not None and part.velocity[0].flags.c_contiguous
         total += part.velocity
     np.testing.assert_array_equal(total, whole)
+
+
+def test_a_windowed_box_is_the_same_bits_on_several_fft_threads():
+    # scipy's FFTs share independent 1-D transforms out among their threads: the record
+    # box on RECORD_FFT_WORKERS threads is the serial box, bit for bit (cold and warm runs,
+    # and machines of any core count, give the same records)
+    from uq.constants import RECORD_FFT_WORKERS
+    grid = tb.BoxGrid(shape=(64, 16, 14), spacing=(4.2, 4.2, 4.2))
+    boxes = [tb.mann_box_window(grid, ALPHA_EPSILON, LENGTH, GAMMA, np.random.default_rng(6),
+                                ((2, 13), (1, 12)), 2, slab_cells=300, workers=workers)
+             for workers in (None, RECORD_FFT_WORKERS, 3)]
+    for box in boxes[1:]:
+        np.testing.assert_array_equal(box.velocity, boxes[0].velocity)

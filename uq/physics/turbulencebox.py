@@ -506,7 +506,7 @@ def _mann_box_host(grid, alpha_epsilon, length_scale, anisotropy, rng, slab_cell
 
 
 def mann_box_window(grid, alpha_epsilon, length_scale, anisotropy, rng, window, parts=1,
-                    slab_cells=constants.BOX_SLAB_CELLS):
+                    slab_cells=constants.BOX_SLAB_CELLS, workers=None):
     """The field of :func:`mann_box` on a window of its (y, z) cells, in the memory of
     1 / `parts` of its half spectra (on the host): the sum of
     :func:`mann_box_window_parts`.
@@ -519,8 +519,9 @@ def mann_box_window(grid, alpha_epsilon, length_scale, anisotropy, rng, window, 
 
     Parameters
     ----------
-    grid, alpha_epsilon, length_scale, anisotropy, rng, slab_cells
-        As :func:`mann_box`.
+    grid, alpha_epsilon, length_scale, anisotropy, rng, slab_cells, workers
+        As :func:`mann_box` (scipy's FFTs on `workers` threads give the same bits: they
+        share out independent 1-D transforms).
     window : ((int, int), (int, int))
         The cells [j0, j1) along y and [m0, m1) along z kept (each at least 2 wide).
     parts : int
@@ -536,7 +537,7 @@ def mann_box_window(grid, alpha_epsilon, length_scale, anisotropy, rng, window, 
     """
     velocity = None
     for part in mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy, rng,
-                                      window, parts, slab_cells):
+                                      window, parts, slab_cells, workers):
         if velocity is None:
             velocity = np.zeros(part.velocity.shape)
         velocity += part.velocity
@@ -544,7 +545,7 @@ def mann_box_window(grid, alpha_epsilon, length_scale, anisotropy, rng, window, 
 
 
 def mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy, rng, window,
-                          parts=1, slab_cells=constants.BOX_SLAB_CELLS):
+                          parts=1, slab_cells=constants.BOX_SLAB_CELLS, workers=None):
     """The field of :func:`mann_box_window` as `parts` fields whose sum it is, one at a
     time (a generator): each part's field of the half spectrum's z wavenumbers
     [a, b) (parameters and the window's grid as :func:`mann_box_window`).
@@ -578,8 +579,8 @@ def mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy, rng, wi
         for c in range(3):
             for slab in slabs:          # C order: component, then x, y, z (white_noise)
                 noise = rng.standard_normal((slab.stop - slab.start, ny, nz))
-                spectra[c, slab] = scipy.fft.rfft2(noise)[..., a:b]
-            _in_place(scipy.fft.fft, spectra[c], None)
+                spectra[c, slab] = scipy.fft.rfft2(noise, workers=workers)[..., a:b]
+            _in_place(scipy.fft.fft, spectra[c], workers)
         here = (cells[:, 2] >= a) & (cells[:, 2] < b)
         index = (slice(None), cells[here, 0], cells[here, 1], cells[here, 2] - a)
         noise_cells = spectra[index]                                # (3, n): a copy
@@ -589,12 +590,13 @@ def mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy, rng, wi
         spectra[index] = scale * np.einsum("ijn,jn->in", factors[:, :, here], noise_cells)
         velocity = _part_field(spectra, (nx, wy, wz))
         for c in range(3):
-            _in_place(scipy.fft.ifft, spectra[c], None)
+            _in_place(scipy.fft.ifft, spectra[c], workers)
             for slab in slabs:
-                rows = scipy.fft.ifft(spectra[c, slab], axis=1)[:, j0:j1]
+                rows = scipy.fft.ifft(spectra[c, slab], axis=1, workers=workers)[:, j0:j1]
                 padded = np.zeros(rows.shape[:2] + (half,), dtype=complex)
                 padded[..., a:b] = rows
-                velocity[c, slab] = scipy.fft.irfft(padded, n=nz, axis=2)[..., m0:m1]
+                velocity[c, slab] = scipy.fft.irfft(padded, n=nz, axis=2,
+                                                    workers=workers)[..., m0:m1]
         yield TurbulenceBox(grid=window_grid, velocity=velocity)
         del spectra, velocity
 

@@ -43,7 +43,7 @@ from uq.physics.lidarspectral import lidar_variances, probe_transfer_for
 from uq.physics.spectraltensor import KaimalSpectra, mann_tensor_for_intensity
 from uq.pipeline import probesection
 from uq.constants import KAIMAL_LENGTH_FACTOR as LENGTH_FACTORS_KAIMAL
-from uq.constants import (RECORD_BOX_SLAB_CELLS, RECORD_SPECTRA_BYTES,
+from uq.constants import (RECORD_BOX_SLAB_CELLS, RECORD_FFT_WORKERS, RECORD_SPECTRA_BYTES,
                           UNIT_RECORD_CACHE_BYTES)
 from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
 
@@ -268,7 +268,7 @@ def unit_box_parts(settings, geometry, rng, motion_margin=0.0):
         return turbulencebox.mann_box_window_parts(
             grid, 1.0, turbulence["length_scale"], turbulence["anisotropy"], rng,
             turbulencebox.box_window(grid, points, motion_margin), parts,
-            slab_cells=RECORD_BOX_SLAB_CELLS), kept
+            slab_cells=RECORD_BOX_SLAB_CELLS, workers=RECORD_FFT_WORKERS), kept
     scale = turbulence["length_scale"] / LENGTH_FACTORS_KAIMAL
     grid = turbulencebox.box_for(geometry, scale, "kaimal", motion_margin=motion_margin)
     return [turbulencebox.kaimal_box(grid, 1.0, speed, scale, rng)], np.nan
