@@ -143,19 +143,17 @@ def scene_settings(scenario, fields):
     return out
 
 
-def record_variables(scenario, fields, dataset, seed=0, compiled=True, spectra_of=None):
+def record_variables(scenario, fields, dataset, seed=0, compiled=True, spectra_of=None,
+                     prepared=None):
     """The record-mode variables of a chunk's scenes (dimension ``scene``, and ``range``):
     `fields` as :func:`scene_settings`; `dataset` the chunk's per-scan results; the
     Monte Carlo records (unless ``sampling.method`` is ``none``) from `seed`; with
     `spectra_of` (the validated settings of the run's file, the same for every chunk)
-    also the records' spectra on its frequencies (:data:`SPECTRA_ATTRIBUTES`)."""
+    also the records' spectra on its frequencies (:data:`SPECTRA_ATTRIBUTES`);
+    `prepared`: :func:`prepare_records` of the same arguments (else done here)."""
     scenes = scene_settings(scenario, fields)
     n_gates = len(scenario.settings["lidar"]["ranges"])
-    lidar, true = np.full((len(scenes), n_gates), np.nan), np.full(len(scenes), np.nan)
-    for i, settings in enumerate(scenes):
-        if settings["wind"]["speed"] > 0:        # no frozen field without a mean wind: NaN
-            variances = spectral_variances(settings)[0]
-            lidar[i], true[i] = variances.lidar[:, 0], variances.true[0]
+    lidar, true = prepared if prepared is not None else scene_spectral_paths(scenes, n_gates)
     speeds = np.array([s["wind"]["speed"] for s in scenes])
     truth = dataset["wind_speed_true"].values.reshape(len(scenes), n_gates)
     u_scan = _scan_uncertainty(dataset).reshape(len(scenes), n_gates)
@@ -173,6 +171,29 @@ def record_variables(scenario, fields, dataset, seed=0, compiled=True, spectra_o
             spectrum_axis(spectra_of) if spectra_of else None,
             bool(spectra_of and spectra_of.get("motion"))))
     return out
+
+
+def prepare_records(scenario, fields, seed, spectra_of=None):
+    """What :func:`record_variables` (same arguments) computes before the chunk's
+    per-scan Monte Carlo: the first scene's record boxes (:func:`draw_first_records`)
+    and every scene's spectral path (:func:`scene_spectral_paths`), returned, so that
+    neither adds its memory to what numba keeps of the kernels that the per-scan run
+    compiles (~100-170 MB); the same numbers whenever computed."""
+    draw_first_records(scenario, fields, seed, spectra_of)
+    return scene_spectral_paths(scene_settings(scenario, fields),
+                                len(scenario.settings["lidar"]["ranges"]))
+
+
+def scene_spectral_paths(scenes, n_gates):
+    """The spectral path of each scene's settings (:func:`spectral_variances`): the
+    lidar's filtered u-variance per gate (n_scenes, n_gates) and the field's at the
+    reference point (n_scenes,) [m2 s-2]; NaN without a mean wind (no frozen field)."""
+    lidar, true = np.full((len(scenes), n_gates), np.nan), np.full(len(scenes), np.nan)
+    for i, settings in enumerate(scenes):
+        if settings["wind"]["speed"] > 0:
+            variances = spectral_variances(settings)[0]
+            lidar[i], true[i] = variances.lidar[:, 0], variances.true[0]
+    return lidar, true
 
 
 def _scan_uncertainty(dataset):

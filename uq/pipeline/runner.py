@@ -135,16 +135,18 @@ def run_chunk(scenario, plan, chunk, seed, compiled=True):
         scenario = scenario.with_values(group_assignments(scenario, plan, chunk.group))
     base = scene_from_settings(scenario.settings)
     fields = vector_fields(scenario, plan, chunk) or {"wind_speed": np.array([base.wind_speed])}
+    prepared = None
     if "turbulence" in scenario.settings and "wind_speed" in model_outputs(scenario.outputs):
-        # record mode: the records' boxes before the per-scan kernels compile (memory)
-        records.draw_first_records(scenario, records.chunk_fields(scenario, plan, chunk),
-                                   seed, spectra_of)
+        # record mode: the spectral path and the records' boxes before the per-scan
+        # kernels compile (memory: numba keeps what it compiled)
+        prepared = records.prepare_records(scenario, records.chunk_fields(scenario, plan, chunk),
+                                           seed, spectra_of)
     dataset = run_scene(scenario, batch_scene(base, fields), seed, compiled)
     if "turbulence" in scenario.settings and "wind_speed_true" in dataset:
         # record mode: the spectral path per scene
         dataset = dataset.assign(records.record_variables(
             scenario, records.chunk_fields(scenario, plan, chunk), dataset, seed, compiled,
-            spectra_of))
+            spectra_of, prepared))
     return dataset
 
 
