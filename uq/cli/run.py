@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from uq.cli.common import EXIT_OK, EXIT_TERMINATED, interrupted_status, parse_overrides, say
+from uq.cli.sidecompile import side_compile
 from uq.errors import OutputError, ScenarioError
 
 
@@ -73,13 +74,17 @@ def command(args):
     compiling = getattr(args, "compile_notice", None)
     load_kernels(args, scenario)
     before_run = compiling.seconds if compiling else 0.0     # compiled before the run
-    progress = None if args.quiet else ProgressBar()
     new_folders = missing_folders(output.parent)
     checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume).acquire()
+    beside = side_compile(args, scenario)
+    if beside:
+        say(args, "uq: compiling the model's kernels in a second process while the "
+            "turbulence boxes are drawn (once after an install)")
+    progress = None if args.quiet else ProgressBar()
     try:
         with dask_client(args) as client:
             dataset = run(scenario, progress=progress, client=client, checkpoint=checkpoint,
-                          model=args.model)
+                          model=args.model, kernels_ready=beside.wait if beside else None)
         dataset.attrs["runtime_s"] += before_run  # the user's wait, compiles included
         write_netcdf(dataset, output)
         checkpoint.clear()                   # still locked: no other run can be in it
@@ -103,8 +108,11 @@ def command(args):
             remove_if_empty(new_folders)
         raise
     finally:
+        if beside:
+            beside.stop()
         checkpoint.release()
-    say(args, summary_table(dataset, compile_s=compiling.seconds if compiling else 0.0))
+    compile_s = (compiling.seconds if compiling else 0.0) + (beside.waited if beside else 0.0)
+    say(args, summary_table(dataset, compile_s=compile_s))
     say(args, f"wrote {output}")
     return EXIT_OK
 
@@ -115,13 +123,17 @@ def load_kernels(args, scenario):
     load when a GUM grid of many scenes first calls them) or the time-resolved model's.
     The wind kernel (scan-wise or point-wise) loads when first called. The first run after an install compiles them into numba's cache; the
     command's :class:`~uq.cli.compiling.CompileNotice` says so, kernel by kernel. A run
-    that draws turbulence records loads the model's kernels when first called, after its
+    that draws turbulence records loads every kernel when first called, after its
     records' boxes are drawn (:func:`uq.pipeline.records.draw_first_records`): numba
-    keeps ~100-170 MB of what it compiles, which a box drawn after it would add to."""
+    keeps ~100-170 MB of what it compiles, which a box drawn after it would add to; on a
+    cold cache a second process compiles them while the boxes are drawn
+    (:mod:`uq.cli.sidecompile`)."""
+    if draws_records(scenario):          # every kernel when first called (or beside:
+        return                           # :mod:`uq.cli.sidecompile`)
     from uq.pipeline import motionsection
     import uq.engine.statkernels  # noqa: F401  (numba compiles or loads on import)
-    if getattr(args, "model", "compiled") == "numpy" or draws_records(scenario):
-        return                                    # no model kernel is called (yet)
+    if getattr(args, "model", "compiled") == "numpy":
+        return                                    # no model kernel is called
     if motionsection.is_time_resolved(scenario.settings):   # the static model unused
         import uq.physics.fusedmotionkernels  # noqa: F401
         return

@@ -8,16 +8,26 @@ def add_parser(commands):
     warmup = commands.add_parser(
         "warmup", help="compile every kernel into numba's cache now (once after an "
         "install; for images and shared environments), so that no run compiles")
+    warmup.add_argument("--for", dest="scenario", metavar="SCENARIO",
+                        help="compile only what a run of this scenario (YAML file or "
+                        "shipped name) calls: its per-scan Monte Carlo, a few trials per "
+                        "scene, results discarded (its turbulence records are left out)")
+    warmup.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="with --for: override a scenario value, as in uq run")
     warmup.set_defaults(handler=command)
     return warmup
 
 
 def command(args):
     """Compile (or load, when already cached) every kernel of the static model in real
-    and complex arithmetic, the time-resolved model's and the statistics'."""
+    and complex arithmetic, the time-resolved model's and the statistics' (or, with
+    ``--for``, those a run of one scenario calls)."""
     import time
     started = time.perf_counter()
     import numba
+    if getattr(args, "scenario", None):
+        compile_for(args.scenario, getattr(args, "set", []))
+        return _said(args, started, numba)
     import uq.engine.statkernels  # noqa: F401  (explicit signatures: compiled on import)
     import uq.engine.passkernels  # noqa: F401  (the same: long runs' one-pass batches)
     from uq.physics import fusedmotionkernels  # (the same)
@@ -28,8 +38,48 @@ def command(args):
             if number is float or name not in fusedkernels.MOUNTED_KERNEL_NAMES:
                 fusedkernels.compiled(number)[name]
     fusedmotionkernels.compiled_mounted_wind()        # a tilted mount's, on first use
+    return _said(args, started, numba)
+
+
+def _said(args, started, numba):
+    """Say what was compiled and where it is kept; the exit status."""
+    import time
     compiling = getattr(args, "compile_notice", None)
     compiled = compiling.kernels if compiling else 0
     say(args, f"uq warmup: {compiled} kernel(s) compiled, the others loaded from the cache "
         f"({numba.config.CACHE_DIR or 'beside the code'}), {time.perf_counter() - started:.1f} s")
     return EXIT_OK
+
+
+def compile_for(scenario, overrides=()):
+    """Run `scenario` (a path, a shipped name or a mapping) with ``--set`` `overrides`
+    without its turbulence records (the ``turbulence`` and ``record`` sections and their
+    sweep keys), :data:`~uq.cli.sidecompile.SIDE_COMPILE_TRIALS` trials per scene, the
+    results discarded: numba compiles (or loads) every kernel of its per-scan Monte
+    Carlo, the GUM's and the statistics'. A record-mode run's own records then call the
+    same kernels (:mod:`uq.cli.sidecompile`)."""
+    import copy
+    import logging
+    from uq.cli.common import parse_overrides
+    from uq.cli.sidecompile import SIDE_COMPILE_TRIALS
+    from uq.pipeline.runner import run
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.shipped import scenario_path
+    if not isinstance(scenario, dict):
+        scenario = scenario_path(scenario)
+    settings = copy.deepcopy(load_scenario(scenario, parse_overrides(overrides)).settings)
+    for section in RECORD_SECTIONS:
+        settings.pop(section, None)
+    sweep = {key: values for key, values in (settings.pop("sweep", None) or {}).items()
+             if key.split(".")[0] not in RECORD_SECTIONS}
+    settings.update({"sweep": sweep} if sweep else {})
+    settings["sampling"] = {**settings["sampling"], "n": SIDE_COMPILE_TRIALS}
+    logging.disable(logging.WARNING)    # the stripped scenario's warnings are not the user's
+    try:
+        run(load_scenario(settings))
+    finally:
+        logging.disable(logging.NOTSET)
+
+
+#: The sections of record mode (:mod:`uq.pipeline.records`), left out by :func:`compile_for`.
+RECORD_SECTIONS = ("turbulence", "record")

@@ -42,7 +42,8 @@ from uq.pipeline.sweep import batch_scene, group_assignments, sweep_plan, vector
 MODEL_CHOICES = ("compiled", "numpy")
 
 
-def run(scenario, progress=None, *, client=None, checkpoint=None, model="compiled"):
+def run(scenario, progress=None, *, client=None, checkpoint=None, model="compiled",
+        kernels_ready=None):
     """Run a scenario and return its results.
 
     Parameters
@@ -59,6 +60,10 @@ def run(scenario, progress=None, *, client=None, checkpoint=None, model="compile
         ``compiled`` (default): the compiled model wherever it applies (else numpy, logged
         at ``-v``); ``numpy``: the numpy reference model throughout. Both give the same
         numbers to 1e-12 m/s (``tests/pipeline/test_model_switch.py``).
+    kernels_ready : callable, optional
+        Called with no argument before a chunk's model first runs, after its turbulence
+        records are drawn: ``uq run`` waits there for the kernels it has a second process
+        compile beside the boxes (:mod:`uq.cli.sidecompile`). Not called on a cluster.
 
     Returns
     -------
@@ -77,17 +82,19 @@ def run(scenario, progress=None, *, client=None, checkpoint=None, model="compile
         if checkpoint:
             checkpoint.start(scenario, seed, plan.chunks, model)
         results = _compute(scenario, plan, seed, progress, client, checkpoint,
-                           model == "compiled")
+                           model == "compiled", kernels_ready)
     dataset = _assemble(scenario, plan, results)
     dataset.attrs.update(_global_attributes(scenario, seed, dataset, started, model))
     return dataset
 
 
-def _compute(scenario, plan, seed, progress, client, checkpoint, compiled):
+def _compute(scenario, plan, seed, progress, client, checkpoint, compiled,
+             kernels_ready=None):
     """Results of every chunk, by index: from the checkpoint, else computed."""
     results = checkpoint.load() if checkpoint else {}
     todo = [chunk for chunk in plan.chunks if chunk.index not in results]
-    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed, compiled), None)
+    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed, compiled,
+                                        kernels_ready), None)
                 for chunk in todo) if client is None else \
         _distributed(client, scenario, plan, todo, seed, compiled,
                      checkpoint.digest if checkpoint else None)
@@ -127,9 +134,10 @@ def chunk_task(scenario, plan, chunk, seed, compiled=True, digest=None):
     return dataset, None if digest is None else encode_chunk(dataset, digest)
 
 
-def run_chunk(scenario, plan, chunk, seed, compiled=True):
+def run_chunk(scenario, plan, chunk, seed, compiled=True, kernels_ready=None):
     """Results of one chunk of scenes: a Dataset with a ``scene`` dimension (`compiled`:
-    the compiled model where it applies, else the numpy model throughout)."""
+    the compiled model where it applies, else the numpy model throughout;
+    `kernels_ready`: as :func:`run`'s)."""
     spectra_of = scenario.settings             # (the file's scene: the records' spectra)
     if plan.group_keys:
         scenario = scenario.with_values(group_assignments(scenario, plan, chunk.group))
@@ -141,6 +149,8 @@ def run_chunk(scenario, plan, chunk, seed, compiled=True):
         # kernels compile (memory: numba keeps what it compiled)
         prepared = records.prepare_records(scenario, records.chunk_fields(scenario, plan, chunk),
                                            seed, spectra_of)
+    if kernels_ready is not None:
+        kernels_ready()
     dataset = run_scene(scenario, batch_scene(base, fields), seed, compiled)
     if "turbulence" in scenario.settings and "wind_speed_true" in dataset:
         # record mode: the spectral path per scene

@@ -1,0 +1,138 @@
+"""Compile a record-mode run's kernels in a second process while this one draws the
+turbulence boxes (``uq run``, first run after an install).
+
+A record-mode run (a ``turbulence`` section with Monte Carlo records) spends its first
+~20 s drawing Mann boxes (numpy and scipy's FFT, :mod:`uq.pipeline.records`) and, on a
+cold numba cache, ~17-35 s compiling the measurement model's and the statistics'
+kernels, one after the other on one core. Here ``uq warmup --for`` (the same scenario
+without its records, a few trials per scene: every kernel its per-scan Monte Carlo calls,
+into numba's on-disk cache, :mod:`uq.cli.warmup`) runs in a child process on the second
+core while the boxes are drawn; the run waits for it (:meth:`SideCompile.wait`) before its
+model first runs (:func:`uq.pipeline.runner.run`'s `kernels_ready`) and then loads the
+kernels from the cache. The numbers never depend on it: the child only fills the cache
+(the same kernels, the same code; a cold and a warm run are bit-identical). Where the
+child fails, the run compiles as it would without it.
+
+Started only where it can help: the compiled model on this machine (no ``--workers`` or
+``--scheduler``: a cluster's workers compile for themselves), two or more usable cores,
+and a cache that does not hold the kernels yet (:func:`kernels_cached`).
+"""
+import logging
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import yaml
+
+#: Trials per scene of the child's run: the kernels' types, not their work, matter.
+SIDE_COMPILE_TRIALS = 64
+#: Seconds the run waits for the child to end after asking it to stop.
+SIDE_COMPILE_STOP_SECONDS = 5.0
+
+LOG = logging.getLogger(__name__)
+
+
+def usable_cores():
+    """The cores this process may run on [1]."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:                   # not on Linux
+        return os.cpu_count() or 1
+
+
+def kernels_cached():
+    """Whether numba's cache already holds the static wind kernel (the largest compile
+    of every record-mode run) for this source: its index file exists and its source
+    stamp is current (numba's own check). Unknown (numba's internals changed): False."""
+    try:
+        from numba.core.caching import FunctionCache
+        from uq.physics import fusedkernels
+        function = fusedkernels._KERNELS["wind_scan"][0]
+        return bool(FunctionCache(function)._cache_file._load_index())
+    except Exception:                        # noqa: BLE001 (an internal API: be safe)
+        return False
+
+
+def wanted(args, scenario):
+    """Whether ``uq run`` `args` of `scenario` should compile its kernels beside."""
+    from uq.cli.run import draws_records
+    return (draws_records(scenario) and getattr(args, "model", "compiled") == "compiled"
+            and getattr(args, "workers", None) is None
+            and getattr(args, "scheduler", None) is None
+            and usable_cores() >= 2 and not kernels_cached())
+
+
+class SideCompile:
+    """The child process of ``uq warmup --for`` a scenario (see the module docstring).
+
+    Parameters
+    ----------
+    settings : dict
+        The run's validated settings (written to a temporary file for the child).
+    stream : file or None
+        Where :meth:`wait` says how long the compile took (None: nothing is said). The
+        child itself prints nothing (``-q``): its lines would cut into the run's.
+
+    Attributes
+    ----------
+    waited : float
+        Wall time the run waited for the child [s] (part of the run's compile time).
+    """
+
+    def __init__(self, settings, stream):
+        handle, self.path = tempfile.mkstemp(prefix="uq-side-compile-", suffix=".yaml")
+        with os.fdopen(handle, "w") as file:
+            yaml.safe_dump(settings, file)
+        self.stream, self.waited = stream, 0.0
+        self.started = time.perf_counter()
+        command = [sys.executable, "-m", "uq.cli", "warmup", "--for", self.path, "-q"]
+        # its own session: Ctrl-C at the terminal reaches the run, which stops the child
+        self.child = subprocess.Popen(command, stdin=subprocess.DEVNULL,
+                                      start_new_session=True)
+
+    def wait(self):
+        """Wait for the child (called before the run's model first runs); True where
+        it filled the cache."""
+        if self.child is None:
+            return True
+        waiting = time.perf_counter()
+        status = self.child.wait()
+        self.waited = time.perf_counter() - waiting
+        self.child = None
+        self._remove_file()
+        if status != 0:
+            LOG.info("the kernels' compile beside the run ended with status %s: the run "
+                     "compiles them itself", status)
+        elif self.stream is not None:
+            print(f"uq: the model's kernels compiled beside the boxes in "
+                  f"{time.perf_counter() - self.started:.1f} s (the run waited "
+                  f"{self.waited:.1f} s for them)", file=self.stream, flush=True)
+        return status == 0
+
+    def stop(self):
+        """End the child if it still runs (the run failed or was stopped)."""
+        if self.child is not None and self.child.poll() is None:
+            self.child.terminate()
+            try:
+                self.child.wait(SIDE_COMPILE_STOP_SECONDS)
+            except subprocess.TimeoutExpired:
+                self.child.kill()
+                self.child.wait()
+        self.child = None
+        self._remove_file()
+
+    def _remove_file(self):
+        try:
+            os.unlink(self.path)
+        except FileNotFoundError:
+            pass
+
+
+def side_compile(args, scenario):
+    """A started :class:`SideCompile` for ``uq run`` `args` of `scenario`, or None."""
+    if not wanted(args, scenario):
+        return None
+    return SideCompile(scenario.settings, None if getattr(args, "quiet", False)
+                       else sys.stderr)
