@@ -143,10 +143,20 @@ def _mounted_layout(scene, outputs):
     MOUNTED_LAYOUT`), None for an upward lidar."""
     if scene.tilt == 0:
         return None
-    pair = None if scene.horizontal_only else nacelle.level_pair(scene.azimuths)
     upper_lower = nacelle.upper_lower(scene.azimuths) if "shear_exponent" in outputs else None
-    return np.array([*(pair or (-1, -1)), *(upper_lower or (-1, -1)),
-                     int("shear_exponent" in outputs)], dtype=np.int64)
+    return np.array([*(upper_lower or (-1, -1)), int("shear_exponent" in outputs)],
+                    dtype=np.int64)
+
+
+def _level_beams(scene):
+    """The beams of a tilted mount's horizontal solve (HEAD ``level_first``,
+    ``level_second``): its two beams, or the level pair (clock 90 and 270); (-1, -1)
+    for none and for an upward lidar."""
+    if scene.tilt == 0:
+        return -1, -1
+    if scene.horizontal_only:
+        return 0, 1
+    return nacelle.level_pair(scene.azimuths) or (-1, -1)
 
 
 #: Inputs of the truth (:func:`uq.physics.fusedmotionkernels.kinematics` and a probe's
@@ -312,6 +322,7 @@ def _scene_plan(scene):
             "has_arm": bool(np.any(arm != 0)), "probe": scene.probe is not None,
             "mounted": scene.tilt != 0, "tilt_cos": math.cos(scene.tilt),
             "tilt_sin": math.sin(scene.tilt)}
+    head["level_first"], head["level_second"] = _level_beams(scene)
     consts = np.array([head[name] if name in head else getattr(scene, name)
                        for name in kernels.HEAD], dtype=float)
     return Plan(consts=consts, pairs=np.array(pairs, dtype=np.int64).reshape(-1, 2),
@@ -363,7 +374,8 @@ def _reconstruction_inputs(errors, n):
 def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     """The outputs of one scene into `into` (name -> (n, gates) view), block by block
     (with a `probe` volume: its weighted speed, :mod:`uq.physics.fusedprobe`; a tilted
-    mount's `layout`: its reconstruction, :func:`~uq.physics.fusedmotionkernels.
+    mount's `layout`: its horizontal wind in :func:`~uq.physics.fusedmotionkernels.
+    reconstruct`, its shear exponent by :func:`~uq.physics.fusedmotionkernels.
     mounted_wind`); with `held` (inputs of the reconstruction alone -> scalar) the
     speed reconstructed from the same truth with those inputs replaced, into
     ``into["wind_speed_held"]``: with the reading shared (:func:`shares_reading`, an
@@ -373,7 +385,8 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     if layout is not None and layout[-1]:   # the shear exponent: the believed lift too
         consts = consts.copy()
         consts[kernels.HEAD.index("mounted")] = 2.0
-    mounted = kernels.compiled_mounted_wind() if layout is not None else None
+    # a tilted mount's shear exponent (its horizontal wind is reconstruct's): one pass
+    mounted = kernels.compiled_mounted_wind() if layout is not None and layout[-1] else None
     n_beams, n_gates = plan.slant.shape
     n_nodes = len(plan.weights)
     ins, has, noise = _reconstruction_inputs(errors, n)
@@ -425,9 +438,9 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
                             plan.read_table, plan.stamps, plan.beams, plan.operator,
                             plan.weights, ins, has, noise, start, count, work, c, turned,
                             states, parts, ratio, normal, out, held_noise, held_out)
-        if layout is not None:                      # a tilted mount's reconstruction
-            mounted(consts, layout, plan.beams, plan.slant, work, normal, count, out,
-                    shear_out if shear_out is not None else speed, speed, vertical)
+        if mounted is not None:                     # a tilted mount's shear exponent
+            mounted(consts, layout, plan.slant, normal, count, out, shear_out, speed,
+                    vertical)
         else:
             kernels.wind_speed(out, count, speed, vertical)
         stop = start + count
@@ -452,9 +465,9 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
                                 plan.read_table, plan.stamps, plan.beams, plan.operator,
                                 plan.weights, *second, start, count, work, c, turned,
                                 states, parts, ratio, normal, out, noise, _NO_HELD)
-            if layout is not None:                  # (the shear row is stored already)
-                mounted(consts, layout, plan.beams, plan.slant, work, normal, count, out,
-                        shear_out if shear_out is not None else speed, speed, vertical)
+            if mounted is not None:                 # (the shear row is stored already)
+                mounted(consts, layout, plan.slant, normal, count, out, speed, speed,
+                        vertical)
             else:
                 kernels.wind_speed(out, count, speed, vertical)
             into[HELD_WIND_SPEED][start:stop] = speed[:, :count].T

@@ -67,18 +67,21 @@ _ASIN = tuple(math.comb(2 * k, k) / (4 ** k * (2 * k + 1)) for k in range(26))
 _SINC = tuple((-1) ** k / math.factorial(2 * k + 1) for k in range(10))
 _COSC = tuple((-1) ** k / math.factorial(2 * k + 2) for k in range(10))
 
-#: The scene vector (:func:`uq.physics.fusedmotion.scene_plan`): these scalars by index.
+#: The scene vector (:func:`uq.physics.fusedmotion.scene_plan`): these scalars by index
+#: (``level_first``, ``level_second``: the beams of a tilted mount's horizontal solve, the
+#: two beams of a 2-beam mount or the level pair at clock 90 and 270; -1: none).
 HEAD = ("n_beams", "n_gates", "n_nodes", "n_slanted", "model", "ins_mode", "rate",
         "heading", "pitch", "roll", "lidar_height", "wind_speed", "reference_height", "shear",
         "to_north", "to_east", "vertical_wind", "ship_north", "ship_east", "ship_up",
         "level_cos", "level_sin", "course_cos", "course_sin", "arm_bow", "arm_starboard",
         "arm_up", "static_arm_up", "half_cone", "misalignment", "moves_yaw", "has_arm", "probe",
-        "mounted", "tilt_cos", "tilt_sin")
+        "mounted", "tilt_cos", "tilt_sin", "level_first", "level_second")
 (_N_BEAMS, _N_GATES, _N_NODES, _N_SLANTED, _MODEL, _INS_MODE, _RATE, _HEADING, _PITCH, _ROLL,
  _LIDAR_HEIGHT, _WIND_SPEED, _REFERENCE_HEIGHT, _SHEAR, _TO_NORTH, _TO_EAST, _VERTICAL_WIND,
  _SHIP_NORTH, _SHIP_EAST, _SHIP_UP, _LEVEL_COS, _LEVEL_SIN, _COURSE_COS, _COURSE_SIN,
  _ARM_BOW, _ARM_STARBOARD, _ARM_UP, _STATIC_ARM_UP, _HALF_CONE, _MISALIGNMENT, _MOVES_YAW,
- _HAS_ARM, _PROBE, _MOUNTED, _TILT_COS, _TILT_SIN) = range(len(HEAD))
+ _HAS_ARM, _PROBE, _MOUNTED, _TILT_COS, _TILT_SIN, _LEVEL_FIRST, _LEVEL_SECOND) = \
+    range(len(HEAD))
 
 #: Correction models: the codes NONE ... POINTWISE of
 #: :class:`uq.physics.modelinputs.Correction` (:mod:`uq.physics.kernelbase`); INS modes.
@@ -134,7 +137,7 @@ def _kernel(signature):
 def _head(consts):
     """The scalars of :data:`HEAD` as a tuple: values, not memory, so that loops reading
     them need no alias checks against the arrays they write."""
-    return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31], consts[32], consts[33], consts[34], consts[35])
+    return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31], consts[32], consts[33], consts[34], consts[35], consts[36], consts[37])
 
 
 @_called
@@ -790,21 +793,22 @@ def _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, sour
 @_helper
 def _store_reading(consts, state, work, normal, row, count, heading_varies, source):
     """A point-wise reading of a tilted mount into normal[row ..]: the believed beam
-    (rows _BEAM), the velocity along it (_ALONG) and, for the shear exponent's believed
-    heights alone (HEAD mounted 2), the lidar's lift ``[(R_read - R_static) r]_up``
+    (rows _BEAM; the velocity along it enters the corrected radial velocity that
+    :func:`reconstruct` keeps) and, for the shear exponent's believed heights alone
+    (HEAD mounted 2), the lidar's lift ``[(R_read - R_static) r]_up`` into row + 4
     through the lever arm r (:func:`uq.physics.timeresolved._lever_arm_lift`; 0 without
     one)."""
-    for j in range(count):                  # (a loop, not four slices: their views
+    for j in range(count):                  # (a loop, not three slices: their views
         normal[row, j] = work[_BEAM, j]     # cost more than the copy of a block)
         normal[row + 1, j] = work[_BEAM + 1, j]
         normal[row + 2, j] = work[_BEAM + 2, j]
-        normal[row + 3, j] = work[_ALONG, j]
     if consts[_MOUNTED] < 2:                # the lift is the shear's alone (HEAD mounted 2)
         return
     normal[row + 4, :count] = 0.0
     if consts[_HAS_ARM] > 0:
+        normal[row + 3, :count] = work[_ALONG, :count]        # (kept while the arm's
         _pointwise_rows(consts, state, work, consts[_ARM_BOW], consts[_ARM_STARBOARD],
-                        consts[_ARM_UP], count, heading_varies, source)
+                        consts[_ARM_UP], count, heading_varies, source)    # rows are made)
         for j in range(count):              # the reading's rotation of the arm
             normal[row + 4, j] = work[_BEAM + 2, j] - consts[_STATIC_ARM_UP]
         for i in range(3):                  # the beam's rows back for the least squares
@@ -843,6 +847,21 @@ def _substitute(normal, row, n_gates, count, out):
             out[0, g, j] = (y0 - l10 * x1 - l20 * x2) / l00
             out[1, g, j] = x1
             out[2, g, j] = x2
+
+
+@_helper
+def _substitute_vertical(normal, row, n_gates, count, out):
+    """out[2, g] of :func:`_substitute` alone (the same operations: bit for bit its up
+    component), where a tilted mount's level pair gives north and east."""
+    for g in range(n_gates):
+        first = row + 3 * g
+        for j in range(count):
+            l00, l10, l20 = normal[0, j], normal[1, j], normal[2, j]
+            l11, l21, l22 = normal[3, j], normal[4, j], normal[5, j]
+            y0 = normal[first, j] / l00
+            y1 = (normal[first + 1, j] - l10 * y0) / l11
+            y2 = (normal[first + 2, j] - l20 * y0 - l21 * y1) / l22
+            out[2, g, j] = y2 / l22
 
 
 @_helper
@@ -902,6 +921,86 @@ def _held_rows(work, held_noise, start, count, b, g, pointwise, operator, normal
             normal[row + 2, j] += o2 * measured
 
 
+@_called
+def _inverse2(a00, a01, a10, a11):
+    """The inverse of ``[[a00, a01], [a10, a11]]`` by Cramer's rule (the systems here are
+    well conditioned: ~cot(half-cone), :func:`uq.physics.fusedkernels._inverse2`)."""
+    scale = 1.0 / (a00 * a11 - a01 * a10)
+    return a11 * scale, -a01 * scale, -a10 * scale, a00 * scale
+
+
+@_helper
+def _level_wind(consts, model, beams, work, normal, stored, n_gates, count, out):
+    """A tilted (nacelle) mount's horizontal wind of trials [0, count), at the end of
+    :func:`reconstruct` (whose `normal` then holds, from row `stored`, the kept beams'
+    believed beams (point-wise; rows 5 k ..) and their corrected radial velocities (rows
+    5 b + k g + gate; one reading per scan: the measured ones, corrected here); its
+    `work` the scan's reading; `out` the 3-D solve's wind).
+
+    Each beam's believed earth-frame beam ``b_k`` (the point-wise reading's, or the
+    scan's rotation of the configured beam as the correction model believes it) and
+    its corrected radial velocity ``c_k = v_k + b_k . s`` (s: the velocity the model
+    removes). 2 beams (HEAD level_first, level_second 0 and 1): the horizontal least
+    squares ``b_k,h . u_h = c_k``, w = 0 assumed; with the level pair: the hub-height
+    horizontal wind ``b_k,h . u_h = c_k - b_k,up w`` with the w of `out`
+    (:mod:`uq.physics.nacelle`); other layouts keep `out`. Inside :func:`reconstruct`
+    and on as few rows as it can (the inverse of each 2 x 2 system made again per gate,
+    not kept): a pass of its own per block read its rows back from beyond the cache
+    (issue 25's speed line). Loops over the trials innermost (SIMD)."""
+    n_beams = int(consts[_N_BEAMS])
+    level_a, level_b = int(consts[_LEVEL_FIRST]), int(consts[_LEVEL_SECOND])
+    keep_all = consts[_MOUNTED] > 1         # the shear's beams too, and their lift
+    measured = stored + 5 * n_beams
+    if model != POINTWISE:                  # the scan's reading (_scan_correction's rows)
+        full = model == FULL
+        for b in range(n_beams):
+            if not (keep_all or b == level_a or b == level_b):
+                continue
+            nx, ny, nz = beams[b, 0], beams[b, 1], beams[b, 2]
+            row = stored + 5 * b
+            for j in range(count):
+                bx, by, bz = rotate(work[_READ_TRIG, j], work[_READ_TRIG + 1, j],
+                                    work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j],
+                                    work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j],
+                                    nx, ny, nz)
+                vu = work[_READ_VELOCITY + 2, j] if full else 0.0
+                normal[row, j], normal[row + 1, j], normal[row + 2, j] = bx, by, bz
+                normal[row + 3, j] = bx * work[_READ_VELOCITY, j] + \
+                    by * work[_READ_VELOCITY + 1, j] + bz * vu
+            for g in range(n_gates):        # corrected: c = v + b . s
+                corrected = measured + b * n_gates + g
+                for j in range(count):
+                    normal[corrected, j] = normal[corrected, j] + normal[row + 3, j]
+            if keep_all:                    # the scan's reading lifts no beam
+                normal[row + 4, :count] = 0.0
+    if level_a < 0:
+        return
+    first, second = stored + 5 * level_a, stored + 5 * level_b
+    for g in range(n_gates):
+        c_first, c_second = measured + level_a * n_gates + g, measured + level_b * n_gates + g
+        if n_beams == 2:                    # the horizontal normal equations
+            for j in range(count):
+                n00, n01 = normal[first, j], normal[first + 1, j]
+                n10, n11 = normal[second, j], normal[second + 1, j]
+                i00, i01, i10, i11 = _inverse2(n00 * n00 + n10 * n10, n00 * n01 + n10 * n11,
+                                               n00 * n01 + n10 * n11, n01 * n01 + n11 * n11)
+                c0, c1 = normal[c_first, j], normal[c_second, j]
+                r0 = n00 * c0 + n10 * c1
+                r1 = n01 * c0 + n11 * c1
+                out[0, g, j] = i00 * r0 + i01 * r1
+                out[1, g, j] = i10 * r0 + i11 * r1
+                out[2, g, j] = 0.0
+        else:
+            for j in range(count):
+                i00, i01, i10, i11 = _inverse2(normal[first, j], normal[first + 1, j],
+                                               normal[second, j], normal[second + 1, j])
+                up = out[2, g, j]
+                r0 = normal[c_first, j] - normal[first + 2, j] * up
+                r1 = normal[c_second, j] - normal[second + 2, j] * up
+                out[0, g, j] = i00 * r0 + i01 * r1
+                out[1, g, j] = i10 * r0 + i11 * r1
+
+
 @_kernel(f"void({_CV}, {_IM}, {_CM}, {_CM}, {_CT}, {_CV}, {_CM}, {_CM}, {_CV}, "
          f"UniTuple({_M}, 8), int64[::1], {_T}, int64, int64, {_CM}, {_CT}, {_CT}, {_CT}, "
          f"{_CT}, {_CT}, {_CM}, {_CT}, {_T}, {_CT})")
@@ -948,18 +1047,23 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                         turned, errors, has, start, count, states[0], work):
             _read_rows(consts, states[0], work, count)
     heading_varies = consts[_MOVES_YAW] > 0 or has[0]
-    # a tilted mount (rows of `normal` beyond the least squares'): its reconstruction
-    # (:func:`mounted_wind`) keeps each beam's measured radial velocity and, point-wise,
-    # its believed beam, the velocity along it and the lidar's believed lift
+    # a tilted mount (rows of `normal` beyond the least squares'): its horizontal solve
+    # (:func:`_level_wind`, after the least squares) keeps the measured radial velocity
+    # and, point-wise, the believed beam and the velocity along it of the beams it
+    # solves with; for the shear exponent (HEAD mounted 2, :func:`mounted_wind`) every
+    # beam's, and the lidar's believed lift
     held = held_out.shape[0] > 0
     second = normal.shape[0] - 3 * n_gates          # the held right-hand sides' rows
     stored = 6 + 3 * n_gates if normal.shape[0] - (3 * n_gates if held else 0) > \
         6 + 3 * n_gates else 0
+    level_a, level_b = int(consts[_LEVEL_FIRST]), int(consts[_LEVEL_SECOND])
+    keep_all = consts[_MOUNTED] > 1
     normal[:6 + 3 * n_gates, :count] = 0.0          # the sums, not a tilted mount's kept
     #                                                 rows (each is written before read)
     if held:
         normal[second:, :count] = 0.0               # the held right-hand sides' sums
     for b in range(n_beams):
+        kept = stored > 0 and (keep_all or b == level_a or b == level_b)
         if model == POINTWISE:          # this beam's own reading: the beam and velocity it implies
             state = states[b if at_nodes else 0]
             if at_nodes:                # the truth's motion is the reading's: errors only
@@ -971,7 +1075,7 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                 source = FROM_ROWS if written else FROM_ANGLES
             _pointwise(consts, state, work, normal, beams[b, 0], beams[b, 1], beams[b, 2],
                        count, heading_varies, source)
-            if stored:                  # a tilted mount's: the believed beam, the along
+            if kept:                    # a tilted mount's: the believed beam (and lift)
                 _store_reading(consts, state, work, normal, stored + 5 * b, count,
                                heading_varies, source)
         beam = b if noise.shape[1] > 1 else 0
@@ -992,9 +1096,13 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
             else:
                 for j in range(count):
                     work[_MEASURED, j] += noise[0, beam, gate]
-            if stored:                  # a tilted mount's: the measured radial velocity
-                normal[stored + 5 * n_beams + b * n_gates + g, :count] = \
-                    work[_MEASURED, :count]
+            if kept:                    # a tilted mount's: the corrected radial velocity
+                row = stored + 5 * n_beams + b * n_gates + g     # (or, one reading per
+                if model == POINTWISE:                          # scan, the measured one)
+                    for j in range(count):
+                        normal[row, j] = work[_MEASURED, j] + work[_ALONG, j]
+                else:
+                    normal[row, :count] = work[_MEASURED, :count]
             if model == POINTWISE:
                 for j in range(count):
                     corrected = work[_MEASURED, j] + work[_ALONG, j]
@@ -1008,15 +1116,24 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                     normal[7 + 3 * g, j] += o1 * work[_MEASURED, j]
                     normal[8 + 3 * g, j] += o2 * work[_MEASURED, j]
     first = np.int64(6)                 # the sums' first row (not a literal: one compile)
-    if model == POINTWISE:
-        _factor(normal, count)
-        _substitute(normal, first, n_gates, count, out)
+    level = stored > 0 and level_a >= 0     # a tilted mount's horizontal solve replaces
+    if model == POINTWISE:                  # the 3-D one's (north, east)
+        if level and n_beams == 2:          # 2 beams: it alone (their B^T B is singular)
+            pass
+        elif level:                         # the level pair's: the 3-D solve's w alone
+            _factor(normal, count)
+            _substitute_vertical(normal, first, n_gates, count, out)
+        else:
+            _factor(normal, count)
+            _substitute(normal, first, n_gates, count, out)
         if held:                                        # the same factor, the held sides
             _substitute(normal, second, n_gates, count, held_out)
     else:
         _scan_correction(consts, model, work, normal, first, n_gates, count, out)
         if held:
             _scan_correction(consts, model, work, normal, second, n_gates, count, held_out)
+    if stored:
+        _level_wind(consts, model, beams, work, normal, stored, n_gates, count, out)
 
 
 
@@ -1035,86 +1152,26 @@ def wind_speed(out, count, speed, vertical):
                 speed[g, j] = math.hypot(out[0, g, j], out[1, g, j])
 
 
-#: The layout vector of :func:`mounted_wind` (int64): the level pair (clock 90 and 270),
-#: the upper and lower beams (-1: none; :mod:`uq.physics.nacelle`) and whether the
-#: shear exponent is wanted.
-MOUNTED_LAYOUT = ("level_first", "level_second", "upper", "lower", "want_shear")
+#: The layout vector of :func:`mounted_wind` (int64): the upper and lower beams (-1:
+#: none; :mod:`uq.physics.nacelle`) and whether the shear exponent is wanted.
+MOUNTED_LAYOUT = ("upper", "lower", "want_shear")
 
 
-def mounted_wind(consts, layout, beams, slant, work, normal, count, out, shear, speed,
-                 vertical):
-    """A tilted (nacelle) mount's wind of trials [0, count), after :func:`reconstruct`
-    (whose `normal` then holds the measured radial velocities and, point-wise, each
-    beam's believed beam, velocity along it and lift; its `work` the scan's reading).
-
-    Each beam's believed earth-frame beam ``b_k`` (the point-wise reading's, or the
-    scan's rotation of the configured beam as the correction model believes it) and
-    its corrected radial velocity ``c_k = v_k + b_k . s`` (s: the velocity the model
-    removes). 2 beams: the horizontal least squares ``b_k,h . u_h = c_k``, w = 0
-    assumed; with the level pair: the hub-height horizontal wind ``b_k,h . u_h = c_k -
-    b_k,up w`` with the w of `out` (:mod:`uq.physics.nacelle`); other layouts keep
-    `out`. Writes out[:, g, j] and, wanted, ``shear[g, j] = ln(U_up / U_down) / ln(z_up /
-    z_down)``, ``U_k = c_k / (b_k,h . e)`` at the believed heights ``z_k = lidar height +
-    lift_k + slant b_k,up`` (NaN where a ratio is not positive); then the speed and the
-    vertical wind as :func:`wind_speed` (in this call: one call less per block, whose
-    Python and dispatch cost ~1.5 us, as much as the pass itself). Loops over the trials
-    innermost (SIMD); the 2 x 2 inverses in work's rows _MATRIX1 (free after
-    :func:`reconstruct`).
-    """
-    n_beams, n_gates, model = int(consts[_N_BEAMS]), int(consts[_N_GATES]), int(consts[_MODEL])
-    level_a, level_b, upper, lower = layout[0], layout[1], layout[2], layout[3]
+def mounted_wind(consts, layout, slant, normal, count, out, shear, speed, vertical):
+    """A tilted mount's shear exponent and wind speed of trials [0, count), after
+    :func:`reconstruct` (HEAD mounted 2: `normal` then holds every beam's believed beam,
+    lift and corrected radial velocities c_k, from row 6 + 3 g; `out` the hub-height wind
+    of :func:`_level_wind`): ``shear[g, j] = ln(U_up / U_down) /
+    ln(z_up / z_down)``, ``U_k = c_k / (b_k,h . e)`` at the believed heights ``z_k =
+    lidar height + lift_k + slant b_k,up`` (NaN where a ratio is not positive); then the
+    speed and the vertical wind as :func:`wind_speed` (in this call: one call less per
+    block, whose dispatch costs ~1 us)."""
+    n_beams, n_gates = int(consts[_N_BEAMS]), int(consts[_N_GATES])
+    upper, lower = layout[0], layout[1]
     stored = 6 + 3 * n_gates
     measured = stored + 5 * n_beams
-    if model != POINTWISE:                  # the scan's reading (_scan_correction's rows)
-        full = model == FULL
-        for b in range(n_beams):
-            nx, ny, nz = beams[b, 0], beams[b, 1], beams[b, 2]
-            row = stored + 5 * b
-            for j in range(count):
-                bx, by, bz = rotate(work[_READ_TRIG, j], work[_READ_TRIG + 1, j],
-                                    work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j],
-                                    work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j],
-                                    nx, ny, nz)
-                vu = work[_READ_VELOCITY + 2, j] if full else 0.0
-                normal[row, j], normal[row + 1, j], normal[row + 2, j] = bx, by, bz
-                normal[row + 3, j] = bx * work[_READ_VELOCITY, j] + \
-                    by * work[_READ_VELOCITY + 1, j] + bz * vu
-            if layout[4] > 0:               # the scan's reading lifts no beam
-                normal[row + 4, :count] = 0.0
-    first = stored + 5 * (0 if n_beams == 2 else level_a)
-    second = stored + 5 * (1 if n_beams == 2 else level_b)
-    inverse = _MATRIX1
-    if n_beams == 2 or level_a >= 0:
-        for j in range(count):
-            n00, n01 = normal[first, j], normal[first + 1, j]
-            n10, n11 = normal[second, j], normal[second + 1, j]
-            if n_beams == 2:                # the horizontal normal equations
-                n00, n01, n10, n11 = (n00 * n00 + n10 * n10, n00 * n01 + n10 * n11,
-                                      n00 * n01 + n10 * n11, n01 * n01 + n11 * n11)
-            i00, i01, i10, i11 = _inverse2(n00, n01, n10, n11)
-            work[inverse, j], work[inverse + 1, j] = i00, i01
-            work[inverse + 2, j], work[inverse + 3, j] = i10, i11
-    m_first = measured + (0 if n_beams == 2 else level_a) * n_gates
-    m_second = measured + (1 if n_beams == 2 else level_b) * n_gates
-    for g in range(n_gates):
-        if n_beams == 2:
-            for j in range(count):
-                c0 = normal[m_first + g, j] + normal[first + 3, j]
-                c1 = normal[m_second + g, j] + normal[second + 3, j]
-                r0 = normal[first, j] * c0 + normal[second, j] * c1
-                r1 = normal[first + 1, j] * c0 + normal[second + 1, j] * c1
-                out[0, g, j] = work[inverse, j] * r0 + work[inverse + 1, j] * r1
-                out[1, g, j] = work[inverse + 2, j] * r0 + work[inverse + 3, j] * r1
-                out[2, g, j] = 0.0
-        elif level_a >= 0:
-            for j in range(count):
-                up = out[2, g, j]
-                r0 = (normal[m_first + g, j] + normal[first + 3, j]) - normal[first + 2, j] * up
-                r1 = (normal[m_second + g, j] + normal[second + 3, j]) - \
-                    normal[second + 2, j] * up
-                out[0, g, j] = work[inverse, j] * r0 + work[inverse + 1, j] * r1
-                out[1, g, j] = work[inverse + 2, j] * r0 + work[inverse + 3, j] * r1
-        if layout[4] > 0:
+    if layout[2] > 0:
+        for g in range(n_gates):
             _shear_rows(consts, normal, stored, measured + upper * n_gates + g,
                         measured + lower * n_gates + g, stored + 5 * upper,
                         stored + 5 * lower, slant[upper, g], slant[lower, g], out, g, count,
@@ -1130,18 +1187,9 @@ def _shear_rows(consts, normal, stored, m_upper, m_lower, upper, lower, slant_up
     for j in range(count):
         shear[g, j] = _shear_exponent(
             out[0, g, j], out[1, g, j], normal[upper, j], normal[upper + 1, j],
-            normal[lower, j], normal[lower + 1, j],
-            normal[m_upper, j] + normal[upper + 3, j], normal[m_lower, j] + normal[lower + 3, j],
+            normal[lower, j], normal[lower + 1, j], normal[m_upper, j], normal[m_lower, j],
             (height + normal[upper + 4, j]) + slant_upper * normal[upper + 2, j],
             (height + normal[lower + 4, j]) + slant_lower * normal[lower + 2, j])
-
-
-@_called
-def _inverse2(a00, a01, a10, a11):
-    """The inverse of ``[[a00, a01], [a10, a11]]`` by Cramer's rule (the systems here are
-    well conditioned: ~cot(half-cone), :func:`uq.physics.fusedkernels._inverse2`)."""
-    scale = 1.0 / (a00 * a11 - a01 * a10)
-    return a11 * scale, -a01 * scale, -a10 * scale, a00 * scale
 
 
 @_called
@@ -1162,5 +1210,5 @@ def _shear_exponent(north, east, upper_north, upper_east, lower_north, lower_eas
 @functools.cache
 def compiled_mounted_wind():
     """:func:`mounted_wind` compiled on first use (a tilted mount's run alone pays it)."""
-    return _kernel(f"void({_CV}, int64[::1], {_CM}, {_CM}, {_CM}, {_CM}, int64, {_CT}, "
-                   f"{_CM}, {_CM}, {_CM})")(mounted_wind)
+    return _kernel(f"void({_CV}, int64[::1], {_CM}, {_CM}, int64, {_CT}, {_CM}, {_CM}, "
+                   f"{_CM})")(mounted_wind)
