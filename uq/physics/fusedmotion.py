@@ -36,7 +36,8 @@ import math
 
 import numpy as np
 
-from uq.constants import FULL_CIRCLE_DEG, MOTION_BLOCK_TRIALS, MOTION_BLOCK_VALUES
+from uq.constants import (FULL_CIRCLE_DEG, MOTION_BLOCK_ROW_PAD, MOTION_BLOCK_TRIALS,
+                          MOTION_BLOCK_VALUES)
 from uq.physics import fusedmotionkernels as kernels
 from uq.physics import fusedprobe
 from uq.physics import probe as probe_volume
@@ -399,21 +400,19 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     geometry = [_column(errors.get(name)) for name in _GEOMETRY]
     m = min(block_trials(plan, probe.nodes if probe is not None else 0), max(n, 1))
     n_components = max(1, len(plan.components))
-    work = np.empty((kernels.WORK_ROWS, m))
-    c, turned = np.empty((2, n_components, m)), np.empty((2, n_components, m))
     at_nodes = plan.at_nodes and not has[kernels.INPUTS.index("ins_clock_offset")]
-    states = np.empty((n_beams if at_nodes else 1, kernels.STATE_ROWS, m))
-    ship_beams = np.empty((n_beams, 3, m))
-    parts = np.empty((2, n_beams * n_nodes, m))
-    ratio = np.empty((n_beams * n_nodes, n_gates, m))
-    normal = np.empty((6 + 3 * n_gates + (0 if layout is None else
-                                          5 * n_beams + n_beams * n_gates)
-                       + (3 * n_gates if shared else 0), m))
+    shear_rows = layout is not None and layout[-1]
+    (work, c, turned, states, ship_beams, parts, ratio, out, speed, vertical, *rest,
+     normal) = block_scratch(m, [
+        (kernels.WORK_ROWS,), (2, n_components), (2, n_components),
+        (n_beams if at_nodes else 1, kernels.STATE_ROWS), (n_beams, 3),
+        (2, n_beams * n_nodes), (n_beams * n_nodes, n_gates), (3, n_gates), (n_gates,),
+        (n_gates,), *([(3, n_gates)] if shared else []), *([(n_gates,)] if shear_rows else []),
+        (6 + 3 * n_gates + (0 if layout is None else 5 * n_beams + n_beams * n_gates)
+         + (3 * n_gates if shared else 0),)])
+    held_out = rest.pop(0) if shared else np.empty((0, 1, 1))
+    shear_out = rest.pop(0) if shear_rows else None
     held_noise = second[2] if shared else noise
-    held_out = np.empty((3, n_gates, m) if shared else (0, 1, 1))
-    shear_out = np.empty((n_gates, m)) if layout is not None and layout[-1] else None
-    out = np.empty((3, n_gates, m))
-    speed, vertical = np.empty((n_gates, m)), np.empty((n_gates, m))
     shear = consts[kernels.HEAD.index("shear")]
     beam_up = np.empty((n_beams * n_nodes, m)) if probe is not None else np.empty((1, 1))
     if probe is not None:
@@ -471,6 +470,26 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
             else:
                 kernels.wind_speed(out, count, speed, vertical)
             into[HELD_WIND_SPEED][start:stop] = speed[:, :count].T
+
+
+def block_scratch(m, shapes):
+    """The block scratch of :func:`_evaluate`: an array (*shape, m + pad) per shape, one
+    after the other in one buffer whose first row is 64-byte aligned, each row
+    :data:`~uq.constants.MOTION_BLOCK_ROW_PAD` values longer than the block's m trials
+    (the loops use the first m): rows of 2^k values let a store and a later load of
+    another row meet at the same address modulo 4 KiB, which the CPU takes for a
+    dependence (4K aliasing), at places that depended on where each array happened to
+    be allocated. The same placement in every process; with m a power of two, rows
+    fewer than 64 apart never share their address modulo 4 KiB."""
+    width = m + MOTION_BLOCK_ROW_PAD
+    sizes = [math.prod(shape) * width for shape in shapes]
+    buffer = np.empty(sum(sizes) + 8)
+    at = (-buffer.ctypes.data // 8) % 8                 # to the 64-byte line
+    arrays = []
+    for shape, size in zip(shapes, sizes):
+        arrays.append(buffer[at:at + size].reshape(*shape, width))
+        at += size
+    return arrays
 
 
 #: ``held_out`` of :func:`~uq.physics.fusedmotionkernels.reconstruct` without a held side.
