@@ -109,8 +109,8 @@ def measurement_model(scene, outputs, scene_draws=False, held=None, **errors):
     outputs: each (n, *S, n_gates) for a batch of scenes of shape S, evaluated one scene
     after the other; with `scene_draws` each scene takes its own slice of the inputs).
     `held` (inputs -> scalar): the wind speed of the same trials with these inputs
-    replaced, ``wind_speed_held``; where the radial noise alone is held (an upward lidar,
-    :func:`shares_reading`) a second right-hand side of the same least squares in the
+    replaced, ``wind_speed_held``; where the radial noise alone is held
+    (:func:`shares_reading`) a second right-hand side of the same least squares in the
     same reconstruction, else where no input of the truth is held
     (:func:`shares_kinematics`) a second reconstruction per block on the same
     kinematics, else a second evaluation (:data:`HELD_PATHS` counts which)."""
@@ -379,8 +379,8 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     reconstruct`, its shear exponent by :func:`~uq.physics.fusedmotionkernels.
     mounted_wind`); with `held` (inputs of the reconstruction alone -> scalar) the
     speed reconstructed from the same truth with those inputs replaced, into
-    ``into["wind_speed_held"]``: with the reading shared (:func:`shares_reading`, an
-    upward lidar) in the same reconstruction, as a second right-hand side of its least
+    ``into["wind_speed_held"]``: with the reading shared (:func:`shares_reading`) in
+    the same reconstruction, as a second right-hand side of its least
     squares, else by a second reconstruction."""
     consts = plan.consts
     if layout is not None and layout[-1]:   # the shear exponent: the believed lift too
@@ -392,7 +392,7 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     n_nodes = len(plan.weights)
     ins, has, noise = _reconstruction_inputs(errors, n)
     second = None if held is None else _reconstruction_inputs({**errors, **held}, n)
-    shared = second is not None and layout is None and shares_reading(held, errors)
+    shared = second is not None and shares_reading(held, errors)
     if second is not None:
         HELD_PATHS["shared reading" if shared else "second reconstruction"] += 1
     phases = _phase_input(errors.get("motion_phases"), plan.n_phases)
@@ -408,7 +408,8 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
         (n_beams if at_nodes else 1, kernels.STATE_ROWS), (n_beams, 3),
         (2, n_beams * n_nodes), (n_beams * n_nodes, n_gates), (3, n_gates), (n_gates,),
         (n_gates,), *([(3, n_gates)] if shared else []), *([(n_gates,)] if shear_rows else []),
-        (6 + 3 * n_gates + (0 if layout is None else 5 * n_beams + n_beams * n_gates)
+        (6 + 3 * n_gates + (0 if layout is None else       # (reconstruct's rows)
+                            5 * n_beams + n_beams * n_gates * (2 if shared else 1))
          + (3 * n_gates if shared else 0),)])
     held_out = rest.pop(0) if shared else np.empty((0, 1, 1))
     shear_out = rest.pop(0) if shear_rows else None

@@ -896,14 +896,21 @@ def _scan_correction(consts, model, work, normal, row, n_gates, count, out):
 
 
 @_helper
-def _held_rows(work, held_noise, start, count, b, g, pointwise, operator, normal, row):
+def _held_rows(work, held_noise, start, count, b, g, pointwise, operator, normal, row, keep):
     """The held right-hand side of beam b, gate g (:func:`reconstruct`): the dwell mean
     in work[_MEASURED] plus the held noise, corrected point-wise by the reading's beam
     and velocity along it (rows _BEAM, _ALONG), or through A^+, into rows row .. row + 2
-    (the operations of the main side's, in its order)."""
+    (the operations of the main side's, in its order); and a tilted mount's kept beam's
+    corrected (one reading per scan: measured) radial velocity into row `keep` (-1:
+    none), as the main side keeps its own."""
     beam = b if held_noise.shape[1] > 1 else 0
     gate = g if held_noise.shape[2] > 1 else 0
     per_trial = held_noise.shape[0] > 1
+    if keep >= 0:
+        for j in range(count):
+            measured = work[_MEASURED, j] + held_noise[start + j if per_trial else 0, beam,
+                                                       gate]
+            normal[keep, j] = measured + work[_ALONG, j] if pointwise else measured
     if pointwise:
         for j in range(count):
             noise = held_noise[start + j if per_trial else 0, beam, gate]
@@ -930,12 +937,13 @@ def _inverse2(a00, a01, a10, a11):
 
 
 @_helper
-def _level_wind(consts, model, beams, work, normal, stored, n_gates, count, out):
+def _level_wind(consts, model, beams, work, normal, stored, measured, n_gates, count, out):
     """A tilted (nacelle) mount's horizontal wind of trials [0, count), at the end of
-    :func:`reconstruct` (whose `normal` then holds, from row `stored`, the kept beams'
-    believed beams (point-wise; rows 5 k ..) and their corrected radial velocities (rows
-    5 b + k g + gate; one reading per scan: the measured ones, corrected here); its
-    `work` the scan's reading; `out` the 3-D solve's wind).
+    :func:`reconstruct` (whose `normal` then holds the kept beams' believed beams from
+    row `stored` (point-wise; 5 rows per beam) and their corrected radial velocities from
+    row `measured` (k g + gate; one reading per scan: the measured ones, corrected here);
+    its `work` the scan's reading; `out` the 3-D solve's wind, of the main side or the
+    held noise's).
 
     Each beam's believed earth-frame beam ``b_k`` (the point-wise reading's, or the
     scan's rotation of the configured beam as the correction model believes it) and
@@ -950,7 +958,6 @@ def _level_wind(consts, model, beams, work, normal, stored, n_gates, count, out)
     n_beams = int(consts[_N_BEAMS])
     level_a, level_b = int(consts[_LEVEL_FIRST]), int(consts[_LEVEL_SECOND])
     keep_all = consts[_MOUNTED] > 1         # the shear's beams too, and their lift
-    measured = stored + 5 * n_beams
     if model != POINTWISE:                  # the scan's reading (_scan_correction's rows)
         full = model == FULL
         for b in range(n_beams):
@@ -1013,15 +1020,17 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
     ratio of :func:`kinematics`); ``errors`` the INS inputs of :data:`INPUTS`, each (n or
     1, k or 1), ``has`` which are given; ``states`` one per beam when the point-wise
     readings are the truth's nodes (from :func:`kinematics`), else one of scratch;
-    ``normal`` (6 + 3 g, trials) scratch for the least squares. Writes ``out[0, g]``
-    north, ``out[1, g]`` east, ``out[2, g]`` up [m s-1].
+    ``normal`` (6 + 3 g, trials) scratch for the least squares (a tilted mount's
+    (HEAD mounted): 5 b + b g more for :func:`_level_wind`, and b g more with a held
+    side). Writes ``out[0, g]`` north, ``out[1, g]`` east, ``out[2, g]`` up [m s-1].
 
-    With a ``held_out`` of 3 rows (an upward lidar only: 0 rows otherwise), also the wind
-    of the same trials with the radial noise ``held_noise`` (shaped as ``noise``) in
-    place of ``noise`` and every other input the same: the same reading, so the same
-    believed beams and least-squares factor, with a second right-hand side (the last 3 g
-    rows of ``normal``) accumulated beside the first, in the same order of operations as
-    a call with ``held_noise`` as its noise (so bit for bit its result).
+    With a ``held_out`` of 3 rows (0 rows otherwise), also the wind of the same trials
+    with the radial noise ``held_noise`` (shaped as ``noise``) in place of ``noise`` and
+    every other input the same: the same reading, so the same believed beams and
+    least-squares factor, with a second right-hand side (the last 3 g rows of
+    ``normal``; a tilted mount's held corrected velocities beside its own) accumulated
+    beside the first, in the same order of operations as a call with ``held_noise`` as
+    its noise (so bit for bit its result).
     """
     n_beams, n_gates, n_nodes = int(consts[_N_BEAMS]), int(consts[_N_GATES]), int(consts[_N_NODES])
     model, mode, speed_ref = int(consts[_MODEL]), int(consts[_INS_MODE]), consts[_WIND_SPEED]
@@ -1053,15 +1062,17 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
     # solves with; for the shear exponent (HEAD mounted 2, :func:`mounted_wind`) every
     # beam's, and the lidar's believed lift
     held = held_out.shape[0] > 0
-    second = normal.shape[0] - 3 * n_gates          # the held right-hand sides' rows
-    stored = 6 + 3 * n_gates if normal.shape[0] - (3 * n_gates if held else 0) > \
-        6 + 3 * n_gates else 0
+    stored = 6 + 3 * n_gates if consts[_MOUNTED] > 0 else 0     # a tilted mount's rows:
+    measured = stored + 5 * n_beams                 # 5 per beam, then the corrected radial
+    measured_held = measured + n_beams * n_gates    # velocities (b, g), then the held ones'
+    second = 6 + 3 * n_gates if stored == 0 else \
+        measured_held + (n_beams * n_gates if held else 0)   # the held right-hand sides
     level_a, level_b = int(consts[_LEVEL_FIRST]), int(consts[_LEVEL_SECOND])
     keep_all = consts[_MOUNTED] > 1
     normal[:6 + 3 * n_gates, :count] = 0.0          # the sums, not a tilted mount's kept
     #                                                 rows (each is written before read)
     if held:
-        normal[second:, :count] = 0.0               # the held right-hand sides' sums
+        normal[second:second + 3 * n_gates, :count] = 0.0   # the held right-hand sides' sums
     for b in range(n_beams):
         kept = stored > 0 and (keep_all or b == level_a or b == level_b)
         if model == POINTWISE:          # this beam's own reading: the beam and velocity it implies
@@ -1088,7 +1099,8 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                                                     * parts[0, node, j] + parts[1, node, j])
             if held:                    # the same dwell mean, the held noise
                 _held_rows(work, held_noise, start, count, b, g, model == POINTWISE,
-                           operator, normal, second + 3 * g)
+                           operator, normal, second + 3 * g,
+                           measured_held + b * n_gates + g if kept else -1)
             gate = g if noise.shape[2] > 1 else 0
             if noise.shape[0] > 1:
                 for j in range(count):
@@ -1097,7 +1109,7 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                 for j in range(count):
                     work[_MEASURED, j] += noise[0, beam, gate]
             if kept:                    # a tilted mount's: the corrected radial velocity
-                row = stored + 5 * n_beams + b * n_gates + g     # (or, one reading per
+                row = measured + b * n_gates + g                 # (or, one reading per
                 if model == POINTWISE:                          # scan, the measured one)
                     for j in range(count):
                         normal[row, j] = work[_MEASURED, j] + work[_ALONG, j]
@@ -1115,25 +1127,23 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                     normal[6 + 3 * g, j] += o0 * work[_MEASURED, j]
                     normal[7 + 3 * g, j] += o1 * work[_MEASURED, j]
                     normal[8 + 3 * g, j] += o2 * work[_MEASURED, j]
-    first = np.int64(6)                 # the sums' first row (not a literal: one compile)
     level = stored > 0 and level_a >= 0     # a tilted mount's horizontal solve replaces
-    if model == POINTWISE:                  # the 3-D one's (north, east)
-        if level and n_beams == 2:          # 2 beams: it alone (their B^T B is singular)
-            pass
-        elif level:                         # the level pair's: the 3-D solve's w alone
-            _factor(normal, count)
-            _substitute_vertical(normal, first, n_gates, count, out)
+    alone = level and n_beams == 2          # the 3-D one's (north, east); with 2 beams it
+    if model == POINTWISE and not alone:    # alone (their B^T B is singular)
+        _factor(normal, count)
+    for side in range(2 if held else 1):    # the wind, then the held noise's (the same
+        row = np.int64(6) if side == 0 else np.int64(second)       # factor, the held
+        into = out if side == 0 else held_out                        # right-hand sides)
+        if model == POINTWISE:
+            if level and not alone:         # the level pair's: the 3-D solve's w alone
+                _substitute_vertical(normal, row, n_gates, count, into)
+            elif not alone:
+                _substitute(normal, row, n_gates, count, into)
         else:
-            _factor(normal, count)
-            _substitute(normal, first, n_gates, count, out)
-        if held:                                        # the same factor, the held sides
-            _substitute(normal, second, n_gates, count, held_out)
-    else:
-        _scan_correction(consts, model, work, normal, first, n_gates, count, out)
-        if held:
-            _scan_correction(consts, model, work, normal, second, n_gates, count, held_out)
-    if stored:
-        _level_wind(consts, model, beams, work, normal, stored, n_gates, count, out)
+            _scan_correction(consts, model, work, normal, row, n_gates, count, into)
+        if stored:
+            _level_wind(consts, model, beams, work, normal, stored,
+                        measured if side == 0 else measured_held, n_gates, count, into)
 
 
 
