@@ -983,12 +983,16 @@ def _level_wind(consts, model, beams, work, normal, stored, measured, n_gates, c
     if level_a < 0:
         return
     first, second = stored + 5 * level_a, stored + 5 * level_b
+    # the last beam's believed beam is still in work's rows _BEAM (point-wise, no lift)
+    last = model == POINTWISE and level_b == n_beams - 1 and not keep_all
+    rows = work if last else normal
+    second = _BEAM if last else second
     for g in range(n_gates):
         c_first, c_second = measured + level_a * n_gates + g, measured + level_b * n_gates + g
         if n_beams == 2:                    # the horizontal normal equations
             for j in range(count):
                 n00, n01 = normal[first, j], normal[first + 1, j]
-                n10, n11 = normal[second, j], normal[second + 1, j]
+                n10, n11 = rows[second, j], rows[second + 1, j]
                 i00, i01, i10, i11 = _inverse2(n00 * n00 + n10 * n10, n00 * n01 + n10 * n11,
                                                n00 * n01 + n10 * n11, n01 * n01 + n11 * n11)
                 c0, c1 = normal[c_first, j], normal[c_second, j]
@@ -1000,10 +1004,10 @@ def _level_wind(consts, model, beams, work, normal, stored, measured, n_gates, c
         else:
             for j in range(count):
                 i00, i01, i10, i11 = _inverse2(normal[first, j], normal[first + 1, j],
-                                               normal[second, j], normal[second + 1, j])
+                                               rows[second, j], rows[second + 1, j])
                 up = out[2, g, j]
                 r0 = normal[c_first, j] - normal[first + 2, j] * up
-                r1 = normal[c_second, j] - normal[second + 2, j] * up
+                r1 = normal[c_second, j] - rows[second + 2, j] * up
                 out[0, g, j] = i00 * r0 + i01 * r1
                 out[1, g, j] = i10 * r0 + i11 * r1
 
@@ -1075,6 +1079,7 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
         normal[second:second + 3 * n_gates, :count] = 0.0   # the held right-hand sides' sums
     for b in range(n_beams):
         kept = stored > 0 and (keep_all or b == level_a or b == level_b)
+        last = not keep_all and b == n_beams - 1          # (its beam stays in work's rows)
         if model == POINTWISE:          # this beam's own reading: the beam and velocity it implies
             state = states[b if at_nodes else 0]
             if at_nodes:                # the truth's motion is the reading's: errors only
@@ -1086,7 +1091,7 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                 source = FROM_ROWS if written else FROM_ANGLES
             _pointwise(consts, state, work, normal, beams[b, 0], beams[b, 1], beams[b, 2],
                        count, heading_varies, source)
-            if kept:                    # a tilted mount's: the believed beam (and lift)
+            if kept and not last:       # a tilted mount's: the believed beam (and lift)
                 _store_reading(consts, state, work, normal, stored + 5 * b, count,
                                heading_varies, source)
         beam = b if noise.shape[1] > 1 else 0
