@@ -116,6 +116,13 @@ WORK, WORK_ROWS = row_layout(WORK_BLOCKS)
 
 
 _helper = njit(cache=True, nogil=True, error_model="numpy")
+#: Compile-time notes (issue 26, cold first runs), kept by every kernel here:
+#: - numba compiles a jitted callee once per distinct *literal* argument (a module-level
+#:   int or a True/False written at the call), so row numbers and flags are passed as
+#:   values (np.int64(...), a comparison), one compile per helper;
+#: - a row is copied by a loop, not ``a[i, :n] = b[k, :n]``: an array-to-array slice
+#:   assignment compiles numba's shape-mismatch error (its message built from strings,
+#:   ~1.7 s of CPU on the first run) though the shapes here always agree.
 #: How the kernels' helpers are compiled (as in :mod:`uq.physics.fusedkernels`): the
 #: small ones (trig, rotations, the rotation-group interpolation) as functions of their
 #: own that LLVM inlines where it pays, not numba's ``inline="always"``, which re-runs
@@ -242,7 +249,7 @@ def _turn_phases(components, c, work, count, turned):
         w = components[k, 0]
         for j in range(count):
             work[_ANGLE, j] = w * work[_SHIFT, j]
-        sincos_rows(work, _ANGLE, _SINE, _COSINE, count)
+        sincos_rows(work, np.int64(_ANGLE), np.int64(_SINE), np.int64(_COSINE), count)
         for j in range(count):
             c1, c2 = c[0, k, j], c[1, k, j]
             cosine, sine = work[_COSINE, j], work[_SINE, j]
@@ -275,7 +282,7 @@ def _geometry_angle(base, error, start, count, work, row):
     """work[row], work[row + 1] = cos, sin of base + error [deg] (error (n or 1,))."""
     for j in range(count):
         work[_ANGLE, j] = base + error[start + j if error.shape[0] > 1 else 0] * _DEG
-    sincos_rows(work, _ANGLE, row + 1, row, count)
+    sincos_rows(work, np.int64(_ANGLE), row + 1, row, count)
 
 
 @_helper
@@ -534,13 +541,13 @@ def _attitude_rows(consts, state, work, count, row, with_errors):
         if with_errors:
             for j in range(count):
                 work[_ANGLE, j] += work[_ERROR + i, j]
-        sincos_rows(work, _ANGLE, row + 2 * i + 1, row + 2 * i, count)
+        sincos_rows(work, np.int64(_ANGLE), row + 2 * i + 1, row + 2 * i, count)
 
 
 @_helper
 def _sample_matrix(consts, state, work, count, row):
     """The attitude of an INS sample (its values in state) as a row-major matrix."""
-    _attitude_rows(consts, state, work, count, _READ_TRIG, False)
+    _attitude_rows(consts, state, work, count, np.int64(_READ_TRIG), count < 0)  # (False)
     for j in range(count):
         ch, sh = work[_READ_TRIG, j], work[_READ_TRIG + 1, j]
         cp, sp = work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j]
@@ -609,7 +616,7 @@ def _error_rows(errors, has, start, count, k, work):
             for j in range(count):
                 work[row, j] = error[start + j, col] * scale
         if i == 4:
-            sincos_rows(work, _ANGLE, _COG + 1, _COG, count)
+            sincos_rows(work, np.int64(_ANGLE), np.int64(_COG + 1), np.int64(_COG), count)
 
 
 @_helper
@@ -629,20 +636,21 @@ def _reading(consts, pairs, amplitudes, components, read_table, stamps, k, c, tu
         _motion(pairs, amplitudes, read_table, k, c, state, count)
     else:                                   # the INS samples at offset + i / rate
         clock, offset = errors[_CLOCK][:, 0], errors[_OFFSET][:, 0]
-        _sample_times(stamp, clock, offset, rate, 0, mode, start, count, work)
+        _sample_times(stamp, clock, offset, rate, np.int64(0), mode, start, count, work)
         _turn_phases(components, c, work, count, turned)
         _motion(pairs, amplitudes, read_table, k, turned, state, count)
         if mode == LINEAR:                  # keep the first sample; then the second
-            _sample_matrix(consts, state, work, count, _MATRIX1)
+            _sample_matrix(consts, state, work, count, np.int64(_MATRIX1))
             for j in range(count):
                 work[_VELOCITY1, j], work[_VELOCITY1 + 1, j], work[_VELOCITY1 + 2, j] = \
                     _ins_velocity(head, state, j)
             for i in range(3):
-                work[_RATES1 + i, :count] = state[_RATE_ROW + 2 - i, :count]
-            _sample_times(stamp, clock, offset, rate, 1, mode, start, count, work)
+                for j in range(count):      # (a loop, not a slice: the notes above)
+                    work[_RATES1 + i, j] = state[_RATE_ROW + 2 - i, j]
+            _sample_times(stamp, clock, offset, rate, np.int64(1), mode, start, count, work)
             _turn_phases(components, c, work, count, turned)
             _motion(pairs, amplitudes, read_table, k, turned, state, count)
-            _sample_matrix(consts, state, work, count, _MATRIX2)
+            _sample_matrix(consts, state, work, count, np.int64(_MATRIX2))
             for j in range(count):          # rates and velocity linearly, with errors
                 a = work[_FRACTION, j]
                 for i in range(3):
@@ -657,7 +665,7 @@ def _reading(consts, pairs, amplitudes, components, read_table, stamps, k, c, tu
             _slerp(work, count)
             for i in range(3):              # (cos, sin) of the slerp's angle + error
                 if has[i]:
-                    sincos_rows(work, _ERROR + i, _SINE, _COSINE, count)
+                    sincos_rows(work, _ERROR + i, np.int64(_SINE), np.int64(_COSINE), count)
                     row = _READ_TRIG + 2 * i
                     for j in range(count):
                         co, si = work[row, j], work[row + 1, j]
@@ -672,7 +680,7 @@ def _read_rows(consts, state, work, count):
     """The (cos, sin) of a reading's attitude with its errors (rows _READ_TRIG) and its
     velocity with its errors (_READ_VELOCITY), from the state :func:`_reading` left."""
     head = _head(consts)
-    _attitude_rows(consts, state, work, count, _READ_TRIG, True)
+    _attitude_rows(consts, state, work, count, np.int64(_READ_TRIG), count >= 0)  # (True)
     for j in range(count):
         vn, ve, vu = _ins_velocity(head, state, j)
         work[_READ_VELOCITY, j], work[_READ_VELOCITY + 1, j], work[_READ_VELOCITY + 2, j] = \
@@ -806,14 +814,15 @@ def _store_reading(consts, state, work, normal, row, count, heading_varies, sour
         return
     normal[row + 4, :count] = 0.0
     if consts[_HAS_ARM] > 0:
-        normal[row + 3, :count] = work[_ALONG, :count]        # (kept while the arm's
+        for j in range(count):              # (kept while the arm's rows are made)
+            normal[row + 3, j] = work[_ALONG, j]
         _pointwise_rows(consts, state, work, consts[_ARM_BOW], consts[_ARM_STARBOARD],
-                        consts[_ARM_UP], count, heading_varies, source)    # rows are made)
+                        consts[_ARM_UP], count, heading_varies, source)
         for j in range(count):              # the reading's rotation of the arm
             normal[row + 4, j] = work[_BEAM + 2, j] - consts[_STATIC_ARM_UP]
-        for i in range(3):                  # the beam's rows back for the least squares
-            work[_BEAM + i, :count] = normal[row + i, :count]
-        work[_ALONG, :count] = normal[row + 3, :count]
+        for j in range(count):              # the beam's rows back for the least squares
+            work[_BEAM, j], work[_BEAM + 1, j] = normal[row, j], normal[row + 1, j]
+            work[_BEAM + 2, j], work[_ALONG, j] = normal[row + 2, j], normal[row + 3, j]
 
 
 @_helper
@@ -1119,7 +1128,8 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                     for j in range(count):
                         normal[row, j] = work[_MEASURED, j] + work[_ALONG, j]
                 else:
-                    normal[row, :count] = work[_MEASURED, :count]
+                    for j in range(count):
+                        normal[row, j] = work[_MEASURED, j]
             if model == POINTWISE:
                 for j in range(count):
                     corrected = work[_MEASURED, j] + work[_ALONG, j]
