@@ -786,12 +786,8 @@ def _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, sour
         for j in range(count):
             _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_STATE)
     else:
-        if heading_varies:
-            for j in range(count):
-                _pointwise_at(head, state, work, nx, ny, nz, j, False, True, FROM_ANGLES)
-        else:
-            for j in range(count):
-                _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_ANGLES)
+        for j in range(count):
+            _pointwise_at(head, state, work, nx, ny, nz, j, False, heading_varies, FROM_ANGLES)
         for j in range(count):
             if not work[_BIG, j] <= SINCOS_REDUCTION_LIMIT:
                 _pointwise_at(head, state, work, nx, ny, nz, j, True, heading_varies,
