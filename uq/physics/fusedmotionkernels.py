@@ -439,12 +439,8 @@ def kinematics(consts, pairs, amplitudes, components, sources, phases, window, n
             node = b * n_nodes + q
             _motion(pairs, amplitudes, node_table, node, c, state, count)
             _attitude_trig(consts, state, work, count, yaw)
-            if yaw:
-                for j in range(count):
-                    _truth_at(head, state, work, ship_beams, parts, b, node, j, False, True)
-            else:
-                for j in range(count):
-                    _truth_at(head, state, work, ship_beams, parts, b, node, j, False, False)
+            for j in range(count):
+                _truth_at(head, state, work, ship_beams, parts, b, node, j, False, yaw)
             for j in range(count):                    # beyond the reduction (and NaN): libm
                 if not work[_BIG, j] <= SINCOS_REDUCTION_LIMIT:
                     _truth_at(head, state, work, ship_beams, parts, b, node, j, True, yaw)
