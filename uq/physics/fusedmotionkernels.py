@@ -773,17 +773,12 @@ def _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, sour
     """:func:`_pointwise_at` for the block's trials: the read rotation of (nx, ny, nz)
     into rows _BEAM, the lidar velocity along it into _ALONG."""
     head = _head(consts)
-    if source == FROM_ROWS:
-        for j in range(count):
-            _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_ROWS)
-    elif source == FROM_STATE and head[_HAS_ARM] == 0:
+    if source == FROM_STATE and head[_HAS_ARM] == 0:
         _pointwise_from_state(head, state, work, nx, ny, nz, count)
-    elif source == FROM_STATE:
-        for j in range(count):
-            _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_STATE)
-    else:
-        for j in range(count):
-            _pointwise_at(head, state, work, nx, ny, nz, j, False, heading_varies, FROM_ANGLES)
+        return
+    for j in range(count):                  # (one inlined copy, `source` a value: LLVM
+        _pointwise_at(head, state, work, nx, ny, nz, j, False, heading_varies, source)
+    if source == FROM_ANGLES:               # unswitches the loop on it)
         for j in range(count):
             if not work[_BIG, j] <= SINCOS_REDUCTION_LIMIT:
                 _pointwise_at(head, state, work, nx, ny, nz, j, True, heading_varies,
