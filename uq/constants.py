@@ -394,6 +394,15 @@ MOTION_BLOCK_VALUES = 2**16
 #: larger block gains nothing (measured on a 5-beam DBS scan, scripts/bench_motion.py).
 MOTION_BLOCK_TRIALS = (64, 2**11)
 
+#: Values [-] by which each row of the compiled time-resolved model's block scratch is
+#: longer than its trials (:func:`uq.physics.fusedmotion.block_scratch`): one 64-byte
+#: line, so that rows of a power-of-two block (256 trials, 2 KiB) do not meet modulo the
+#: 4 KiB a CPU's store-to-load check compares (4K aliasing; Intel 64 and IA-32
+#: Optimization Reference Manual, Sec. 3.6.8.1). Measured on the 4-beam point-wise DBS of
+#: uq.bench.targets.nacelle_models, 2^17 trials, CPU time: 0.030-0.034 s over processes
+#: with rows of 256 values, 0.0297-0.0299 s with this pad (2026-11-25).
+MOTION_BLOCK_ROW_PAD = 8
+
 # --- Turbulence defaults (issue 24) ------------------------------------------------------
 # IEC 61400-1 Ed. 3 (2005), Sec. 6.3 and Annex B: the turbulence scale parameter
 # Lambda_1 = 0.7 z below 60 m above ground and 42 m above; the Mann (1994) uniform-shear

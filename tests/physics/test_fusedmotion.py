@@ -196,6 +196,33 @@ def test_held_noise_alone_shares_the_reading(changes, per_trial):
     _held_speed_agrees(scene, held, errors, fast)
 
 
+@pytest.mark.parametrize("azimuths", [[0, 90, 180, 270], [90, 270]], ids=["4 beams", "2 beams"])
+@pytest.mark.parametrize("changes", SHARED_CASES.values(), ids=SHARED_CASES.keys())
+def test_a_nacelle_lidar_s_held_noise_shares_the_reading(changes, azimuths):
+    """A tilted mount's held noise shares the reading too (issue 25's speed line: the
+    run's motion-only speed is no second reconstruction): its level pair's (or 2 beams')
+    held corrected velocities are kept beside its own and solved with the held side's w,
+    so its held speed is bit for bit a separate evaluation with the noise replaced, the
+    other outputs (the shear exponent's kept rows among them) bit for bit a run without
+    `held`, and the numpy model's held speed to TOLERANCE."""
+    settings = load_scenario({"name": "t", **merged(BASE, {
+        **NACELLE, "lidar.azimuths": azimuths, **changes})}).settings
+    scene = scene_from_settings(settings)
+    inputs = error_inputs(settings, scene.n_beams, len(scene.ranges))
+    random = input_set({k: v for k, v in inputs.items() if not isinstance(v, float)})
+    rng = np.random.default_rng(9)
+    errors = random.values(rng.standard_normal((300, random.dimension)))
+    held = {"lidar_radial_velocity": rng.normal(0.0, 0.3, errors["lidar_radial_velocity"].shape)}
+    outputs = NACELLE_OUTPUTS if 0 in azimuths else NACELLE_OUTPUTS[:-1]
+    before = fusedmotion.HELD_PATHS.copy()
+    fast = measurement_model(scene, outputs, held=held, **errors)
+    assert fusedmotion.HELD_PATHS - before == {"shared reading": 1}
+    _held_speed_agrees(scene, held, errors, fast)
+    plain = measurement_model(scene, outputs, **errors)
+    for q in outputs:                       # (the shear exponent's too)
+        np.testing.assert_array_equal(fast[q], plain[q])
+
+
 def test_a_held_reading_error_is_a_second_reconstruction():
     """An INS error held at a value other than the run's (here an absent one held away from
     0) changes the reading: no shared factor, a second reconstruction."""

@@ -36,7 +36,8 @@ import math
 
 import numpy as np
 
-from uq.constants import FULL_CIRCLE_DEG, MOTION_BLOCK_TRIALS, MOTION_BLOCK_VALUES
+from uq.constants import (FULL_CIRCLE_DEG, MOTION_BLOCK_ROW_PAD, MOTION_BLOCK_TRIALS,
+                          MOTION_BLOCK_VALUES)
 from uq.physics import fusedmotionkernels as kernels
 from uq.physics import fusedprobe
 from uq.physics import probe as probe_volume
@@ -108,8 +109,8 @@ def measurement_model(scene, outputs, scene_draws=False, held=None, **errors):
     outputs: each (n, *S, n_gates) for a batch of scenes of shape S, evaluated one scene
     after the other; with `scene_draws` each scene takes its own slice of the inputs).
     `held` (inputs -> scalar): the wind speed of the same trials with these inputs
-    replaced, ``wind_speed_held``; where the radial noise alone is held (an upward lidar,
-    :func:`shares_reading`) a second right-hand side of the same least squares in the
+    replaced, ``wind_speed_held``; where the radial noise alone is held
+    (:func:`shares_reading`) a second right-hand side of the same least squares in the
     same reconstruction, else where no input of the truth is held
     (:func:`shares_kinematics`) a second reconstruction per block on the same
     kinematics, else a second evaluation (:data:`HELD_PATHS` counts which)."""
@@ -143,10 +144,20 @@ def _mounted_layout(scene, outputs):
     MOUNTED_LAYOUT`), None for an upward lidar."""
     if scene.tilt == 0:
         return None
-    pair = None if scene.horizontal_only else nacelle.level_pair(scene.azimuths)
     upper_lower = nacelle.upper_lower(scene.azimuths) if "shear_exponent" in outputs else None
-    return np.array([*(pair or (-1, -1)), *(upper_lower or (-1, -1)),
-                     int("shear_exponent" in outputs)], dtype=np.int64)
+    return np.array([*(upper_lower or (-1, -1)), int("shear_exponent" in outputs)],
+                    dtype=np.int64)
+
+
+def _level_beams(scene):
+    """The beams of a tilted mount's horizontal solve (HEAD ``level_first``,
+    ``level_second``): its two beams, or the level pair (clock 90 and 270); (-1, -1)
+    for none and for an upward lidar."""
+    if scene.tilt == 0:
+        return -1, -1
+    if scene.horizontal_only:
+        return 0, 1
+    return nacelle.level_pair(scene.azimuths) or (-1, -1)
 
 
 #: Inputs of the truth (:func:`uq.physics.fusedmotionkernels.kinematics` and a probe's
@@ -312,6 +323,7 @@ def _scene_plan(scene):
             "has_arm": bool(np.any(arm != 0)), "probe": scene.probe is not None,
             "mounted": scene.tilt != 0, "tilt_cos": math.cos(scene.tilt),
             "tilt_sin": math.sin(scene.tilt)}
+    head["level_first"], head["level_second"] = _level_beams(scene)
     consts = np.array([head[name] if name in head else getattr(scene, name)
                        for name in kernels.HEAD], dtype=float)
     return Plan(consts=consts, pairs=np.array(pairs, dtype=np.int64).reshape(-1, 2),
@@ -363,22 +375,24 @@ def _reconstruction_inputs(errors, n):
 def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     """The outputs of one scene into `into` (name -> (n, gates) view), block by block
     (with a `probe` volume: its weighted speed, :mod:`uq.physics.fusedprobe`; a tilted
-    mount's `layout`: its reconstruction, :func:`~uq.physics.fusedmotionkernels.
+    mount's `layout`: its horizontal wind in :func:`~uq.physics.fusedmotionkernels.
+    reconstruct`, its shear exponent by :func:`~uq.physics.fusedmotionkernels.
     mounted_wind`); with `held` (inputs of the reconstruction alone -> scalar) the
     speed reconstructed from the same truth with those inputs replaced, into
-    ``into["wind_speed_held"]``: with the reading shared (:func:`shares_reading`, an
-    upward lidar) in the same reconstruction, as a second right-hand side of its least
+    ``into["wind_speed_held"]``: with the reading shared (:func:`shares_reading`) in
+    the same reconstruction, as a second right-hand side of its least
     squares, else by a second reconstruction."""
     consts = plan.consts
     if layout is not None and layout[-1]:   # the shear exponent: the believed lift too
         consts = consts.copy()
         consts[kernels.HEAD.index("mounted")] = 2.0
-    mounted = kernels.compiled_mounted_wind() if layout is not None else None
+    # a tilted mount's shear exponent (its horizontal wind is reconstruct's): one pass
+    mounted = kernels.compiled_mounted_wind() if layout is not None and layout[-1] else None
     n_beams, n_gates = plan.slant.shape
     n_nodes = len(plan.weights)
     ins, has, noise = _reconstruction_inputs(errors, n)
     second = None if held is None else _reconstruction_inputs({**errors, **held}, n)
-    shared = second is not None and layout is None and shares_reading(held, errors)
+    shared = second is not None and shares_reading(held, errors)
     if second is not None:
         HELD_PATHS["shared reading" if shared else "second reconstruction"] += 1
     phases = _phase_input(errors.get("motion_phases"), plan.n_phases)
@@ -386,21 +400,20 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
     geometry = [_column(errors.get(name)) for name in _GEOMETRY]
     m = min(block_trials(plan, probe.nodes if probe is not None else 0), max(n, 1))
     n_components = max(1, len(plan.components))
-    work = np.empty((kernels.WORK_ROWS, m))
-    c, turned = np.empty((2, n_components, m)), np.empty((2, n_components, m))
     at_nodes = plan.at_nodes and not has[kernels.INPUTS.index("ins_clock_offset")]
-    states = np.empty((n_beams if at_nodes else 1, kernels.STATE_ROWS, m))
-    ship_beams = np.empty((n_beams, 3, m))
-    parts = np.empty((2, n_beams * n_nodes, m))
-    ratio = np.empty((n_beams * n_nodes, n_gates, m))
-    normal = np.empty((6 + 3 * n_gates + (0 if layout is None else
-                                          5 * n_beams + n_beams * n_gates)
-                       + (3 * n_gates if shared else 0), m))
+    shear_rows = layout is not None and layout[-1]
+    (work, c, turned, states, ship_beams, parts, ratio, out, speed, vertical, *rest,
+     normal) = block_scratch(m, [
+        (kernels.WORK_ROWS,), (2, n_components), (2, n_components),
+        (n_beams if at_nodes else 1, kernels.STATE_ROWS), (n_beams, 3),
+        (2, n_beams * n_nodes), (n_beams * n_nodes, n_gates), (3, n_gates), (n_gates,),
+        (n_gates,), *([(3, n_gates)] if shared else []), *([(n_gates,)] if shear_rows else []),
+        (6 + 3 * n_gates + (0 if layout is None else       # (reconstruct's rows)
+                            5 * n_beams + n_beams * n_gates * (2 if shared else 1))
+         + (3 * n_gates if shared else 0),)])
+    held_out = rest.pop(0) if shared else np.empty((0, 1, 1))
+    shear_out = rest.pop(0) if shear_rows else None
     held_noise = second[2] if shared else noise
-    held_out = np.empty((3, n_gates, m) if shared else (0, 1, 1))
-    shear_out = np.empty((n_gates, m)) if layout is not None and layout[-1] else None
-    out = np.empty((3, n_gates, m))
-    speed, vertical = np.empty((n_gates, m)), np.empty((n_gates, m))
     shear = consts[kernels.HEAD.index("shear")]
     beam_up = np.empty((n_beams * n_nodes, m)) if probe is not None else np.empty((1, 1))
     if probe is not None:
@@ -425,9 +438,9 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
                             plan.read_table, plan.stamps, plan.beams, plan.operator,
                             plan.weights, ins, has, noise, start, count, work, c, turned,
                             states, parts, ratio, normal, out, held_noise, held_out)
-        if layout is not None:                      # a tilted mount's reconstruction
-            mounted(consts, layout, plan.beams, plan.slant, work, normal, count, out,
-                    shear_out if shear_out is not None else speed, speed, vertical)
+        if mounted is not None:                     # a tilted mount's shear exponent
+            mounted(consts, layout, plan.slant, normal, count, out, shear_out, speed,
+                    vertical)
         else:
             kernels.wind_speed(out, count, speed, vertical)
         stop = start + count
@@ -452,12 +465,32 @@ def _evaluate(plan, errors, n, into, probe=None, layout=None, held=None):
                                 plan.read_table, plan.stamps, plan.beams, plan.operator,
                                 plan.weights, *second, start, count, work, c, turned,
                                 states, parts, ratio, normal, out, noise, _NO_HELD)
-            if layout is not None:                  # (the shear row is stored already)
-                mounted(consts, layout, plan.beams, plan.slant, work, normal, count, out,
-                        shear_out if shear_out is not None else speed, speed, vertical)
+            if mounted is not None:                 # (the shear row is stored already)
+                mounted(consts, layout, plan.slant, normal, count, out, speed, speed,
+                        vertical)
             else:
                 kernels.wind_speed(out, count, speed, vertical)
             into[HELD_WIND_SPEED][start:stop] = speed[:, :count].T
+
+
+def block_scratch(m, shapes):
+    """The block scratch of :func:`_evaluate`: an array (*shape, m + pad) per shape, one
+    after the other in one buffer whose first row is 64-byte aligned, each row
+    :data:`~uq.constants.MOTION_BLOCK_ROW_PAD` values longer than the block's m trials
+    (the loops use the first m): rows of 2^k values let a store and a later load of
+    another row meet at the same address modulo 4 KiB, which the CPU takes for a
+    dependence (4K aliasing), at places that depended on where each array happened to
+    be allocated. The same placement in every process; with m a power of two, rows
+    fewer than 64 apart never share their address modulo 4 KiB."""
+    width = m + MOTION_BLOCK_ROW_PAD
+    sizes = [math.prod(shape) * width for shape in shapes]
+    buffer = np.empty(sum(sizes) + 8)
+    at = (-buffer.ctypes.data // 8) % 8                 # to the 64-byte line
+    arrays = []
+    for shape, size in zip(shapes, sizes):
+        arrays.append(buffer[at:at + size].reshape(*shape, width))
+        at += size
+    return arrays
 
 
 #: ``held_out`` of :func:`~uq.physics.fusedmotionkernels.reconstruct` without a held side.

@@ -67,18 +67,21 @@ _ASIN = tuple(math.comb(2 * k, k) / (4 ** k * (2 * k + 1)) for k in range(26))
 _SINC = tuple((-1) ** k / math.factorial(2 * k + 1) for k in range(10))
 _COSC = tuple((-1) ** k / math.factorial(2 * k + 2) for k in range(10))
 
-#: The scene vector (:func:`uq.physics.fusedmotion.scene_plan`): these scalars by index.
+#: The scene vector (:func:`uq.physics.fusedmotion.scene_plan`): these scalars by index
+#: (``level_first``, ``level_second``: the beams of a tilted mount's horizontal solve, the
+#: two beams of a 2-beam mount or the level pair at clock 90 and 270; -1: none).
 HEAD = ("n_beams", "n_gates", "n_nodes", "n_slanted", "model", "ins_mode", "rate",
         "heading", "pitch", "roll", "lidar_height", "wind_speed", "reference_height", "shear",
         "to_north", "to_east", "vertical_wind", "ship_north", "ship_east", "ship_up",
         "level_cos", "level_sin", "course_cos", "course_sin", "arm_bow", "arm_starboard",
         "arm_up", "static_arm_up", "half_cone", "misalignment", "moves_yaw", "has_arm", "probe",
-        "mounted", "tilt_cos", "tilt_sin")
+        "mounted", "tilt_cos", "tilt_sin", "level_first", "level_second")
 (_N_BEAMS, _N_GATES, _N_NODES, _N_SLANTED, _MODEL, _INS_MODE, _RATE, _HEADING, _PITCH, _ROLL,
  _LIDAR_HEIGHT, _WIND_SPEED, _REFERENCE_HEIGHT, _SHEAR, _TO_NORTH, _TO_EAST, _VERTICAL_WIND,
  _SHIP_NORTH, _SHIP_EAST, _SHIP_UP, _LEVEL_COS, _LEVEL_SIN, _COURSE_COS, _COURSE_SIN,
  _ARM_BOW, _ARM_STARBOARD, _ARM_UP, _STATIC_ARM_UP, _HALF_CONE, _MISALIGNMENT, _MOVES_YAW,
- _HAS_ARM, _PROBE, _MOUNTED, _TILT_COS, _TILT_SIN) = range(len(HEAD))
+ _HAS_ARM, _PROBE, _MOUNTED, _TILT_COS, _TILT_SIN, _LEVEL_FIRST, _LEVEL_SECOND) = \
+    range(len(HEAD))
 
 #: Correction models: the codes NONE ... POINTWISE of
 #: :class:`uq.physics.modelinputs.Correction` (:mod:`uq.physics.kernelbase`); INS modes.
@@ -113,6 +116,13 @@ WORK, WORK_ROWS = row_layout(WORK_BLOCKS)
 
 
 _helper = njit(cache=True, nogil=True, error_model="numpy")
+#: Compile-time notes (issue 26, cold first runs), kept by every kernel here:
+#: - numba compiles a jitted callee once per distinct *literal* argument (a module-level
+#:   int or a True/False written at the call), so row numbers and flags are passed as
+#:   values (np.int64(...), a comparison), one compile per helper;
+#: - a row is copied by a loop, not ``a[i, :n] = b[k, :n]``: an array-to-array slice
+#:   assignment compiles numba's shape-mismatch error (its message built from strings,
+#:   ~1.7 s of CPU on the first run) though the shapes here always agree.
 #: How the kernels' helpers are compiled (as in :mod:`uq.physics.fusedkernels`): the
 #: small ones (trig, rotations, the rotation-group interpolation) as functions of their
 #: own that LLVM inlines where it pays, not numba's ``inline="always"``, which re-runs
@@ -134,7 +144,7 @@ def _kernel(signature):
 def _head(consts):
     """The scalars of :data:`HEAD` as a tuple: values, not memory, so that loops reading
     them need no alias checks against the arrays they write."""
-    return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31], consts[32], consts[33], consts[34], consts[35])
+    return (consts[0], consts[1], consts[2], consts[3], consts[4], consts[5], consts[6], consts[7], consts[8], consts[9], consts[10], consts[11], consts[12], consts[13], consts[14], consts[15], consts[16], consts[17], consts[18], consts[19], consts[20], consts[21], consts[22], consts[23], consts[24], consts[25], consts[26], consts[27], consts[28], consts[29], consts[30], consts[31], consts[32], consts[33], consts[34], consts[35], consts[36], consts[37])
 
 
 @_called
@@ -239,7 +249,7 @@ def _turn_phases(components, c, work, count, turned):
         w = components[k, 0]
         for j in range(count):
             work[_ANGLE, j] = w * work[_SHIFT, j]
-        sincos_rows(work, _ANGLE, _SINE, _COSINE, count)
+        sincos_rows(work, np.int64(_ANGLE), np.int64(_SINE), np.int64(_COSINE), count)
         for j in range(count):
             c1, c2 = c[0, k, j], c[1, k, j]
             cosine, sine = work[_COSINE, j], work[_SINE, j]
@@ -272,7 +282,7 @@ def _geometry_angle(base, error, start, count, work, row):
     """work[row], work[row + 1] = cos, sin of base + error [deg] (error (n or 1,))."""
     for j in range(count):
         work[_ANGLE, j] = base + error[start + j if error.shape[0] > 1 else 0] * _DEG
-    sincos_rows(work, _ANGLE, row + 1, row, count)
+    sincos_rows(work, np.int64(_ANGLE), row + 1, row, count)
 
 
 @_helper
@@ -429,12 +439,8 @@ def kinematics(consts, pairs, amplitudes, components, sources, phases, window, n
             node = b * n_nodes + q
             _motion(pairs, amplitudes, node_table, node, c, state, count)
             _attitude_trig(consts, state, work, count, yaw)
-            if yaw:
-                for j in range(count):
-                    _truth_at(head, state, work, ship_beams, parts, b, node, j, False, True)
-            else:
-                for j in range(count):
-                    _truth_at(head, state, work, ship_beams, parts, b, node, j, False, False)
+            for j in range(count):
+                _truth_at(head, state, work, ship_beams, parts, b, node, j, False, yaw)
             for j in range(count):                    # beyond the reduction (and NaN): libm
                 if not work[_BIG, j] <= SINCOS_REDUCTION_LIMIT:
                     _truth_at(head, state, work, ship_beams, parts, b, node, j, True, yaw)
@@ -531,13 +537,13 @@ def _attitude_rows(consts, state, work, count, row, with_errors):
         if with_errors:
             for j in range(count):
                 work[_ANGLE, j] += work[_ERROR + i, j]
-        sincos_rows(work, _ANGLE, row + 2 * i + 1, row + 2 * i, count)
+        sincos_rows(work, np.int64(_ANGLE), row + 2 * i + 1, row + 2 * i, count)
 
 
 @_helper
 def _sample_matrix(consts, state, work, count, row):
     """The attitude of an INS sample (its values in state) as a row-major matrix."""
-    _attitude_rows(consts, state, work, count, _READ_TRIG, False)
+    _attitude_rows(consts, state, work, count, np.int64(_READ_TRIG), count < 0)  # (False)
     for j in range(count):
         ch, sh = work[_READ_TRIG, j], work[_READ_TRIG + 1, j]
         cp, sp = work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j]
@@ -606,7 +612,7 @@ def _error_rows(errors, has, start, count, k, work):
             for j in range(count):
                 work[row, j] = error[start + j, col] * scale
         if i == 4:
-            sincos_rows(work, _ANGLE, _COG + 1, _COG, count)
+            sincos_rows(work, np.int64(_ANGLE), np.int64(_COG + 1), np.int64(_COG), count)
 
 
 @_helper
@@ -626,20 +632,21 @@ def _reading(consts, pairs, amplitudes, components, read_table, stamps, k, c, tu
         _motion(pairs, amplitudes, read_table, k, c, state, count)
     else:                                   # the INS samples at offset + i / rate
         clock, offset = errors[_CLOCK][:, 0], errors[_OFFSET][:, 0]
-        _sample_times(stamp, clock, offset, rate, 0, mode, start, count, work)
+        _sample_times(stamp, clock, offset, rate, np.int64(0), mode, start, count, work)
         _turn_phases(components, c, work, count, turned)
         _motion(pairs, amplitudes, read_table, k, turned, state, count)
         if mode == LINEAR:                  # keep the first sample; then the second
-            _sample_matrix(consts, state, work, count, _MATRIX1)
+            _sample_matrix(consts, state, work, count, np.int64(_MATRIX1))
             for j in range(count):
                 work[_VELOCITY1, j], work[_VELOCITY1 + 1, j], work[_VELOCITY1 + 2, j] = \
                     _ins_velocity(head, state, j)
             for i in range(3):
-                work[_RATES1 + i, :count] = state[_RATE_ROW + 2 - i, :count]
-            _sample_times(stamp, clock, offset, rate, 1, mode, start, count, work)
+                for j in range(count):      # (a loop, not a slice: the notes above)
+                    work[_RATES1 + i, j] = state[_RATE_ROW + 2 - i, j]
+            _sample_times(stamp, clock, offset, rate, np.int64(1), mode, start, count, work)
             _turn_phases(components, c, work, count, turned)
             _motion(pairs, amplitudes, read_table, k, turned, state, count)
-            _sample_matrix(consts, state, work, count, _MATRIX2)
+            _sample_matrix(consts, state, work, count, np.int64(_MATRIX2))
             for j in range(count):          # rates and velocity linearly, with errors
                 a = work[_FRACTION, j]
                 for i in range(3):
@@ -654,7 +661,7 @@ def _reading(consts, pairs, amplitudes, components, read_table, stamps, k, c, tu
             _slerp(work, count)
             for i in range(3):              # (cos, sin) of the slerp's angle + error
                 if has[i]:
-                    sincos_rows(work, _ERROR + i, _SINE, _COSINE, count)
+                    sincos_rows(work, _ERROR + i, np.int64(_SINE), np.int64(_COSINE), count)
                     row = _READ_TRIG + 2 * i
                     for j in range(count):
                         co, si = work[row, j], work[row + 1, j]
@@ -669,7 +676,7 @@ def _read_rows(consts, state, work, count):
     """The (cos, sin) of a reading's attitude with its errors (rows _READ_TRIG) and its
     velocity with its errors (_READ_VELOCITY), from the state :func:`_reading` left."""
     head = _head(consts)
-    _attitude_rows(consts, state, work, count, _READ_TRIG, True)
+    _attitude_rows(consts, state, work, count, np.int64(_READ_TRIG), count >= 0)  # (True)
     for j in range(count):
         vn, ve, vu = _ins_velocity(head, state, j)
         work[_READ_VELOCITY, j], work[_READ_VELOCITY + 1, j], work[_READ_VELOCITY + 2, j] = \
@@ -766,21 +773,12 @@ def _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, sour
     """:func:`_pointwise_at` for the block's trials: the read rotation of (nx, ny, nz)
     into rows _BEAM, the lidar velocity along it into _ALONG."""
     head = _head(consts)
-    if source == FROM_ROWS:
-        for j in range(count):
-            _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_ROWS)
-    elif source == FROM_STATE and head[_HAS_ARM] == 0:
+    if source == FROM_STATE and head[_HAS_ARM] == 0:
         _pointwise_from_state(head, state, work, nx, ny, nz, count)
-    elif source == FROM_STATE:
-        for j in range(count):
-            _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_STATE)
-    else:
-        if heading_varies:
-            for j in range(count):
-                _pointwise_at(head, state, work, nx, ny, nz, j, False, True, FROM_ANGLES)
-        else:
-            for j in range(count):
-                _pointwise_at(head, state, work, nx, ny, nz, j, False, False, FROM_ANGLES)
+        return
+    for j in range(count):                  # (one inlined copy, `source` a value: LLVM
+        _pointwise_at(head, state, work, nx, ny, nz, j, False, heading_varies, source)
+    if source == FROM_ANGLES:               # unswitches the loop on it)
         for j in range(count):
             if not work[_BIG, j] <= SINCOS_REDUCTION_LIMIT:
                 _pointwise_at(head, state, work, nx, ny, nz, j, True, heading_varies,
@@ -790,26 +788,28 @@ def _pointwise_rows(consts, state, work, nx, ny, nz, count, heading_varies, sour
 @_helper
 def _store_reading(consts, state, work, normal, row, count, heading_varies, source):
     """A point-wise reading of a tilted mount into normal[row ..]: the believed beam
-    (rows _BEAM), the velocity along it (_ALONG) and, for the shear exponent's believed
-    heights alone (HEAD mounted 2), the lidar's lift ``[(R_read - R_static) r]_up``
+    (rows _BEAM; the velocity along it enters the corrected radial velocity that
+    :func:`reconstruct` keeps) and, for the shear exponent's believed heights alone
+    (HEAD mounted 2), the lidar's lift ``[(R_read - R_static) r]_up`` into row + 4
     through the lever arm r (:func:`uq.physics.timeresolved._lever_arm_lift`; 0 without
     one)."""
-    for j in range(count):                  # (a loop, not four slices: their views
+    for j in range(count):                  # (a loop, not three slices: their views
         normal[row, j] = work[_BEAM, j]     # cost more than the copy of a block)
         normal[row + 1, j] = work[_BEAM + 1, j]
         normal[row + 2, j] = work[_BEAM + 2, j]
-        normal[row + 3, j] = work[_ALONG, j]
     if consts[_MOUNTED] < 2:                # the lift is the shear's alone (HEAD mounted 2)
         return
     normal[row + 4, :count] = 0.0
     if consts[_HAS_ARM] > 0:
+        for j in range(count):              # (kept while the arm's rows are made)
+            normal[row + 3, j] = work[_ALONG, j]
         _pointwise_rows(consts, state, work, consts[_ARM_BOW], consts[_ARM_STARBOARD],
                         consts[_ARM_UP], count, heading_varies, source)
         for j in range(count):              # the reading's rotation of the arm
             normal[row + 4, j] = work[_BEAM + 2, j] - consts[_STATIC_ARM_UP]
-        for i in range(3):                  # the beam's rows back for the least squares
-            work[_BEAM + i, :count] = normal[row + i, :count]
-        work[_ALONG, :count] = normal[row + 3, :count]
+        for j in range(count):              # the beam's rows back for the least squares
+            work[_BEAM, j], work[_BEAM + 1, j] = normal[row, j], normal[row + 1, j]
+            work[_BEAM + 2, j], work[_ALONG, j] = normal[row + 2, j], normal[row + 3, j]
 
 
 @_helper
@@ -846,6 +846,21 @@ def _substitute(normal, row, n_gates, count, out):
 
 
 @_helper
+def _substitute_vertical(normal, row, n_gates, count, out):
+    """out[2, g] of :func:`_substitute` alone (the same operations: bit for bit its up
+    component), where a tilted mount's level pair gives north and east."""
+    for g in range(n_gates):
+        first = row + 3 * g
+        for j in range(count):
+            l00, l10, l20 = normal[0, j], normal[1, j], normal[2, j]
+            l11, l21, l22 = normal[3, j], normal[4, j], normal[5, j]
+            y0 = normal[first, j] / l00
+            y1 = (normal[first + 1, j] - l10 * y0) / l11
+            y2 = (normal[first + 2, j] - l20 * y0 - l21 * y1) / l22
+            out[2, g, j] = y2 / l22
+
+
+@_helper
 def _scan_correction(consts, model, work, normal, row, n_gates, count, out):
     """Eq. 13 of Rubio and Gottschall (2022) with the scan's one reading
     (:mod:`uq.physics.correction`): ``none`` turns by the configured heading, ``yaw`` by
@@ -877,14 +892,21 @@ def _scan_correction(consts, model, work, normal, row, n_gates, count, out):
 
 
 @_helper
-def _held_rows(work, held_noise, start, count, b, g, pointwise, operator, normal, row):
+def _held_rows(work, held_noise, start, count, b, g, pointwise, operator, normal, row, keep):
     """The held right-hand side of beam b, gate g (:func:`reconstruct`): the dwell mean
     in work[_MEASURED] plus the held noise, corrected point-wise by the reading's beam
     and velocity along it (rows _BEAM, _ALONG), or through A^+, into rows row .. row + 2
-    (the operations of the main side's, in its order)."""
+    (the operations of the main side's, in its order); and a tilted mount's kept beam's
+    corrected (one reading per scan: measured) radial velocity into row `keep` (-1:
+    none), as the main side keeps its own."""
     beam = b if held_noise.shape[1] > 1 else 0
     gate = g if held_noise.shape[2] > 1 else 0
     per_trial = held_noise.shape[0] > 1
+    if keep >= 0:
+        for j in range(count):
+            measured = work[_MEASURED, j] + held_noise[start + j if per_trial else 0, beam,
+                                                       gate]
+            normal[keep, j] = measured + work[_ALONG, j] if pointwise else measured
     if pointwise:
         for j in range(count):
             noise = held_noise[start + j if per_trial else 0, beam, gate]
@@ -902,6 +924,90 @@ def _held_rows(work, held_noise, start, count, b, g, pointwise, operator, normal
             normal[row + 2, j] += o2 * measured
 
 
+@_called
+def _inverse2(a00, a01, a10, a11):
+    """The inverse of ``[[a00, a01], [a10, a11]]`` by Cramer's rule (the systems here are
+    well conditioned: ~cot(half-cone), :func:`uq.physics.fusedkernels._inverse2`)."""
+    scale = 1.0 / (a00 * a11 - a01 * a10)
+    return a11 * scale, -a01 * scale, -a10 * scale, a00 * scale
+
+
+@_helper
+def _level_wind(consts, model, beams, work, normal, stored, measured, n_gates, count, out):
+    """A tilted (nacelle) mount's horizontal wind of trials [0, count), at the end of
+    :func:`reconstruct` (whose `normal` then holds the kept beams' believed beams from
+    row `stored` (point-wise; 5 rows per beam) and their corrected radial velocities from
+    row `measured` (k g + gate; one reading per scan: the measured ones, corrected here);
+    its `work` the scan's reading; `out` the 3-D solve's wind, of the main side or the
+    held noise's).
+
+    Each beam's believed earth-frame beam ``b_k`` (the point-wise reading's, or the
+    scan's rotation of the configured beam as the correction model believes it) and
+    its corrected radial velocity ``c_k = v_k + b_k . s`` (s: the velocity the model
+    removes). 2 beams (HEAD level_first, level_second 0 and 1): the horizontal least
+    squares ``b_k,h . u_h = c_k``, w = 0 assumed; with the level pair: the hub-height
+    horizontal wind ``b_k,h . u_h = c_k - b_k,up w`` with the w of `out`
+    (:mod:`uq.physics.nacelle`); other layouts keep `out`. Inside :func:`reconstruct`
+    and on as few rows as it can (the inverse of each 2 x 2 system made again per gate,
+    not kept): a pass of its own per block read its rows back from beyond the cache
+    (issue 25's speed line). Loops over the trials innermost (SIMD)."""
+    n_beams = int(consts[_N_BEAMS])
+    level_a, level_b = int(consts[_LEVEL_FIRST]), int(consts[_LEVEL_SECOND])
+    keep_all = consts[_MOUNTED] > 1         # the shear's beams too, and their lift
+    if model != POINTWISE:                  # the scan's reading (_scan_correction's rows)
+        full = model == FULL
+        for b in range(n_beams):
+            if not (keep_all or b == level_a or b == level_b):
+                continue
+            nx, ny, nz = beams[b, 0], beams[b, 1], beams[b, 2]
+            row = stored + 5 * b
+            for j in range(count):
+                bx, by, bz = rotate(work[_READ_TRIG, j], work[_READ_TRIG + 1, j],
+                                    work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j],
+                                    work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j],
+                                    nx, ny, nz)
+                vu = work[_READ_VELOCITY + 2, j] if full else 0.0
+                normal[row, j], normal[row + 1, j], normal[row + 2, j] = bx, by, bz
+                normal[row + 3, j] = bx * work[_READ_VELOCITY, j] + \
+                    by * work[_READ_VELOCITY + 1, j] + bz * vu
+            for g in range(n_gates):        # corrected: c = v + b . s
+                corrected = measured + b * n_gates + g
+                for j in range(count):
+                    normal[corrected, j] = normal[corrected, j] + normal[row + 3, j]
+            if keep_all:                    # the scan's reading lifts no beam
+                normal[row + 4, :count] = 0.0
+    if level_a < 0:
+        return
+    first, second = stored + 5 * level_a, stored + 5 * level_b
+    # the last beam's believed beam is still in work's rows _BEAM (point-wise, no lift)
+    last = model == POINTWISE and level_b == n_beams - 1 and not keep_all
+    rows = work if last else normal
+    second = _BEAM if last else second
+    for g in range(n_gates):
+        c_first, c_second = measured + level_a * n_gates + g, measured + level_b * n_gates + g
+        if n_beams == 2:                    # the horizontal normal equations
+            for j in range(count):
+                n00, n01 = normal[first, j], normal[first + 1, j]
+                n10, n11 = rows[second, j], rows[second + 1, j]
+                i00, i01, i10, i11 = _inverse2(n00 * n00 + n10 * n10, n00 * n01 + n10 * n11,
+                                               n00 * n01 + n10 * n11, n01 * n01 + n11 * n11)
+                c0, c1 = normal[c_first, j], normal[c_second, j]
+                r0 = n00 * c0 + n10 * c1
+                r1 = n01 * c0 + n11 * c1
+                out[0, g, j] = i00 * r0 + i01 * r1
+                out[1, g, j] = i10 * r0 + i11 * r1
+                out[2, g, j] = 0.0
+        else:
+            for j in range(count):
+                i00, i01, i10, i11 = _inverse2(normal[first, j], normal[first + 1, j],
+                                               rows[second, j], rows[second + 1, j])
+                up = out[2, g, j]
+                r0 = normal[c_first, j] - normal[first + 2, j] * up
+                r1 = normal[c_second, j] - rows[second + 2, j] * up
+                out[0, g, j] = i00 * r0 + i01 * r1
+                out[1, g, j] = i10 * r0 + i11 * r1
+
+
 @_kernel(f"void({_CV}, {_IM}, {_CM}, {_CM}, {_CT}, {_CV}, {_CM}, {_CM}, {_CV}, "
          f"UniTuple({_M}, 8), int64[::1], {_T}, int64, int64, {_CM}, {_CT}, {_CT}, {_CT}, "
          f"{_CT}, {_CT}, {_CM}, {_CT}, {_T}, {_CT})")
@@ -914,15 +1020,17 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
     ratio of :func:`kinematics`); ``errors`` the INS inputs of :data:`INPUTS`, each (n or
     1, k or 1), ``has`` which are given; ``states`` one per beam when the point-wise
     readings are the truth's nodes (from :func:`kinematics`), else one of scratch;
-    ``normal`` (6 + 3 g, trials) scratch for the least squares. Writes ``out[0, g]``
-    north, ``out[1, g]`` east, ``out[2, g]`` up [m s-1].
+    ``normal`` (6 + 3 g, trials) scratch for the least squares (a tilted mount's
+    (HEAD mounted): 5 b + b g more for :func:`_level_wind`, and b g more with a held
+    side). Writes ``out[0, g]`` north, ``out[1, g]`` east, ``out[2, g]`` up [m s-1].
 
-    With a ``held_out`` of 3 rows (an upward lidar only: 0 rows otherwise), also the wind
-    of the same trials with the radial noise ``held_noise`` (shaped as ``noise``) in
-    place of ``noise`` and every other input the same: the same reading, so the same
-    believed beams and least-squares factor, with a second right-hand side (the last 3 g
-    rows of ``normal``) accumulated beside the first, in the same order of operations as
-    a call with ``held_noise`` as its noise (so bit for bit its result).
+    With a ``held_out`` of 3 rows (0 rows otherwise), also the wind of the same trials
+    with the radial noise ``held_noise`` (shaped as ``noise``) in place of ``noise`` and
+    every other input the same: the same reading, so the same believed beams and
+    least-squares factor, with a second right-hand side (the last 3 g rows of
+    ``normal``; a tilted mount's held corrected velocities beside its own) accumulated
+    beside the first, in the same order of operations as a call with ``held_noise`` as
+    its noise (so bit for bit its result).
     """
     n_beams, n_gates, n_nodes = int(consts[_N_BEAMS]), int(consts[_N_GATES]), int(consts[_N_NODES])
     model, mode, speed_ref = int(consts[_MODEL]), int(consts[_INS_MODE]), consts[_WIND_SPEED]
@@ -948,18 +1056,26 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                         turned, errors, has, start, count, states[0], work):
             _read_rows(consts, states[0], work, count)
     heading_varies = consts[_MOVES_YAW] > 0 or has[0]
-    # a tilted mount (rows of `normal` beyond the least squares'): its reconstruction
-    # (:func:`mounted_wind`) keeps each beam's measured radial velocity and, point-wise,
-    # its believed beam, the velocity along it and the lidar's believed lift
+    # a tilted mount (rows of `normal` beyond the least squares'): its horizontal solve
+    # (:func:`_level_wind`, after the least squares) keeps the measured radial velocity
+    # and, point-wise, the believed beam and the velocity along it of the beams it
+    # solves with; for the shear exponent (HEAD mounted 2, :func:`mounted_wind`) every
+    # beam's, and the lidar's believed lift
     held = held_out.shape[0] > 0
-    second = normal.shape[0] - 3 * n_gates          # the held right-hand sides' rows
-    stored = 6 + 3 * n_gates if normal.shape[0] - (3 * n_gates if held else 0) > \
-        6 + 3 * n_gates else 0
+    stored = 6 + 3 * n_gates if consts[_MOUNTED] > 0 else 0     # a tilted mount's rows:
+    measured = stored + 5 * n_beams                 # 5 per beam, then the corrected radial
+    measured_held = measured + n_beams * n_gates    # velocities (b, g), then the held ones'
+    second = 6 + 3 * n_gates if stored == 0 else \
+        measured_held + (n_beams * n_gates if held else 0)   # the held right-hand sides
+    level_a, level_b = int(consts[_LEVEL_FIRST]), int(consts[_LEVEL_SECOND])
+    keep_all = consts[_MOUNTED] > 1
     normal[:6 + 3 * n_gates, :count] = 0.0          # the sums, not a tilted mount's kept
     #                                                 rows (each is written before read)
     if held:
-        normal[second:, :count] = 0.0               # the held right-hand sides' sums
+        normal[second:second + 3 * n_gates, :count] = 0.0   # the held right-hand sides' sums
     for b in range(n_beams):
+        kept = stored > 0 and (keep_all or b == level_a or b == level_b)
+        last = not keep_all and b == n_beams - 1          # (its beam stays in work's rows)
         if model == POINTWISE:          # this beam's own reading: the beam and velocity it implies
             state = states[b if at_nodes else 0]
             if at_nodes:                # the truth's motion is the reading's: errors only
@@ -971,7 +1087,7 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                 source = FROM_ROWS if written else FROM_ANGLES
             _pointwise(consts, state, work, normal, beams[b, 0], beams[b, 1], beams[b, 2],
                        count, heading_varies, source)
-            if stored:                  # a tilted mount's: the believed beam, the along
+            if kept and not last:       # a tilted mount's: the believed beam (and lift)
                 _store_reading(consts, state, work, normal, stored + 5 * b, count,
                                heading_varies, source)
         beam = b if noise.shape[1] > 1 else 0
@@ -984,7 +1100,8 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                                                     * parts[0, node, j] + parts[1, node, j])
             if held:                    # the same dwell mean, the held noise
                 _held_rows(work, held_noise, start, count, b, g, model == POINTWISE,
-                           operator, normal, second + 3 * g)
+                           operator, normal, second + 3 * g,
+                           measured_held + b * n_gates + g if kept else -1)
             gate = g if noise.shape[2] > 1 else 0
             if noise.shape[0] > 1:
                 for j in range(count):
@@ -992,9 +1109,14 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
             else:
                 for j in range(count):
                     work[_MEASURED, j] += noise[0, beam, gate]
-            if stored:                  # a tilted mount's: the measured radial velocity
-                normal[stored + 5 * n_beams + b * n_gates + g, :count] = \
-                    work[_MEASURED, :count]
+            if kept:                    # a tilted mount's: the corrected radial velocity
+                row = measured + b * n_gates + g                 # (or, one reading per
+                if model == POINTWISE:                          # scan, the measured one)
+                    for j in range(count):
+                        normal[row, j] = work[_MEASURED, j] + work[_ALONG, j]
+                else:
+                    for j in range(count):
+                        normal[row, j] = work[_MEASURED, j]
             if model == POINTWISE:
                 for j in range(count):
                     corrected = work[_MEASURED, j] + work[_ALONG, j]
@@ -1007,16 +1129,23 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                     normal[6 + 3 * g, j] += o0 * work[_MEASURED, j]
                     normal[7 + 3 * g, j] += o1 * work[_MEASURED, j]
                     normal[8 + 3 * g, j] += o2 * work[_MEASURED, j]
-    first = np.int64(6)                 # the sums' first row (not a literal: one compile)
-    if model == POINTWISE:
+    level = stored > 0 and level_a >= 0     # a tilted mount's horizontal solve replaces
+    alone = level and n_beams == 2          # the 3-D one's (north, east); with 2 beams it
+    if model == POINTWISE and not alone:    # alone (their B^T B is singular)
         _factor(normal, count)
-        _substitute(normal, first, n_gates, count, out)
-        if held:                                        # the same factor, the held sides
-            _substitute(normal, second, n_gates, count, held_out)
-    else:
-        _scan_correction(consts, model, work, normal, first, n_gates, count, out)
-        if held:
-            _scan_correction(consts, model, work, normal, second, n_gates, count, held_out)
+    for side in range(2 if held else 1):    # the wind, then the held noise's (the same
+        row = np.int64(6) if side == 0 else np.int64(second)       # factor, the held
+        into = out if side == 0 else held_out                        # right-hand sides)
+        if model == POINTWISE:
+            if level and not alone:         # the level pair's: the 3-D solve's w alone
+                _substitute_vertical(normal, row, n_gates, count, into)
+            elif not alone:
+                _substitute(normal, row, n_gates, count, into)
+        else:
+            _scan_correction(consts, model, work, normal, row, n_gates, count, into)
+        if stored:
+            _level_wind(consts, model, beams, work, normal, stored,
+                        measured if side == 0 else measured_held, n_gates, count, into)
 
 
 
@@ -1035,86 +1164,26 @@ def wind_speed(out, count, speed, vertical):
                 speed[g, j] = math.hypot(out[0, g, j], out[1, g, j])
 
 
-#: The layout vector of :func:`mounted_wind` (int64): the level pair (clock 90 and 270),
-#: the upper and lower beams (-1: none; :mod:`uq.physics.nacelle`) and whether the
-#: shear exponent is wanted.
-MOUNTED_LAYOUT = ("level_first", "level_second", "upper", "lower", "want_shear")
+#: The layout vector of :func:`mounted_wind` (int64): the upper and lower beams (-1:
+#: none; :mod:`uq.physics.nacelle`) and whether the shear exponent is wanted.
+MOUNTED_LAYOUT = ("upper", "lower", "want_shear")
 
 
-def mounted_wind(consts, layout, beams, slant, work, normal, count, out, shear, speed,
-                 vertical):
-    """A tilted (nacelle) mount's wind of trials [0, count), after :func:`reconstruct`
-    (whose `normal` then holds the measured radial velocities and, point-wise, each
-    beam's believed beam, velocity along it and lift; its `work` the scan's reading).
-
-    Each beam's believed earth-frame beam ``b_k`` (the point-wise reading's, or the
-    scan's rotation of the configured beam as the correction model believes it) and
-    its corrected radial velocity ``c_k = v_k + b_k . s`` (s: the velocity the model
-    removes). 2 beams: the horizontal least squares ``b_k,h . u_h = c_k``, w = 0
-    assumed; with the level pair: the hub-height horizontal wind ``b_k,h . u_h = c_k -
-    b_k,up w`` with the w of `out` (:mod:`uq.physics.nacelle`); other layouts keep
-    `out`. Writes out[:, g, j] and, wanted, ``shear[g, j] = ln(U_up / U_down) / ln(z_up /
-    z_down)``, ``U_k = c_k / (b_k,h . e)`` at the believed heights ``z_k = lidar height +
-    lift_k + slant b_k,up`` (NaN where a ratio is not positive); then the speed and the
-    vertical wind as :func:`wind_speed` (in this call: one call less per block, whose
-    Python and dispatch cost ~1.5 us, as much as the pass itself). Loops over the trials
-    innermost (SIMD); the 2 x 2 inverses in work's rows _MATRIX1 (free after
-    :func:`reconstruct`).
-    """
-    n_beams, n_gates, model = int(consts[_N_BEAMS]), int(consts[_N_GATES]), int(consts[_MODEL])
-    level_a, level_b, upper, lower = layout[0], layout[1], layout[2], layout[3]
+def mounted_wind(consts, layout, slant, normal, count, out, shear, speed, vertical):
+    """A tilted mount's shear exponent and wind speed of trials [0, count), after
+    :func:`reconstruct` (HEAD mounted 2: `normal` then holds every beam's believed beam,
+    lift and corrected radial velocities c_k, from row 6 + 3 g; `out` the hub-height wind
+    of :func:`_level_wind`): ``shear[g, j] = ln(U_up / U_down) /
+    ln(z_up / z_down)``, ``U_k = c_k / (b_k,h . e)`` at the believed heights ``z_k =
+    lidar height + lift_k + slant b_k,up`` (NaN where a ratio is not positive); then the
+    speed and the vertical wind as :func:`wind_speed` (in this call: one call less per
+    block, whose dispatch costs ~1 us)."""
+    n_beams, n_gates = int(consts[_N_BEAMS]), int(consts[_N_GATES])
+    upper, lower = layout[0], layout[1]
     stored = 6 + 3 * n_gates
     measured = stored + 5 * n_beams
-    if model != POINTWISE:                  # the scan's reading (_scan_correction's rows)
-        full = model == FULL
-        for b in range(n_beams):
-            nx, ny, nz = beams[b, 0], beams[b, 1], beams[b, 2]
-            row = stored + 5 * b
-            for j in range(count):
-                bx, by, bz = rotate(work[_READ_TRIG, j], work[_READ_TRIG + 1, j],
-                                    work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j],
-                                    work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j],
-                                    nx, ny, nz)
-                vu = work[_READ_VELOCITY + 2, j] if full else 0.0
-                normal[row, j], normal[row + 1, j], normal[row + 2, j] = bx, by, bz
-                normal[row + 3, j] = bx * work[_READ_VELOCITY, j] + \
-                    by * work[_READ_VELOCITY + 1, j] + bz * vu
-            if layout[4] > 0:               # the scan's reading lifts no beam
-                normal[row + 4, :count] = 0.0
-    first = stored + 5 * (0 if n_beams == 2 else level_a)
-    second = stored + 5 * (1 if n_beams == 2 else level_b)
-    inverse = _MATRIX1
-    if n_beams == 2 or level_a >= 0:
-        for j in range(count):
-            n00, n01 = normal[first, j], normal[first + 1, j]
-            n10, n11 = normal[second, j], normal[second + 1, j]
-            if n_beams == 2:                # the horizontal normal equations
-                n00, n01, n10, n11 = (n00 * n00 + n10 * n10, n00 * n01 + n10 * n11,
-                                      n00 * n01 + n10 * n11, n01 * n01 + n11 * n11)
-            i00, i01, i10, i11 = _inverse2(n00, n01, n10, n11)
-            work[inverse, j], work[inverse + 1, j] = i00, i01
-            work[inverse + 2, j], work[inverse + 3, j] = i10, i11
-    m_first = measured + (0 if n_beams == 2 else level_a) * n_gates
-    m_second = measured + (1 if n_beams == 2 else level_b) * n_gates
-    for g in range(n_gates):
-        if n_beams == 2:
-            for j in range(count):
-                c0 = normal[m_first + g, j] + normal[first + 3, j]
-                c1 = normal[m_second + g, j] + normal[second + 3, j]
-                r0 = normal[first, j] * c0 + normal[second, j] * c1
-                r1 = normal[first + 1, j] * c0 + normal[second + 1, j] * c1
-                out[0, g, j] = work[inverse, j] * r0 + work[inverse + 1, j] * r1
-                out[1, g, j] = work[inverse + 2, j] * r0 + work[inverse + 3, j] * r1
-                out[2, g, j] = 0.0
-        elif level_a >= 0:
-            for j in range(count):
-                up = out[2, g, j]
-                r0 = (normal[m_first + g, j] + normal[first + 3, j]) - normal[first + 2, j] * up
-                r1 = (normal[m_second + g, j] + normal[second + 3, j]) - \
-                    normal[second + 2, j] * up
-                out[0, g, j] = work[inverse, j] * r0 + work[inverse + 1, j] * r1
-                out[1, g, j] = work[inverse + 2, j] * r0 + work[inverse + 3, j] * r1
-        if layout[4] > 0:
+    if layout[2] > 0:
+        for g in range(n_gates):
             _shear_rows(consts, normal, stored, measured + upper * n_gates + g,
                         measured + lower * n_gates + g, stored + 5 * upper,
                         stored + 5 * lower, slant[upper, g], slant[lower, g], out, g, count,
@@ -1130,18 +1199,9 @@ def _shear_rows(consts, normal, stored, m_upper, m_lower, upper, lower, slant_up
     for j in range(count):
         shear[g, j] = _shear_exponent(
             out[0, g, j], out[1, g, j], normal[upper, j], normal[upper + 1, j],
-            normal[lower, j], normal[lower + 1, j],
-            normal[m_upper, j] + normal[upper + 3, j], normal[m_lower, j] + normal[lower + 3, j],
+            normal[lower, j], normal[lower + 1, j], normal[m_upper, j], normal[m_lower, j],
             (height + normal[upper + 4, j]) + slant_upper * normal[upper + 2, j],
             (height + normal[lower + 4, j]) + slant_lower * normal[lower + 2, j])
-
-
-@_called
-def _inverse2(a00, a01, a10, a11):
-    """The inverse of ``[[a00, a01], [a10, a11]]`` by Cramer's rule (the systems here are
-    well conditioned: ~cot(half-cone), :func:`uq.physics.fusedkernels._inverse2`)."""
-    scale = 1.0 / (a00 * a11 - a01 * a10)
-    return a11 * scale, -a01 * scale, -a10 * scale, a00 * scale
 
 
 @_called
@@ -1162,5 +1222,5 @@ def _shear_exponent(north, east, upper_north, upper_east, lower_north, lower_eas
 @functools.cache
 def compiled_mounted_wind():
     """:func:`mounted_wind` compiled on first use (a tilted mount's run alone pays it)."""
-    return _kernel(f"void({_CV}, int64[::1], {_CM}, {_CM}, {_CM}, {_CM}, int64, {_CT}, "
-                   f"{_CM}, {_CM}, {_CM})")(mounted_wind)
+    return _kernel(f"void({_CV}, int64[::1], {_CM}, {_CM}, int64, {_CT}, {_CM}, {_CM}, "
+                   f"{_CM})")(mounted_wind)
