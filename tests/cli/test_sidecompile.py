@@ -52,23 +52,42 @@ def test_compile_for_takes_overrides(monkeypatch):
 ])
 def test_wanted_only_where_it_can_help(monkeypatch, changes, cores, cached, expected):
     monkeypatch.setattr(sidecompile, "usable_cores", lambda: cores)
-    monkeypatch.setattr(sidecompile, "kernels_cached", lambda: cached)
+    monkeypatch.setattr(sidecompile, "kernels_cached", lambda motion: cached)
     scenario = load_scenario(scenario_path("sathe2011_ti"))
     assert sidecompile.wanted(_args(**changes), scenario) is expected
 
 
 def test_not_wanted_without_records(monkeypatch):
     monkeypatch.setattr(sidecompile, "usable_cores", lambda: 2)
-    monkeypatch.setattr(sidecompile, "kernels_cached", lambda: False)
+    monkeypatch.setattr(sidecompile, "kernels_cached", lambda motion: False)
     for name, changes in (("rubio2022_case_i", {}), ("sathe2011_ti", {"sampling.method": "none"})):
         scenario = load_scenario(scenario_path(name), changes)
         assert not sidecompile.wanted(_args(), scenario)
 
 
-def test_kernels_cached_once_the_wind_kernel_is_compiled():
+def test_the_stand_in_finds_the_kernel_s_own_cache_files():
+    from numba.core.caching import FunctionCache
+    from uq.physics import fusedkernels
+    real = FunctionCache(fusedkernels._KERNELS["wind_scan"][0])
+    found = FunctionCache(sidecompile._stand_in(*sidecompile.LARGEST_KERNELS[False]))
+    assert found._cache_file._index_path == real._cache_file._index_path
+
+
+@pytest.mark.parametrize("time_resolved", [False, True])
+def test_kernels_cached_once_the_largest_kernel_is_compiled(time_resolved):
     from uq.physics import fusedkernels
     fusedkernels.compiled(float)["wind_scan"]       # compiled or loaded: now in the cache
-    assert sidecompile.kernels_cached() is True
+    import uq.physics.fusedmotionkernels  # noqa: F401  (the same, on import)
+    assert sidecompile.kernels_cached(time_resolved) is True
+
+
+def test_wanted_asks_the_cache_of_the_run_s_kind(monkeypatch):
+    asked = []
+    monkeypatch.setattr(sidecompile, "usable_cores", lambda: 2)
+    monkeypatch.setattr(sidecompile, "kernels_cached", lambda motion: asked.append(motion))
+    for name in ("sathe2011_ti", "floating_lidar_ti"):
+        sidecompile.wanted(_args(), load_scenario(scenario_path(name)))
+    assert asked == [False, True]
 
 
 def test_kernels_cached_is_false_where_numba_internals_fail(monkeypatch):

@@ -42,26 +42,54 @@ def usable_cores():
         return os.cpu_count() or 1
 
 
-def kernels_cached():
-    """Whether numba's cache already holds the static wind kernel (the largest compile
-    of every record-mode run) for this source: its index file exists and its source
-    stamp is current (numba's own check). Unknown (numba's internals changed): False."""
+#: The largest kernel of each kind of record-mode run, (module, function): a cache that
+#: holds it for the current source holds the run's kernels (:func:`kernels_cached`).
+LARGEST_KERNELS = {False: ("uq.physics.fusedkernels", "wind_scan"),
+                   True: ("uq.physics.fusedmotionkernels", "reconstruct")}
+
+
+def kernels_cached(time_resolved=False):
+    """Whether numba's cache holds the largest kernel of a static (or `time_resolved`)
+    record-mode run for the current source (:data:`LARGEST_KERNELS`), asked without
+    importing its module (the motion kernels compile on import): numba's own index
+    file and source stamp, found for a stand-in function of the kernel's file, name and
+    first line (:func:`_stand_in`). Unknown (numba's internals changed): False."""
     try:
         from numba.core.caching import FunctionCache
-        from uq.physics import fusedkernels
-        function = fusedkernels._KERNELS["wind_scan"][0]
-        return bool(FunctionCache(function)._cache_file._load_index())
+        return bool(FunctionCache(_stand_in(*LARGEST_KERNELS[time_resolved]))
+                    ._cache_file._load_index())
     except Exception:                        # noqa: BLE001 (an internal API: be safe)
         return False
+
+
+def _stand_in(module, name):
+    """A function with the code location numba's cache keys a kernel by: the module's
+    file, the kernel's name and its first line (its first decorator's, as Python
+    records it), read from the source with :mod:`ast`."""
+    import ast
+    import importlib.util
+    import types
+    path = importlib.util.find_spec(module).origin
+    with open(path, encoding="utf-8") as file:
+        tree = ast.parse(file.read(), path)
+    (node,) = [n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == name]
+    line = min([node.lineno] + [d.lineno for d in node.decorator_list])
+    code = _stand_in.__code__.replace(co_filename=path, co_firstlineno=line, co_name=name,
+                                      co_qualname=name)
+    function = types.FunctionType(code, {})
+    function.__qualname__ = name
+    return function
 
 
 def wanted(args, scenario):
     """Whether ``uq run`` `args` of `scenario` should compile its kernels beside."""
     from uq.cli.run import draws_records
+    from uq.pipeline import motionsection
     return (draws_records(scenario) and getattr(args, "model", "compiled") == "compiled"
             and getattr(args, "workers", None) is None
             and getattr(args, "scheduler", None) is None
-            and usable_cores() >= 2 and not kernels_cached())
+            and usable_cores() >= 2
+            and not kernels_cached(motionsection.is_time_resolved(scenario.settings)))
 
 
 class SideCompile:
