@@ -1,6 +1,7 @@
 """The kernels' compile in a second process beside a record-mode run's boxes
 (uq.cli.sidecompile, uq warmup --for)."""
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -42,16 +43,21 @@ def test_compile_for_takes_overrides(monkeypatch):
     assert ran[0].settings["correction"] == "none"
 
 
-@pytest.mark.parametrize("changes, cores, cached, expected", [
-    ({}, 2, False, True),
-    ({}, 1, False, False),                          # no second core to compile on
-    ({}, 2, True, False),                           # nothing to compile
-    ({"workers": 2}, 2, False, False),              # the workers compile for themselves
-    ({"scheduler": "tcp://x:1"}, 2, False, False),
-    ({"model": "numpy"}, 2, False, False),          # no kernel is called
+FREE = sidecompile.SIDE_COMPILE_MIN_AVAILABLE_MB
+
+
+@pytest.mark.parametrize("changes, cores, cached, free, expected", [
+    ({}, 2, False, FREE, True),
+    ({}, 1, False, FREE, False),                    # no second core to compile on
+    ({}, 2, False, FREE - 1, False),                # no room for a second process
+    ({}, 2, True, FREE, False),                     # nothing to compile
+    ({"workers": 2}, 2, False, FREE, False),        # the workers compile for themselves
+    ({"scheduler": "tcp://x:1"}, 2, False, FREE, False),
+    ({"model": "numpy"}, 2, False, FREE, False),    # no kernel is called
 ])
-def test_wanted_only_where_it_can_help(monkeypatch, changes, cores, cached, expected):
+def test_wanted_only_where_it_can_help(monkeypatch, changes, cores, cached, free, expected):
     monkeypatch.setattr(sidecompile, "usable_cores", lambda: cores)
+    monkeypatch.setattr(sidecompile, "available_memory_mb", lambda: free)
     monkeypatch.setattr(sidecompile, "kernels_cached", lambda motion: cached)
     scenario = load_scenario(scenario_path("sathe2011_ti"))
     assert sidecompile.wanted(_args(**changes), scenario) is expected
@@ -59,6 +65,7 @@ def test_wanted_only_where_it_can_help(monkeypatch, changes, cores, cached, expe
 
 def test_not_wanted_without_records(monkeypatch):
     monkeypatch.setattr(sidecompile, "usable_cores", lambda: 2)
+    monkeypatch.setattr(sidecompile, "available_memory_mb", lambda: FREE)
     monkeypatch.setattr(sidecompile, "kernels_cached", lambda motion: False)
     for name, changes in (("rubio2022_case_i", {}), ("sathe2011_ti", {"sampling.method": "none"})):
         scenario = load_scenario(scenario_path(name), changes)
@@ -84,6 +91,7 @@ def test_kernels_cached_once_the_largest_kernel_is_compiled(time_resolved):
 def test_wanted_asks_the_cache_of_the_run_s_kind(monkeypatch):
     asked = []
     monkeypatch.setattr(sidecompile, "usable_cores", lambda: 2)
+    monkeypatch.setattr(sidecompile, "available_memory_mb", lambda: FREE)
     monkeypatch.setattr(sidecompile, "kernels_cached", lambda motion: asked.append(motion))
     for name in ("sathe2011_ti", "floating_lidar_ti"):
         sidecompile.wanted(_args(), load_scenario(scenario_path(name)))
@@ -154,3 +162,9 @@ def test_run_waits_for_the_kernels_after_the_boxes_before_the_model(monkeypatch,
     scenario.write_text(SMALL_RECORDS)
     assert main(["run", str(scenario), "-q", "-o", str(tmp_path / "ti.nc")]) == 0
     assert events == ["boxes", "wait", "model", "stop"]
+
+
+def test_available_memory_is_the_machine_s():
+    # MemAvailable lies between 0 and the machine's physical memory
+    total = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") / 2**20
+    assert 0.0 < sidecompile.available_memory_mb() <= total

@@ -13,9 +13,11 @@ kernels from the cache. The numbers never depend on it: the child only fills the
 (the same kernels, the same code; a cold and a warm run are bit-identical). Where the
 child fails, the run compiles as it would without it.
 
-Started only where it can help: the compiled model on this machine (no ``--workers`` or
-``--scheduler``: a cluster's workers compile for themselves), two or more usable cores,
-and a cache that does not hold the kernels yet (:func:`kernels_cached`).
+Started only where it can help and the machine has room: the compiled model on this
+machine (no ``--workers`` or ``--scheduler``: a cluster's workers compile for
+themselves), two or more usable cores, :data:`SIDE_COMPILE_MIN_AVAILABLE_MB` of free
+memory (the two processes together peak at ~870 MB against ~490 MB for one), and a
+cache that does not hold the kernels yet (:func:`kernels_cached`).
 """
 import logging
 import os
@@ -28,6 +30,10 @@ import yaml
 
 #: Trials per scene of the child's run: the kernels' types, not their work, matter.
 SIDE_COMPILE_TRIALS = 64
+#: Memory the machine must have free to start the child [MB]: its peak (~390-400 MB,
+#: ``uq warmup --for sathe2011_ti`` on an empty cache, 2026-11-25) beside the run's own
+#: (~490 MB), with room to spare; with less the run compiles its kernels itself.
+SIDE_COMPILE_MIN_AVAILABLE_MB = 1024
 #: Seconds the run waits for the child to end after asking it to stop.
 SIDE_COMPILE_STOP_SECONDS = 5.0
 
@@ -46,6 +52,22 @@ def usable_cores():
 #: holds it for the current source holds the run's kernels (:func:`kernels_cached`).
 LARGEST_KERNELS = {False: ("uq.physics.fusedkernels", "wind_scan"),
                    True: ("uq.physics.fusedmotionkernels", "reconstruct")}
+
+
+def available_memory_mb():
+    """Memory the machine has free for a new process [MB] (``MemAvailable`` of
+    /proc/meminfo; elsewhere the free physical pages); 0 where unknown."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as file:
+            for line in file:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") / 2**20
+    except (AttributeError, ValueError, OSError):
+        return 0.0
 
 
 def kernels_cached(time_resolved=False):
@@ -89,6 +111,7 @@ def wanted(args, scenario):
             and getattr(args, "workers", None) is None
             and getattr(args, "scheduler", None) is None
             and usable_cores() >= 2
+            and available_memory_mb() >= SIDE_COMPILE_MIN_AVAILABLE_MB
             and not kernels_cached(motionsection.is_time_resolved(scenario.settings)))
 
 
