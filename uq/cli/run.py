@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from uq.cli.common import EXIT_OK, EXIT_TERMINATED, interrupted_status, parse_overrides, say
-from uq.cli.sidecompile import side_compile
+from uq.cli.sidecompile import draws_records, side_compile
 from uq.errors import OutputError, ScenarioError
 
 
@@ -140,12 +140,6 @@ def load_kernels(args, scenario):
     from uq.physics import fusedkernels
     for name in ("ins_trig", "geometry"):         # the complex kernels: a large GUM grid's
         fusedkernels.compiled(float)[name]
-
-
-def draws_records(scenario):
-    """Whether a run of `scenario` draws Monte Carlo turbulence records (record mode
-    with ``sampling.method`` other than none)."""
-    return "turbulence" in scenario.settings and scenario.sampling["method"] != "none"
 
 
 def check_scale_out(args):

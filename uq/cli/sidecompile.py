@@ -103,9 +103,14 @@ def _stand_in(module, name):
     return function
 
 
+def draws_records(scenario):
+    """Whether a run of `scenario` draws Monte Carlo turbulence records (record mode
+    with ``sampling.method`` other than none)."""
+    return "turbulence" in scenario.settings and scenario.sampling["method"] != "none"
+
+
 def wanted(args, scenario):
     """Whether ``uq run`` `args` of `scenario` should compile its kernels beside."""
-    from uq.cli.run import draws_records
     from uq.pipeline import motionsection
     return (draws_records(scenario) and getattr(args, "model", "compiled") == "compiled"
             and getattr(args, "workers", None) is None
