@@ -281,3 +281,21 @@ def test_stored_spectra_hold_the_records_variance():
     expected = np.mean([reference.var() for _, reference, *_ in series])
     assert float(ds["record_psd_u_true"].sum() * step) == pytest.approx(expected, rel=1e-12)
     assert records.spectrum_axis(settings) == (2.0, 15)
+
+
+def test_scenes_differing_only_outside_the_spectral_path_share_its_computation(monkeypatch):
+    from uq.pipeline import records
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.shipped import scenario_path
+    base = load_scenario(scenario_path("sathe2011_ti")).settings
+    scenes = [base, {**base, "correction": "none"},
+              {**base, "wind": {**base["wind"], "direction": 300.0}}]
+    computed, original = [], records.spectral_variances
+    monkeypatch.setattr(records, "spectral_variances",
+                        lambda settings: (computed.append(settings), original(settings))[1])
+    lidar, true = records.scene_spectral_paths(scenes, len(base["lidar"]["ranges"]))
+    assert [s is base for s in computed] == [True, False] and computed[1] is scenes[2]
+    # the shared computation gives the second scene exactly what its own would
+    alone = original(scenes[1])[0]
+    assert np.array_equal(lidar[1], alone.lidar[:, 0]) and true[1] == alone.true[0]
+    assert np.array_equal(lidar[0], lidar[1])

@@ -154,6 +154,10 @@ class SideCompile:
         if self.child is None:
             return True
         waiting = time.perf_counter()
+        if self.child.poll() is None:
+            # the statistics' kernels, which the child compiles last, here meanwhile:
+            # the child then loads them (a kernel both compile is only time lost)
+            import uq.engine.statkernels  # noqa: F401  (compiled or loaded on import)
         status = self.child.wait()
         self.waited = time.perf_counter() - waiting
         self.child = None

@@ -33,6 +33,7 @@ import copy
 import dataclasses
 import functools
 import hashlib
+import json
 import math
 import threading
 
@@ -189,11 +190,26 @@ def scene_spectral_paths(scenes, n_gates):
     lidar's filtered u-variance per gate (n_scenes, n_gates) and the field's at the
     reference point (n_scenes,) [m2 s-2]; NaN without a mean wind (no frozen field)."""
     lidar, true = np.full((len(scenes), n_gates), np.nan), np.full(len(scenes), np.nan)
+    done = {}
     for i, settings in enumerate(scenes):
         if settings["wind"]["speed"] > 0:
-            variances = spectral_variances(settings)[0]
-            lidar[i], true[i] = variances.lidar[:, 0], variances.true[0]
+            key = spectral_key(settings)
+            if key not in done:
+                done[key] = spectral_variances(settings)[0]
+            lidar[i], true[i] = done[key].lidar[:, 0], done[key].true[0]
     return lidar, true
+
+
+#: The sections :func:`spectral_variances` reads (its scan geometry, probe and spectra).
+SPECTRAL_SECTIONS = ("lidar", "ship", "wind", "turbulence", "record")
+
+
+def spectral_key(settings):
+    """What the spectral path of validated `settings` depends on, as a hashable key
+    (:data:`SPECTRAL_SECTIONS`): scenes that differ only elsewhere (``correction``, the
+    INS, the motion) share one computation."""
+    return json.dumps({name: settings.get(name) for name in SPECTRAL_SECTIONS},
+                      sort_keys=True, default=repr)
 
 
 def _scan_uncertainty(dataset):
