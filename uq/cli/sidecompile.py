@@ -153,11 +153,12 @@ class SideCompile:
         it filled the cache."""
         if self.child is None:
             return True
-        waiting = time.perf_counter()
         if self.child.poll() is None:
             # the statistics' kernels, which the child compiles last, here meanwhile:
-            # the child then loads them (a kernel both compile is only time lost)
+            # the child then loads them (a kernel both compile is only time lost; this
+            # compile is counted by the command's own notice, not in `waited`)
             import uq.engine.statkernels  # noqa: F401  (compiled or loaded on import)
+        waiting = time.perf_counter()
         status = self.child.wait()
         self.waited = time.perf_counter() - waiting
         self.child = None
