@@ -299,3 +299,21 @@ def test_scenes_differing_only_outside_the_spectral_path_share_its_computation(m
     alone = original(scenes[1])[0]
     assert np.array_equal(lidar[1], alone.lidar[:, 0]) and true[1] == alone.true[0]
     assert np.array_equal(lidar[0], lidar[1])
+
+
+@pytest.mark.parametrize("model", ["mann", "kaimal"])
+def test_a_scene_s_spectral_path_scaled_from_another_intensity_equals_its_own(model):
+    # both spectral models are proportional to (I U)^2: scaled and computed agree to
+    # rounding (1e-13 relative: a few operations' rounding, far below the paths' use)
+    from uq.pipeline import records
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.shipped import scenario_path
+    base = load_scenario(scenario_path("sathe2011_ti"),        # one gate: a cheap path
+                         {"turbulence.model": model, "lidar.ranges": [100.0]}).settings
+    other = {**base, "turbulence": {**base["turbulence"], "intensity": 0.17}}
+    n_gates = len(base["lidar"]["ranges"])
+    lidar, true = records.scene_spectral_paths([base, other], n_gates)
+    own = records.spectral_variances(other)[0]
+    np.testing.assert_allclose(lidar[1], own.lidar[:, 0], rtol=1e-13)
+    np.testing.assert_allclose(true[1], own.true[0], rtol=1e-13)
+    assert not np.allclose(lidar[0], lidar[1])          # the intensity does matter

@@ -193,10 +193,12 @@ def scene_spectral_paths(scenes, n_gates):
     done = {}
     for i, settings in enumerate(scenes):
         if settings["wind"]["speed"] > 0:
-            key = spectral_key(settings)
+            key, intensity = spectral_key(settings), settings["turbulence"]["intensity"]
             if key not in done:
-                done[key] = spectral_variances(settings)[0]
-            lidar[i], true[i] = done[key].lidar[:, 0], done[key].true[0]
+                done[key] = spectral_variances(settings)[0], intensity
+            variances, computed_at = done[key]
+            factor = (intensity / computed_at) ** 2     # the spectra scale with (I U)^2
+            lidar[i], true[i] = variances.lidar[:, 0] * factor, variances.true[0] * factor
     return lidar, true
 
 
@@ -205,11 +207,16 @@ SPECTRAL_SECTIONS = ("lidar", "ship", "wind", "turbulence", "record")
 
 
 def spectral_key(settings):
-    """What the spectral path of validated `settings` depends on, as a hashable key
-    (:data:`SPECTRAL_SECTIONS`): scenes that differ only elsewhere (``correction``, the
-    INS, the motion) share one computation."""
-    return json.dumps({name: settings.get(name) for name in SPECTRAL_SECTIONS},
-                      sort_keys=True, default=repr)
+    """What the spectral path of validated `settings` depends on besides the intensity,
+    as a hashable key (:data:`SPECTRAL_SECTIONS`): scenes that differ only elsewhere
+    (``correction``, the INS, the motion) or in ``turbulence.intensity`` share one
+    computation, scaled by the square of the intensities' ratio (the Mann tensor's
+    alpha eps^(2/3) and the Kaimal spectra are proportional to (I U)^2, and the lidar's
+    variances linear in them); a zero intensity is a key of its own."""
+    sections = {name: settings.get(name) for name in SPECTRAL_SECTIONS}
+    if sections["turbulence"]["intensity"] > 0:
+        sections["turbulence"] = {**sections["turbulence"], "intensity": None}
+    return json.dumps(sections, sort_keys=True, default=repr)
 
 
 def _scan_uncertainty(dataset):
