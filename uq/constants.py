@@ -520,6 +520,10 @@ SAMPLING_CHUNK_POINTS = 2**18
 #: or of the correction); a record of a 50-beam VAD over 10 min at 4 gates is ~1 MB,
 #: so 64 MB keeps every record of any shipped scenario. Results do not depend on it.
 UNIT_RECORD_CACHE_BYTES = 2**26
+#: Spectral paths of record mode kept per process for a run's other chunks [1]
+#: (:func:`uq.pipeline.records.scene_spectral_paths`): a few numbers per gate each;
+#: 64 covers every shipped sweep's distinct lidars. Results do not depend on it.
+SPECTRAL_PATHS_KEPT = 64
 #: Cells of a record's box transformed, or of its factor's variance summed, at a time
 #: [1]: 2^18 keeps each slab's temporaries near 4 MB (the box's half spectra, ~24 bytes
 #: a cell, are the record's memory); boxes do not depend on it.

@@ -291,6 +291,7 @@ def test_scenes_differing_only_outside_the_spectral_path_share_its_computation(m
     scenes = [base, {**base, "correction": "none"},
               {**base, "wind": {**base["wind"], "direction": 300.0}}]
     computed, original = [], records.spectral_variances
+    monkeypatch.setattr(records, "_SPECTRAL_PATHS", type(records._SPECTRAL_PATHS)())
     monkeypatch.setattr(records, "spectral_variances",
                         lambda settings: (computed.append(settings), original(settings))[1])
     lidar, true = records.scene_spectral_paths(scenes, len(base["lidar"]["ranges"]))
@@ -302,7 +303,8 @@ def test_scenes_differing_only_outside_the_spectral_path_share_its_computation(m
 
 
 @pytest.mark.parametrize("model", ["mann", "kaimal"])
-def test_a_scene_s_spectral_path_scaled_from_another_intensity_equals_its_own(model):
+def test_a_scene_s_spectral_path_scaled_from_another_intensity_equals_its_own(model,
+                                                                             monkeypatch):
     # both spectral models are proportional to (I U)^2: scaled and computed agree to
     # rounding (1e-13 relative: a few operations' rounding, far below the paths' use)
     from uq.pipeline import records
@@ -311,9 +313,25 @@ def test_a_scene_s_spectral_path_scaled_from_another_intensity_equals_its_own(mo
     base = load_scenario(scenario_path("sathe2011_ti"),        # one gate: a cheap path
                          {"turbulence.model": model, "lidar.ranges": [100.0]}).settings
     other = {**base, "turbulence": {**base["turbulence"], "intensity": 0.17}}
+    monkeypatch.setattr(records, "_SPECTRAL_PATHS", type(records._SPECTRAL_PATHS)())
     n_gates = len(base["lidar"]["ranges"])
     lidar, true = records.scene_spectral_paths([base, other], n_gates)
     own = records.spectral_variances(other)[0]
     np.testing.assert_allclose(lidar[1], own.lidar[:, 0], rtol=1e-13)
     np.testing.assert_allclose(true[1], own.true[0], rtol=1e-13)
     assert not np.allclose(lidar[0], lidar[1])          # the intensity does matter
+
+
+def test_the_spectral_path_is_computed_once_for_a_run_s_chunks(monkeypatch):
+    from uq.pipeline import records
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.shipped import scenario_path
+    monkeypatch.setattr(records, "_SPECTRAL_PATHS", type(records._SPECTRAL_PATHS)())
+    base = load_scenario(scenario_path("sathe2011_ti"), {"lidar.ranges": [100.0]}).settings
+    computed, original = [], records.spectral_variances
+    monkeypatch.setattr(records, "spectral_variances",
+                        lambda settings: (computed.append(settings), original(settings))[1])
+    for intensity in (0.05, 0.1):                   # two chunks, one scene each
+        other = {**base, "turbulence": {**base["turbulence"], "intensity": intensity}}
+        records.scene_spectral_paths([other], 1)
+    assert len(computed) == 1

@@ -45,7 +45,7 @@ from uq.physics.spectraltensor import KaimalSpectra, mann_tensor_for_intensity
 from uq.pipeline import probesection
 from uq.constants import KAIMAL_LENGTH_FACTOR as LENGTH_FACTORS_KAIMAL
 from uq.constants import (RECORD_BOX_SLAB_CELLS, RECORD_FFT_WORKERS, RECORD_SPECTRA_BYTES,
-                          UNIT_RECORD_CACHE_BYTES)
+                          SPECTRAL_PATHS_KEPT, UNIT_RECORD_CACHE_BYTES)
 from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
 
 #: Attributes of the record-mode variables.
@@ -190,16 +190,36 @@ def scene_spectral_paths(scenes, n_gates):
     lidar's filtered u-variance per gate (n_scenes, n_gates) and the field's at the
     reference point (n_scenes,) [m2 s-2]; NaN without a mean wind (no frozen field)."""
     lidar, true = np.full((len(scenes), n_gates), np.nan), np.full(len(scenes), np.nan)
-    done = {}
     for i, settings in enumerate(scenes):
         if settings["wind"]["speed"] > 0:
-            key, intensity = spectral_key(settings), settings["turbulence"]["intensity"]
-            if key not in done:
-                done[key] = spectral_variances(settings)[0], intensity
-            variances, computed_at = done[key]
-            factor = (intensity / computed_at) ** 2     # the spectra scale with (I U)^2
-            lidar[i], true[i] = variances.lidar[:, 0] * factor, variances.true[0] * factor
+            gates, point, computed_at = _spectral_path(settings)
+            factor = (settings["turbulence"]["intensity"] / computed_at) ** 2  # (I U)^2
+            lidar[i], true[i] = gates * factor, point * factor
     return lidar, true
+
+
+#: Spectral paths kept for the run's other chunks, by :func:`spectral_key` (the oldest
+#: dropped beyond :data:`~uq.constants.SPECTRAL_PATHS_KEPT`).
+_SPECTRAL_PATHS = collections.OrderedDict()
+_SPECTRAL_PATHS_LOCK = threading.Lock()
+
+
+def _spectral_path(settings):
+    """(lidar u-variance per gate (n_gates,), the field's at the reference point,
+    the intensity they were computed at) of `settings`' key, computed once per key."""
+    key = spectral_key(settings)
+    with _SPECTRAL_PATHS_LOCK:
+        if key in _SPECTRAL_PATHS:
+            _SPECTRAL_PATHS.move_to_end(key)
+            return _SPECTRAL_PATHS[key]
+    variances = spectral_variances(settings)[0]
+    found = (variances.lidar[:, 0].copy(), float(variances.true[0]),
+             settings["turbulence"]["intensity"])
+    with _SPECTRAL_PATHS_LOCK:
+        _SPECTRAL_PATHS[key] = found
+        while len(_SPECTRAL_PATHS) > SPECTRAL_PATHS_KEPT:
+            _SPECTRAL_PATHS.popitem(last=False)
+    return found
 
 
 #: The sections :func:`spectral_variances` reads (its scan geometry, probe and spectra).
