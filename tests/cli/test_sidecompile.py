@@ -168,3 +168,12 @@ def test_available_memory_is_the_machine_s():
     # MemAvailable lies between 0 and the machine's physical memory
     total = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") / 2**20
     assert 0.0 < sidecompile.available_memory_mb() <= total
+
+
+def test_nothing_of_the_child_reaches_the_terminal(monkeypatch, capfd):
+    # the child's own lines ("uq: terminated" when the run stops it) would cut into the
+    # run's: its output is discarded, at the file descriptors
+    side = _side(monkeypatch, "import sys; print('out'); sys.stderr.write('uq: terminated')")
+    assert side.wait() is True
+    captured = capfd.readouterr()
+    assert captured.out == "" and captured.err == ""

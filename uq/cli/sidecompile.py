@@ -129,7 +129,8 @@ class SideCompile:
         The run's validated settings (written to a temporary file for the child).
     stream : file or None
         Where :meth:`wait` says how long the compile took (None: nothing is said). The
-        child itself prints nothing (``-q``): its lines would cut into the run's.
+        child itself prints nothing (``-q``, its output discarded): its lines would cut
+        into the run's.
 
     Attributes
     ----------
@@ -144,8 +145,10 @@ class SideCompile:
         self.stream, self.waited = stream, 0.0
         self.started = time.perf_counter()
         command = [sys.executable, "-m", "uq.cli", "warmup", "--for", self.path, "-q"]
-        # its own session: Ctrl-C at the terminal reaches the run, which stops the child
+        # its own session: Ctrl-C at the terminal reaches the run, which stops the child;
+        # nothing of it on the terminal (its "terminated" when the run stops it, say)
         self.child = subprocess.Popen(command, stdin=subprocess.DEVNULL,
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                       start_new_session=True)
 
     def wait(self):
