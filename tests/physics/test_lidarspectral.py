@@ -252,3 +252,21 @@ def test_beam_pairs_and_component_vectors_agree(tensor, monkeypatch):
     monkeypatch.setattr(lidarspectral, "_PAIR_BEAMS", 0)
     np.testing.assert_allclose(mann_lidar_variances(g, tensor, transfer, grid).lidar, by_pairs,
                                rtol=1e-10)
+
+
+def test_kaimal_gates_with_their_nodes_side_by_side_equal_each_gate_alone():
+    # a pulsed lidar's gates at different foci put every gate's probe nodes side by side,
+    # each gate weighting only its own: each gate's variance must be that of the same
+    # lidar with that gate alone (1e-12: the same terms, summed in another order)
+    from uq.pipeline import records
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.shipped import scenario_path
+
+    def variances(ranges):
+        settings = load_scenario(scenario_path("sathe2011_ti"),
+                                 {"turbulence.model": "kaimal", "lidar.ranges": ranges}).settings
+        return records.spectral_variances(settings)[0]
+    both = variances([40.0, 100.0])
+    for g, height in enumerate((40.0, 100.0)):
+        alone = variances([height])
+        np.testing.assert_allclose(both.lidar[g], alone.lidar[0], rtol=1e-12)

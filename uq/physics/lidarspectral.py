@@ -408,14 +408,17 @@ def kaimal_lidar_variances(geometry, spectra, frequency_decades=KAIMAL_FREQUENCY
     n_nodes = points.shape[2]
     lidar = np.zeros((geometry.n_gates, 3))
     for g in range(geometry.n_gates):
-        p = points[:, g].reshape(-1, 3)                                      # (P, 3)
-        tau = (np.repeat(np.asarray(geometry.times, float), n_nodes)
+        # only the nodes gate g weights: where the gates' nodes sit side by side (their
+        # foci differ) the others' weights are zero, and their pairs add nothing
+        kept = np.tile(np.asarray(geometry.probe_weights)[g] != 0, directions.shape[0])
+        p = points[:, g].reshape(-1, 3)[kept]                                # (P, 3)
+        tau = (np.repeat(np.asarray(geometry.times, float), n_nodes)[kept]
                - p[:, 0] / geometry.speed)
         across = np.hypot(p[:, None, 1] - p[None, :, 1], p[:, None, 2] - p[None, :, 2])
         lag = tau[:, None] - tau[None, :]
         # a[c, p, j] = R_gcb n_bj w_gi
         a = np.einsum("cb,bj,i->cbij", np.asarray(geometry.reconstruction)[g], directions,
-                      np.asarray(geometry.probe_weights)[g]).reshape(3, -1, 3)
+                      np.asarray(geometry.probe_weights)[g]).reshape(3, -1, 3)[:, kept]
         for k, fk in enumerate(f):
             kernel = spectra.coherence(across, fk) * np.cos(2 * np.pi * fk * lag)
             pair = np.einsum("cpj,pq,cqj->cj", a, kernel, a)                # (3, 3)
