@@ -24,10 +24,9 @@ def command(args):
     ``--for``, those a run of one scenario calls)."""
     import time
     started = time.perf_counter()
-    import numba
     if getattr(args, "scenario", None):
         compile_for(args.scenario, getattr(args, "set", []))
-        return _said(args, started, numba)
+        return _said(args, started)
     import uq.engine.statkernels  # noqa: F401  (explicit signatures: compiled on import)
     import uq.engine.passkernels  # noqa: F401  (the same: long runs' one-pass batches)
     from uq.physics import fusedmotionkernels  # (the same)
@@ -38,12 +37,13 @@ def command(args):
             if number is float or name not in fusedkernels.MOUNTED_KERNEL_NAMES:
                 fusedkernels.compiled(number)[name]
     fusedmotionkernels.compiled_mounted_wind()        # a tilted mount's, on first use
-    return _said(args, started, numba)
+    return _said(args, started)
 
 
-def _said(args, started, numba):
+def _said(args, started):
     """Say what was compiled and where it is kept; the exit status."""
     import time
+    import numba
     compiling = getattr(args, "compile_notice", None)
     compiled = compiling.kernels if compiling else 0
     say(args, f"uq warmup: {compiled} kernel(s) compiled, the others loaded from the cache "

@@ -535,9 +535,15 @@ def mann_box_window(grid, alpha_epsilon, length_scale, anisotropy, rng, window, 
         cell (0, j0, m0), periodic along x only (``periodic_yz`` False: a point outside
         the window is refused, not wrapped).
     """
+    return box_sum(mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy,
+                                         rng, window, parts, slab_cells, workers))
+
+
+def box_sum(parts):
+    """The box whose field is the sum of `parts`' (an iterable of
+    :class:`TurbulenceBox` on one grid, each used before the next is taken)."""
     velocity = None
-    for part in mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy, rng,
-                                      window, parts, slab_cells, workers):
+    for part in parts:
         if velocity is None:
             velocity = np.zeros(part.velocity.shape)
         velocity += part.velocity

@@ -306,12 +306,7 @@ def unit_box(settings, geometry, rng, motion_margin=0.0, window=True):
                                       turbulence["anisotropy"], rng,
                                       slab_cells=RECORD_BOX_SLAB_CELLS), kept
     parts, kept = unit_box_parts(settings, geometry, rng, motion_margin)
-    velocity = None
-    for part in parts:                  # (as mann_box_window adds them)
-        if velocity is None:
-            velocity = np.zeros(part.velocity.shape)
-        velocity += part.velocity
-    return turbulencebox.TurbulenceBox(grid=part.grid, velocity=velocity), kept
+    return turbulencebox.box_sum(parts), kept
 
 
 def unit_box_parts(settings, geometry, rng, motion_margin=0.0):

@@ -143,20 +143,20 @@ def run_chunk(scenario, plan, chunk, seed, compiled=True, kernels_ready=None):
         scenario = scenario.with_values(group_assignments(scenario, plan, chunk.group))
     base = scene_from_settings(scenario.settings)
     fields = vector_fields(scenario, plan, chunk) or {"wind_speed": np.array([base.wind_speed])}
+    record_fields = (records.chunk_fields(scenario, plan, chunk)
+                     if "turbulence" in scenario.settings else None)   # record mode
     prepared = None
-    if "turbulence" in scenario.settings and "wind_speed" in model_outputs(scenario.outputs):
-        # record mode: the spectral path and the records' boxes before the per-scan
-        # kernels compile (memory: numba keeps what it compiled)
-        prepared = records.prepare_records(scenario, records.chunk_fields(scenario, plan, chunk),
-                                           seed, spectra_of)
+    if record_fields is not None and "wind_speed" in model_outputs(scenario.outputs):
+        # the spectral path and the records' boxes before the per-scan kernels compile
+        # (memory: numba keeps what it compiled)
+        prepared = records.prepare_records(scenario, record_fields, seed, spectra_of)
     if kernels_ready is not None:
         kernels_ready()
     dataset = run_scene(scenario, batch_scene(base, fields), seed, compiled)
-    if "turbulence" in scenario.settings and "wind_speed_true" in dataset:
-        # record mode: the spectral path per scene
+    if record_fields is not None and "wind_speed_true" in dataset:
+        # the records' variables of each scene
         dataset = dataset.assign(records.record_variables(
-            scenario, records.chunk_fields(scenario, plan, chunk), dataset, seed, compiled,
-            spectra_of, prepared))
+            scenario, record_fields, dataset, seed, compiled, spectra_of, prepared))
     return dataset
 
 
