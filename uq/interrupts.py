@@ -12,15 +12,19 @@ twice in 600 Ctrl-C sent 0.05-1.55 s into a first run; the one traced was raised
 module lock's callback during an import).
 
 So the handler (:func:`stop`) writes the stop down before it raises, and the stop
-stays *pending* until an ``except`` that handles it says so (:func:`acknowledge`). A
-stop discarded in a finaliser is sent again from a thread, after the hook has returned
-(:func:`_redeliver`). Code that commits a result asks first (:func:`raise_if_stopped`):
-the atomic file and folder writes of :mod:`uq.files` and each finished chunk of
-:mod:`uq.pipeline.runner`; the command line's ``main`` asks once more when a command
-returns. So a stop dropped in C costs at most the work up to the next commit, never a
-result the user asked to stop. Outside the command line nothing is ever pending (only
-:func:`stopping_on_signals` installs the handler) and the checks are one dict read. No
-numpy; main thread only (where Python runs signal handlers).
+stays *pending* until an ``except`` that handles it says so (:func:`acknowledge`).
+Two things make sure it arrives:
+
+* a watcher thread (:func:`_watch`) sends the signal again when, a little later, the
+  stop is still pending and the main thread is not cleaning up after it (in an
+  ``except``, ``finally`` or ``__exit__`` of a KeyboardInterrupt): it was dropped;
+* code that commits a result asks first (:func:`raise_if_stopped`): the atomic file and
+  folder writes of :mod:`uq.files`, each finished chunk of :mod:`uq.pipeline.runner`,
+  and the command line's ``main`` when a command returns.
+
+Outside the command line nothing is ever pending (only :func:`stopping_on_signals`
+installs the handler) and the checks are one dict read. No numpy; main thread only
+(where Python runs signal handlers).
 """
 import contextlib
 import os
@@ -34,6 +38,16 @@ from uq.errors import Terminated
 #: The signal number of the stop not yet handled, or None.
 _pending = {"number": None}
 
+#: How often the watcher looks at a pending stop [s]. A stop is sent again after two
+#: looks in a row found it pending with the main thread not handling it, so 10-20 ms
+#: after it was dropped: ~1e4 bytecodes, well out of the finaliser or C call that
+#: dropped it (sent from there, it would be dropped there again), and well under what a
+#: person notices after Ctrl-C.
+WATCH_INTERVAL_S = 0.01
+#: Looks in a row that find the stop dropped before it is sent again: one look can
+#: fall in the microseconds when the exception unwinds frames with no handler.
+WATCH_LOOKS = 2
+
 
 def exception_for(number):
     """The exception a stop raises: :class:`~uq.errors.Terminated` for SIGTERM,
@@ -42,8 +56,8 @@ def exception_for(number):
 
 
 def stop(number, frame=None):
-    """Signal handler: remember the stop, then raise its exception."""
-    _pending["number"] = number
+    """Signal handler: write the stop down, watch that it arrives, raise its exception."""
+    _note(number)
     raise exception_for(number)
 
 
@@ -65,47 +79,61 @@ def acknowledge():
     return number
 
 
-#: How long after a stop's exception was discarded it is sent again [s]: the exception
-#: raised inside the unraisable-exception hook itself would be discarded too (the first
-#: bytecode after ``os.kill`` runs the handler), so the signal comes from a thread once
-#: the hook has returned; 10 ms is ~1e4 bytecodes later, well out of any finaliser.
-REDELIVERY_DELAY_S = 0.01
+def _note(number):
+    """Write the stop `number` down and start its watcher."""
+    _pending["number"] = number
+    threading.Thread(target=_watch, args=(number,), daemon=True,
+                     name="uq-stop-watcher").start()
 
 
-def _redeliver(previous_hook):
-    """An unraisable-exception hook that does not lose a stop: a signal handler's
-    exception raised inside a callback Python cannot propagate from (a weakref's, as
-    the import system's module locks have, a finaliser's) would be printed as
-    "Exception ignored in ..." with a traceback and dropped, so the run would go on.
-    The hook writes the stop down and has it sent again shortly (to be raised at the
-    next point that can, silently); other exceptions go to `previous_hook`."""
+def _watch(number):
+    """Send `number` to this process again if the stop stays pending while the main
+    thread does not handle it (:data:`WATCH_LOOKS` looks in a row); ends when the stop is
+    handled. The sent signal runs :func:`stop` again, with a watcher of its own."""
+    dropped = 0
+    while _pending["number"] == number:
+        time.sleep(WATCH_INTERVAL_S)
+        dropped = 0 if _main_thread_handles_a_stop() else dropped + 1
+        if dropped >= WATCH_LOOKS and _pending["number"] == number:
+            os.kill(os.getpid(), number)
+            return
+
+
+def _main_thread_handles_a_stop():
+    """Whether the main thread is in an ``except``, ``finally`` or ``__exit__`` of a
+    KeyboardInterrupt (its ``sys.exc_info()``, read from another thread): cleaning up
+    after the stop, which a second one would break (a dask client left half closed
+    printed its failure at exit)."""
+    handled = sys._current_exceptions().get(threading.main_thread().ident)
+    if isinstance(handled, tuple):               # Python 3.11: an exc_info triple
+        handled = handled[1]
+    return isinstance(handled, KeyboardInterrupt)
+
+
+def _unraisable_hook(previous_hook):
+    """An unraisable-exception hook that keeps a stop quiet: a stop's exception dropped
+    in a finaliser or weakref callback is not printed as "Exception ignored in ..." with
+    a traceback; it stays pending and its watcher sends it again. Other exceptions go to
+    `previous_hook`."""
     def hook(unraisable):
         if not issubclass(unraisable.exc_type, KeyboardInterrupt):
             previous_hook(unraisable)
             return
         number = signal.SIGTERM if issubclass(unraisable.exc_type, Terminated) \
             else signal.SIGINT
-        _pending["number"] = number
-        threading.Thread(target=_send_again, args=(number,), daemon=True).start()
+        if _pending["number"] != number:     # not raised by stop(): watch it here
+            _note(number)
     return hook
-
-
-def _send_again(number):
-    """Send `number` to this process after REDELIVERY_DELAY_S, unless handled by then."""
-    time.sleep(REDELIVERY_DELAY_S)
-    if _pending["number"] == number:
-        os.kill(os.getpid(), number)
 
 
 @contextlib.contextmanager
 def stopping_on_signals():
     """Within the block, SIGTERM (a batch system's time limit, ``timeout``) raises
-    :class:`~uq.errors.Terminated` and Ctrl-C KeyboardInterrupt, each written down first
-    (:func:`stop`); one discarded in a finaliser is sent again (:func:`_redeliver`).
-    SIGINT keeps an ignored or a foreign handler (a program that runs ``main`` inside
-    its own). The earlier handlers and unraisable-exception hook are restored afterwards
-    and a stop left pending is forgotten. Main thread only (elsewhere the block runs as
-    it is)."""
+    :class:`~uq.errors.Terminated` and Ctrl-C KeyboardInterrupt, each written down and
+    watched until handled (:func:`stop`). SIGINT keeps an ignored or a foreign handler
+    (a program that runs ``main`` inside its own). The earlier handlers and
+    unraisable-exception hook are restored afterwards and a stop left pending is
+    forgotten. Main thread only (elsewhere the block runs as it is)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -113,7 +141,8 @@ def stopping_on_signals():
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
         numbers.append(signal.SIGINT)
     previous = {number: signal.signal(number, stop) for number in numbers}
-    previous_hook, sys.unraisablehook = sys.unraisablehook, _redeliver(sys.unraisablehook)
+    previous_hook = sys.unraisablehook
+    sys.unraisablehook = _unraisable_hook(previous_hook)
     try:
         yield
     finally:
