@@ -2,8 +2,8 @@
 level or inside a function): physics -> engine -> pipeline -> outputs -> wings -> cli.
 
 Rules (issue 15):
-* base modules (constants, errors, files, complexstep, _version, data, shipped,
-  numbacache) import no other layer;
+* base modules (constants, errors, interrupts, files, complexstep, _version, data,
+  shipped, numbacache) import no other layer;
 * physics and engine are independent of each other and import only base modules;
 * the pipeline imports base, physics and engine; outputs import those and the pipeline;
 * a wing (fit, golden, bench) imports the layers below it, never another wing;
@@ -21,8 +21,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "uq"
-BASE = {"uq._version", "uq.constants", "uq.errors", "uq.files", "uq.complexstep", "uq.data",
-        "uq.shipped", "uq.numbacache"}
+BASE = {"uq._version", "uq.constants", "uq.errors", "uq.interrupts", "uq.files",
+        "uq.complexstep", "uq.data", "uq.shipped", "uq.numbacache"}
 #: layer -> the layers it may import (besides itself and the base)
 ALLOWED = {"base": set(), "physics": set(), "engine": set(),
            "pipeline": {"physics", "engine"},

@@ -32,7 +32,8 @@ import threading
 from pathlib import Path
 
 from uq._version import __version__
-from uq.errors import OutputError, Terminated
+from uq.errors import OutputError
+from uq.interrupts import raise_if_stopped, stop
 
 #: Text that marks a file as written by uq (in reports and figure metadata).
 SIGNATURE = "written by uq"
@@ -143,11 +144,13 @@ def check_target(path, source="-o"):
 
 
 @contextlib.contextmanager
-def atomic_file(path, source="-o", replace_any=False):
+def atomic_file(path, source="-o", replace_any=False, *, checkpoint=False):
     """Yield a temporary path beside `path`; on success give it the umask's permissions
     and rename it onto `path`, on failure remove it. Refuses targets uq did not write,
     unless the user asked to replace any file (`replace_any`, ``uq export --force``);
-    a folder is refused always."""
+    a folder is refused always. A result is not put in place while a Ctrl-C is pending
+    (:func:`uq.interrupts.raise_if_stopped`), unless it is a `checkpoint` file (a
+    finished chunk, kept for ``--resume``)."""
     path = check_target(path, source) if not replace_any else _not_a_folder(path, source)
     _make_folder(path.parent, source)
     try:
@@ -161,6 +164,8 @@ def atomic_file(path, source="-o", replace_any=False):
         with deferred_interrupt():           # Ctrl-C waits until the file is whole
             yield Path(temporary)
             os.chmod(temporary, file_mode())
+            if not checkpoint:
+                raise_if_stopped()           # a Ctrl-C lost on its way: no result
             os.replace(temporary, path)
     except (OSError, RuntimeError) as error:     # a full disk, a quota, a read-only mount
         if isinstance(error, RuntimeError) and not str(error).startswith(NETCDF_ERROR):
@@ -179,7 +184,8 @@ def atomic_file(path, source="-o", replace_any=False):
 @contextlib.contextmanager
 def deferred_interrupt():
     """Hold Ctrl-C (SIGINT) and SIGTERM back until the block is done, then raise
-    KeyboardInterrupt (:class:`~uq.errors.Terminated` for SIGTERM).
+    KeyboardInterrupt (:class:`~uq.errors.Terminated` for SIGTERM), pending until handled
+    (:func:`uq.interrupts.stop`).
 
     A KeyboardInterrupt in the middle of a netCDF write can leave the writer's internal
     (non-reentrant) lock held, and its clean-up then waits on it forever; a write takes
@@ -197,10 +203,8 @@ def deferred_interrupt():
     finally:
         for number, handler in previous.items():
             signal.signal(number, handler)
-    if signal.SIGTERM in received:
-        raise Terminated
-    if received:
-        raise KeyboardInterrupt
+    if received:                             # written down, then raised (SIGTERM first)
+        stop(signal.SIGTERM if signal.SIGTERM in received else signal.SIGINT)
 
 
 def _full_disk(folder):
@@ -224,25 +228,28 @@ def _make_folder(folder, source):
                           f"({error.strerror}); allowed: a writable folder") from None
 
 
-def write_text(path, text, source="-o", replace_any=False):
+def write_text(path, text, source="-o", replace_any=False, *, checkpoint=False):
     """Write `text` to `path` atomically; returns the path. `replace_any`: replace a file
-    uq did not write (only where the user asked for it)."""
-    with atomic_file(path, source, replace_any) as temporary:
+    uq did not write (only where the user asked for it); `checkpoint`: see
+    :func:`atomic_file`."""
+    with atomic_file(path, source, replace_any, checkpoint=checkpoint) as temporary:
         temporary.write_text(text)
     return Path(path)
 
 
-def write_bytes(path, data, source="-o"):
-    """Write the bytes `data` to `path` atomically; returns the path."""
-    with atomic_file(path, source) as temporary:
+def write_bytes(path, data, source="-o", *, checkpoint=False):
+    """Write the bytes `data` to `path` atomically; returns the path (`checkpoint`: see
+    :func:`atomic_file`)."""
+    with atomic_file(path, source, checkpoint=checkpoint) as temporary:
         temporary.write_bytes(data)
     return Path(path)
 
 
-def write_netcdf(dataset, path, source="-o"):
+def write_netcdf(dataset, path, source="-o", *, checkpoint=False):
     """Write an xarray Dataset to netCDF4 at `path` atomically, stamped with
-    ``uq_version`` (its mark of ownership); returns the path."""
-    with atomic_file(path, source) as temporary:
+    ``uq_version`` (its mark of ownership); returns the path (`checkpoint`: see
+    :func:`atomic_file`)."""
+    with atomic_file(path, source, checkpoint=checkpoint) as temporary:
         _stamped(dataset).to_netcdf(temporary, format="NETCDF4", engine="netcdf4")
     return Path(path)
 
@@ -325,6 +332,11 @@ def replace_folder(partial, folder, kind, source="-o"):
     the earlier one (the tool's own) deleted.
     """
     partial, folder = Path(partial), Path(folder)
+    try:
+        raise_if_stopped()                   # a Ctrl-C lost on its way: no result
+    except KeyboardInterrupt:
+        shutil.rmtree(partial, ignore_errors=True)
+        raise
     write_marker(partial, kind)
     aside = None
     if folder.exists() or folder.is_symlink():

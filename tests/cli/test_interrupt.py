@@ -117,13 +117,13 @@ def test_an_interrupt_raised_inside_a_callback_is_not_lost():
     a finaliser) is neither printed as 'Exception ignored' with a traceback nor dropped:
     the signal comes again and ends the block at the next safe point."""
     import types
-    from uq.cli.common import stop_on_sigterm
+    from uq.interrupts import stopping_on_signals
     from uq.errors import Terminated
     unraisable = types.SimpleNamespace(exc_type=Terminated, exc_value=Terminated(),
                                        exc_traceback=None, err_msg=None, object=None)
     before = sys.unraisablehook
     with pytest.raises(Terminated):
-        with stop_on_sigterm():
+        with stopping_on_signals():
             sys.unraisablehook(unraisable)           # as Python does inside a callback
             for _ in range(1000):                    # the redelivered signal lands here
                 time.sleep(0.001)

@@ -17,8 +17,9 @@ from uq._version import __version__
 from uq.cli import bench, check, export, fit, golden, listing, plot, report, run, warmup
 from uq.cli.common import (EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK,  # noqa: F401
                            EXIT_TERMINATED, Parser, add_common_options, configure_logging,
-                           interrupted_status, parse_overrides, stop_on_sigterm)
+                           interrupted_status, parse_overrides)
 from uq.errors import InputError
+from uq.interrupts import raise_if_stopped, stopping_on_signals
 
 SUBCOMMANDS = (run, check, listing, plot, report, export, bench, fit, golden, warmup)
 #: Commands that may compile numba kernels: they say so on stderr (uq.cli.compiling).
@@ -47,8 +48,10 @@ def main(argv=None):
             parser.print_help(sys.stderr)
             return EXIT_BAD_INPUT
         configure_logging(args)
-        with stop_on_sigterm(), _compile_notice(args):
-            return args.handler(args)
+        with stopping_on_signals(), _compile_notice(args):
+            status = args.handler(args)
+            raise_if_stopped()                   # a stop some library code swallowed
+            return status
     except InputError as error:
         print(f"uq: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT

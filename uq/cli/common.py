@@ -1,7 +1,6 @@
 """What every subcommand shares: exit codes, the parser that reports usage errors as bad
 input, and ``--set`` overrides. Imports nothing heavy (``uq --help`` stays fast)."""
 import argparse
-import contextlib
 import logging
 import sys
 
@@ -12,55 +11,12 @@ EXIT_INTERRUPTED = 130          # the shell's code for SIGINT
 EXIT_TERMINATED = 143           # the shell's code for SIGTERM (128 + 15)
 
 
-@contextlib.contextmanager
-def stop_on_sigterm():
-    """Within the block, SIGTERM (a batch system's time limit, ``timeout``) raises
-    :class:`uq.errors.Terminated`, a KeyboardInterrupt: every command cleans up after it
-    as after Ctrl-C. The earlier handler is restored afterwards (``main`` may run inside
-    another program). Main thread only (where signals are delivered)."""
-    import signal
-    import threading
-    from uq.errors import Terminated
-
-    def terminate(number, frame):
-        raise Terminated
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGTERM, terminate)
-    previous_hook = sys.unraisablehook
-    sys.unraisablehook = _redeliver(previous_hook)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-        sys.unraisablehook = previous_hook
-
-
-def _redeliver(previous_hook):
-    """An unraisable-exception hook that does not lose an interrupt: a signal handler's
-    exception raised inside a callback Python cannot propagate from (a weakref's, a
-    finaliser's) would be printed as "Exception ignored in ..." with a traceback and then
-    dropped, so the run would go on. The hook sends the signal again instead, to be
-    raised at the next point that can (silently); other exceptions go to `previous_hook`."""
-    import os
-    import signal
-    from uq.errors import Terminated
-
-    def hook(unraisable):
-        if issubclass(unraisable.exc_type, KeyboardInterrupt):
-            number = signal.SIGTERM if issubclass(unraisable.exc_type, Terminated) \
-                else signal.SIGINT
-            os.kill(os.getpid(), number)
-            return
-        previous_hook(unraisable)
-    return hook
-
-
 def interrupted_status(error):
-    """The exit status after an interrupt: 143 for SIGTERM, 130 for Ctrl-C."""
+    """The exit status after an interrupt, which is now handled (no longer pending,
+    :func:`uq.interrupts.acknowledge`): 143 for SIGTERM, 130 for Ctrl-C."""
     from uq.errors import Terminated
+    from uq.interrupts import acknowledge
+    acknowledge()
     return EXIT_TERMINATED if isinstance(error, Terminated) else EXIT_INTERRUPTED
 
 

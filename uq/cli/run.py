@@ -205,8 +205,8 @@ def _quiet_at_stop():
     error with a traceback ("tornado.application - ERROR - Exception in callback
     ... sync.<locals>.cancel", seen on a loaded machine) before any ``except`` of ours
     runs; silencing in the signal handler comes first. The earlier handlers are then
-    called as before (Python's KeyboardInterrupt, :func:`uq.cli.common.stop_on_sigterm`'s
-    Terminated) and restored at the end. Main thread only."""
+    called as before (:func:`uq.interrupts.stop`'s KeyboardInterrupt or Terminated) and
+    restored at the end. Main thread only."""
     import threading
     if threading.current_thread() is not threading.main_thread():
         yield

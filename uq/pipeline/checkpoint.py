@@ -157,7 +157,8 @@ class Checkpoint:
             return
         self._remove_chunks()                 # a fresh start: the folder is ours (marked)
         self._remove(self.directory / MANIFEST)
-        write_text(self.directory / MANIFEST, json.dumps(manifest, indent=1))
+        write_text(self.directory / MANIFEST, json.dumps(manifest, indent=1),
+                   checkpoint=True)
 
     def _refuse_changed_files(self, previous, manifest):
         """CheckpointError naming a file the scenario reads whose content differs from
@@ -214,12 +215,12 @@ class Checkpoint:
             item.verify()
         path = self.directory / f"chunk-{index:06d}.nc"
         if encoded is None:
-            write_netcdf(_with_digest(dataset, self.digest), path)
+            write_netcdf(_with_digest(dataset, self.digest), path, checkpoint=True)
             digest = _sha256(path)
         else:
-            write_bytes(path, encoded)
+            write_bytes(path, encoded, checkpoint=True)
             digest = hashlib.sha256(encoded).hexdigest()
-        write_text(path.with_name(path.name + ".sha256"), digest + "\n")
+        write_text(path.with_name(path.name + ".sha256"), digest + "\n", checkpoint=True)
 
     def is_empty(self):
         """No chunk on disk (nothing a --resume could reuse)?"""

@@ -35,6 +35,7 @@ from uq.engine.sampling import new_seed
 from uq.pipeline.scenario import load_scenario
 from uq.engine.statistics import unwrap
 from uq.engine.stopping import STOPPED_BY
+from uq.interrupts import raise_if_stopped
 from uq.pipeline.sweep import batch_scene, group_assignments, sweep_plan, vector_fields
 
 
@@ -104,6 +105,7 @@ def _compute(scenario, plan, seed, progress, client, checkpoint, compiled,
         results[index] = dataset
         if checkpoint:
             checkpoint.save(index, dataset, encoded)
+        raise_if_stopped()                   # a Ctrl-C some library code swallowed
         if progress:
             progress(len(results), len(plan.chunks))
     return results
