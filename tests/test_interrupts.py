@@ -196,3 +196,24 @@ def test_a_command_that_swallowed_ctrl_c_exits_130(python_sigint, no_watcher,
     assert captured.out == "listed\n" and captured.err == "\nuq: interrupted\n"
     assert interrupts.pending() is None          # handled
     assert (signal.getsignal(signal.SIGTERM), sys.unraisablehook) == before   # restored
+
+
+def test_a_stop_turned_into_another_error_is_the_stop(python_sigint, no_watcher, monkeypatch,
+                                                        capsys):
+    """Ctrl-C landing in a C extension's initialisation made its import fail with
+    "ImportError: initialization failed" (its cause the KeyboardInterrupt): seen in a
+    test run as status 1 and a traceback. With the stop pending, that is the stop."""
+    def command(args):
+        swallowed(signal.SIGINT)
+        raise ImportError("initialization failed")
+    monkeypatch.setattr(uq.cli.listing, "command", command)
+    assert main(["list"]) == 130
+    assert capsys.readouterr().err == "\nuq: interrupted\n"
+
+
+def test_an_error_without_a_stop_stays_the_error(python_sigint, monkeypatch):
+    def command(args):
+        raise ImportError("initialization failed")
+    monkeypatch.setattr(uq.cli.listing, "command", command)
+    with pytest.raises(ImportError):
+        main(["list"])

@@ -20,7 +20,10 @@ Two things make sure it arrives:
   ``except``, ``finally`` or ``__exit__`` of a KeyboardInterrupt): it was dropped;
 * code that commits a result asks first (:func:`raise_if_stopped`): the atomic file and
   folder writes of :mod:`uq.files`, each finished chunk of :mod:`uq.pipeline.runner`,
-  and the command line's ``main`` when a command returns.
+  and the command line's ``main`` when a command returns, or when it fails: an error
+  raised while a stop is pending is taken for the stop (library code can turn the
+  KeyboardInterrupt into another error: a C extension's import fails with
+  "ImportError: initialization failed" when Ctrl-C lands in its initialisation).
 
 Outside the command line nothing is ever pending (only :func:`stopping_on_signals`
 installs the handler) and the checks are one dict read. No numpy; main thread only

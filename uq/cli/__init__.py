@@ -49,7 +49,14 @@ def main(argv=None):
             return EXIT_BAD_INPUT
         configure_logging(args)
         with stopping_on_signals(), _compile_notice(args):
-            status = args.handler(args)
+            try:
+                status = args.handler(args)
+            except Exception:
+                # a stop that library code turned into another error (a C extension's
+                # import fails with "ImportError: initialization failed" when Ctrl-C
+                # lands in its initialisation) is the stop
+                raise_if_stopped()
+                raise
             raise_if_stopped()                   # a stop some library code swallowed
             return status
     except InputError as error:
