@@ -121,7 +121,7 @@ def test_the_nacelle_figure_compares_like_with_like(caplog):
     with caplog.at_level(logging.INFO, logger="uq.physics.modelinputs"):
         times = targets.nacelle_scans(2**10, repeats=1)
     assert set(times) == {(4, "static"), (4, "motion"), (2, "static"), (2, "motion")}
-    assert all(nacelle > 0 and dbs > 0 for nacelle, dbs in times.values())
+    assert all(nacelle > 0 and dbs > 0 and ratio > 0 for nacelle, dbs, ratio in times.values())
     declined = [r.getMessage() for r in caplog.records if "does not take" in r.getMessage()]
     assert declined and all("complex" in message for message in declined)
 
@@ -136,5 +136,23 @@ def test_the_nacelle_models_alone_run_compiled(caplog):
     with caplog.at_level(logging.INFO, logger="uq.physics.modelinputs"):
         times = targets.nacelle_models(2**10, repeats=1)
     assert set(times) == {"static", "motion"}
-    assert all(nacelle > 0 and dbs > 0 for nacelle, dbs in times.values())
+    assert all(nacelle > 0 and dbs > 0 and ratio > 0 for nacelle, dbs, ratio in times.values())
     assert not [r for r in caplog.records if "does not take" in r.getMessage()]
+
+
+def test_paired_times_alternate_and_keep_each_side(monkeypatch):
+    """``paired_cpu_times``: the calls alternate ABBA after one warm call of each, and each
+    pair's times go back to their own side before the ratio (a clock that advances by a
+    function's cost: 2 for the first, 1 for the second, gives 2, 1 and 2 exactly)."""
+    from uq.bench import targets
+    clock, order = [0.0], []
+
+    def costing(name, cost):
+        def function():
+            order.append(name)
+            clock[0] += cost
+        return function
+    monkeypatch.setattr(targets.time, "process_time", lambda: clock[0])
+    result = targets.paired_cpu_times(costing("a", 2.0), costing("b", 1.0), 4)
+    assert result == (2.0, 1.0, 2.0)
+    assert "".join(order) == "ab" + "abba" * 2

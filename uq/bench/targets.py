@@ -283,6 +283,28 @@ def median_cpu_time(function, repeats):
     return median_time(function, repeats, clock=time.process_time)
 
 
+def paired_cpu_times(first, second, repeats):
+    """(median CPU time [s] of `first`, of `second`, median of their ratios) over
+    `repeats` pairs after one warm call of each. The calls alternate, the order turning
+    each pair (ABBA), so a drift of the machine's speed (frequency, a neighbour's cache
+    use) falls on both alike; each pair's ratio is taken before the median: two runs
+    of tens of ms differ by 1-2 % from one call to the next, more than the difference
+    a like-for-like ratio is asked about."""
+    first(), second()
+    times = []
+    for index in range(repeats):
+        pair = (first, second) if index % 2 == 0 else (second, first)
+        measured = []
+        for function in pair:
+            started = time.process_time()
+            function()
+            measured.append(time.process_time() - started)
+        times.append(measured if index % 2 == 0 else measured[::-1])
+    times = np.asarray(times)
+    return (float(np.median(times[:, 0])), float(np.median(times[:, 1])),
+            float(np.median(times[:, 0] / times[:, 1])))
+
+
 #: The nacelle lidar of the issue's held-out check: 4 beams at clock positions up,
 #: starboard, down, port, half-cone 15 deg, the boresight along the bow at 150 m, 100 m
 #: preview; in motion pitch 3 deg at 25 s of random phase, the INS 150 m below.
@@ -294,12 +316,13 @@ NACELLE_MOTION = {"correction": "pointwise", "lidar.scan.beam_duration": 0.25,
                   "motion.pitch": {"amplitude": 3.0, "period": 25.0}}
 
 
-def nacelle_scans(n=2**17, repeats=3):
+def nacelle_scans(n=2**17, repeats=15):
     """CPU time [s] of ``uq.run`` of n nacelle scans and of n DBS scans of the same beam
     count (the DBS: the same lidar upward, half-cone 15 deg, azimuths 0/90/180/270), the
-    same outputs, radial noise, correction and motion: {(beams, kind): (nacelle, dbs)}
-    for 4 beams static (``ship.pitch`` 2 deg) and in motion (point-wise), and the 2-beam
-    nacelle lidar (clock 90/270) against the 4-beam DBS (a DBS needs 3 beams or more)."""
+    same outputs, radial noise, correction and motion: {(beams, kind): (nacelle, dbs,
+    median ratio)} (:func:`paired_cpu_times`) for 4 beams static (``ship.pitch`` 2 deg)
+    and in motion (point-wise), and the 2-beam nacelle lidar (clock 90/270) against the
+    4-beam DBS (a DBS needs 3 beams or more)."""
     static = {"ship.pitch": 2.0}
     cases = {(4, "static"): static, (4, "motion"): NACELLE_MOTION,
              (2, "static"): static, (2, "motion"): NACELLE_MOTION}
@@ -309,16 +332,17 @@ def nacelle_scans(n=2**17, repeats=3):
         nacelle = _scans(n, **NACELLE, **changes, **{"lidar.azimuths": azimuths})
         dbs = _scans(n, **{**NACELLE, "lidar.mount": {"tilt": 0.0}}, **changes,
                      **{"lidar.azimuths": [0.0, 90.0, 180.0, 270.0]})
-        times[beams, kind] = (median_cpu_time(lambda: run(nacelle), repeats),
-                              median_cpu_time(lambda: run(dbs), repeats))
+        times[beams, kind] = paired_cpu_times(lambda: run(nacelle), lambda: run(dbs),
+                                              repeats)
     return times
 
 
-def nacelle_models(n=2**17, repeats=5):
+def nacelle_models(n=2**17, repeats=15):
     """CPU time [s] of the measurement model alone (the compiled one, as ``uq.run`` calls
     it, the same draws) of the 4-beam nacelle lidar and the DBS of :func:`nacelle_scans`:
-    {kind: (nacelle, dbs)} for "static" and "motion" (the whole run's ratio also counts
-    the draws and the pipeline, the same for both)."""
+    {kind: (nacelle, dbs, median ratio)} (:func:`paired_cpu_times`) for "static" and
+    "motion" (the whole run's ratio also counts the draws and the pipeline, the same for
+    both)."""
     from uq.physics.measurement import measurement_model
     from uq.pipeline.modelsetup import error_inputs, scene_from_settings
     from uq.engine.inputs import input_set
@@ -336,7 +360,7 @@ def nacelle_models(n=2**17, repeats=5):
             errors.update(inputs.constants)
             calls.append(lambda scene=scene, errors=errors: measurement_model(
                 scene, tuple(NACELLE["outputs"]), **errors))
-        times[kind] = tuple(median_cpu_time(call, repeats) for call in calls)
+        times[kind] = paired_cpu_times(*calls, repeats)
     return times
 
 
@@ -441,14 +465,14 @@ def measure(quick=False, progress=None, scale=1):
     say(f"floating_lidar_full, pulsed probe, n = {n}: {probe_s:.3f} s, at a point "
         f"{point_s:.3f} s (the model alone {probe_model_s:.3f} s, {point_model_s:.3f} s)")
     n = trials(2**17)
-    for (beams, kind), (nacelle_s, dbs_s) in nacelle_scans(n).items():
+    for (beams, kind), (nacelle_s, dbs_s, ratio) in nacelle_scans(n).items():
         name = f"nacelle_{kind}" + ("" if beams == 4 else "_2_beams")
         figures.update({f"{name}_cpu_s": nacelle_s, f"dbs_{kind}_cpu_s": dbs_s,
-                        f"{name}_over_dbs": nacelle_s / dbs_s})
+                        f"{name}_over_dbs": ratio})
         say(f"{n} nacelle scans, {beams} beams, {kind}: {nacelle_s:.3f} s of CPU, a 4-beam "
             f"DBS {dbs_s:.3f} s")
-    for kind, (nacelle_s, dbs_s) in nacelle_models(n).items():
-        figures[f"nacelle_{kind}_model_over_dbs"] = nacelle_s / dbs_s
+    for kind, (nacelle_s, dbs_s, ratio) in nacelle_models(n).items():
+        figures[f"nacelle_{kind}_model_over_dbs"] = ratio
         say(f"{n} nacelle scans, 4 beams, {kind}, the measurement model alone: "
             f"{nacelle_s:.4f} s of CPU, a 4-beam DBS {dbs_s:.4f} s")
     per_scene, floor = sweep_monte_carlo(trials(MC_DRAWS))
