@@ -120,7 +120,8 @@ def test_the_nacelle_figure_compares_like_with_like(caplog):
     modelinputs._LOGGED.clear()
     with caplog.at_level(logging.INFO, logger="uq.physics.modelinputs"):
         times = targets.nacelle_scans(2**10, repeats=1)
-    assert set(times) == {(4, "static"), (4, "motion"), (2, "static"), (2, "motion")}
+    assert set(times) == {(4, "static"), (4, "motion"), (4, "motion_none"), (2, "static"),
+                          (2, "motion")}
     assert all(nacelle > 0 and dbs > 0 and ratio > 0 for nacelle, dbs, ratio in times.values())
     declined = [r.getMessage() for r in caplog.records if "does not take" in r.getMessage()]
     assert declined and all("complex" in message for message in declined)
@@ -135,7 +136,7 @@ def test_the_nacelle_models_alone_run_compiled(caplog):
     modelinputs._LOGGED.clear()
     with caplog.at_level(logging.INFO, logger="uq.physics.modelinputs"):
         times = targets.nacelle_models(2**10, repeats=1)
-    assert set(times) == {"static", "motion"}
+    assert set(times) == {"static", "motion", "motion_none"}
     assert all(nacelle > 0 and dbs > 0 and ratio > 0 for nacelle, dbs, ratio in times.values())
     assert not [r for r in caplog.records if "does not take" in r.getMessage()]
 

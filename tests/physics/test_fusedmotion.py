@@ -347,7 +347,7 @@ def test_a_nacelle_lidar_compiled_equals_numpy(changes, azimuths):
 
 
 @pytest.mark.parametrize("case", ["pointwise, continuous INS", "pointwise, clock offset",
-                                  "full (one reading per scan)", "none"])
+                                  "full (one reading per scan)", "yaw", "tilt2d", "none"])
 def test_a_four_beam_nacelle_lidar_without_the_shear_exponent_equals_numpy(case):
     """Without the shear exponent a tilted mount keeps no believed lift (the level pair's
     wind alone, its speed in the same pass: fusedmotionkernels.mounted_wind); its

@@ -314,6 +314,8 @@ NACELLE = {"lidar.mount": {"tilt": 90.0}, "lidar.half_cone": 15.0, "lidar.height
 NACELLE_MOTION = {"correction": "pointwise", "lidar.scan.beam_duration": 0.25,
                   "lidar.lever_arm": [0.0, 0.0, 150.0],
                   "motion.pitch": {"amplitude": 3.0, "period": 25.0}}
+#: The held-out check's other correction: none (the same motion).
+NACELLE_MOTION_NONE = {**NACELLE_MOTION, "correction": "none"}
 
 
 def nacelle_scans(n=2**17, repeats=15):
@@ -325,6 +327,7 @@ def nacelle_scans(n=2**17, repeats=15):
     4-beam DBS (a DBS needs 3 beams or more)."""
     static = {"ship.pitch": 2.0}
     cases = {(4, "static"): static, (4, "motion"): NACELLE_MOTION,
+             (4, "motion_none"): NACELLE_MOTION_NONE,
              (2, "static"): static, (2, "motion"): NACELLE_MOTION}
     times = {}
     for (beams, kind), changes in cases.items():
@@ -348,7 +351,8 @@ def nacelle_models(n=2**17, repeats=15):
     from uq.engine.inputs import input_set
     azimuths = {"lidar.azimuths": [0.0, 90.0, 180.0, 270.0]}
     times = {}
-    for kind, changes in (("static", {"ship.pitch": 2.0}), ("motion", NACELLE_MOTION)):
+    for kind, changes in (("static", {"ship.pitch": 2.0}), ("motion", NACELLE_MOTION),
+                          ("motion_none", NACELLE_MOTION_NONE)):
         calls = []
         for mount in (NACELLE["lidar.mount"], {"tilt": 0.0}):
             scenario = _scans(n, **{**NACELLE, "lidar.mount": mount}, **changes, **azimuths)

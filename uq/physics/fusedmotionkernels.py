@@ -874,14 +874,10 @@ def _substitute_vertical(normal, row, n_gates, count, out):
 
 
 @_helper
-def _scan_correction(consts, model, work, normal, row, n_gates, count, out):
-    """Eq. 13 of Rubio and Gottschall (2022) with the scan's one reading
-    (:mod:`uq.physics.correction`): ``none`` turns by the configured heading, ``yaw`` by
-    the read heading, ``tilt2d`` applies the read attitude to the horizontal lidar-frame
-    components, ``full`` to all three; the read velocity is added (horizontal; with the
-    vertical for ``full``; nothing for ``none``); the vertical wind of all but ``full`` is
-    the lidar-frame one. The lidar-frame wind of gate g is in rows row + 3 g .. + 2 of
-    `normal`."""
+def _scan_reading(consts, model, work, count):
+    """The rows of the scan's one reading as the correction model believes it: ``none``
+    the configured heading and no velocity, ``yaw`` the read heading alone (level
+    attitude); ``tilt2d`` and ``full`` the reading as read."""
     if model == NONE:
         work[_READ_TRIG, :count] = consts[_LEVEL_COS]
         work[_READ_TRIG + 1, :count] = consts[_LEVEL_SIN]
@@ -890,6 +886,39 @@ def _scan_correction(consts, model, work, normal, row, n_gates, count, out):
     if model == NONE or model == YAW:
         work[_READ_TRIG + 2, :count], work[_READ_TRIG + 3, :count] = 1.0, 0.0
         work[_READ_TRIG + 4, :count], work[_READ_TRIG + 5, :count] = 1.0, 0.0
+
+
+@_helper
+def _scan_vertical(consts, model, work, normal, row, n_gates, count, out):
+    """out[2, g] of :func:`_scan_correction` alone (the same operations: bit for bit its
+    up component), where a tilted mount's level pair gives north and east: with ``full``
+    the read attitude's up row applied to the lidar-frame wind plus the read vertical
+    velocity, else the lidar-frame vertical wind."""
+    _scan_reading(consts, model, work, count)
+    for g in range(n_gates):
+        first = row + 3 * g
+        if model == FULL:
+            for j in range(count):
+                cp, sp = work[_READ_TRIG + 2, j], work[_READ_TRIG + 3, j]
+                cr, sr = work[_READ_TRIG + 4, j], work[_READ_TRIG + 5, j]
+                x, y, z = normal[first, j], normal[first + 1, j], normal[first + 2, j]
+                z1 = cr * z - sr * y                            # rotate's up row
+                out[2, g, j] = (sp * x + cp * z1) + work[_READ_VELOCITY + 2, j]
+        else:
+            for j in range(count):
+                out[2, g, j] = normal[first + 2, j]
+
+
+@_helper
+def _scan_correction(consts, model, work, normal, row, n_gates, count, out):
+    """Eq. 13 of Rubio and Gottschall (2022) with the scan's one reading
+    (:mod:`uq.physics.correction`): ``none`` turns by the configured heading, ``yaw`` by
+    the read heading, ``tilt2d`` applies the read attitude to the horizontal lidar-frame
+    components, ``full`` to all three; the read velocity is added (horizontal; with the
+    vertical for ``full``; nothing for ``none``); the vertical wind of all but ``full`` is
+    the lidar-frame one. The lidar-frame wind of gate g is in rows row + 3 g .. + 2 of
+    `normal`."""
+    _scan_reading(consts, model, work, count)
     full = model == FULL
     for g in range(n_gates):
         for j in range(count):
@@ -946,6 +975,44 @@ def _inverse2(a00, a01, a10, a11):
 
 
 @_helper
+def _level_wind_fixed(consts, beams, normal, measured, n_gates, count, out):
+    """:func:`_level_wind` for ``none`` without the shear exponent: the believed beams
+    are the configured ones turned by the configured heading, the same in every trial,
+    and no velocity is removed (``c_k = v_k``), so the 2 x 2 system and its inverse are
+    made once per block, not per trial (the same operations on the same values: its
+    result bit for bit, up to the sign of a zero)."""
+    level_a, level_b = int(consts[_LEVEL_FIRST]), int(consts[_LEVEL_SECOND])
+    ch, sh = consts[_LEVEL_COS], consts[_LEVEL_SIN]     # _scan_reading's rows for none
+    ax, ay, az = rotate(ch, sh, 1.0, 0.0, 1.0, 0.0, beams[level_a, 0], beams[level_a, 1],
+                        beams[level_a, 2])
+    bx, by, bz = rotate(ch, sh, 1.0, 0.0, 1.0, 0.0, beams[level_b, 0], beams[level_b, 1],
+                        beams[level_b, 2])
+    two = int(consts[_N_BEAMS]) == 2
+    if two:                                 # the horizontal normal equations
+        i00, i01, i10, i11 = _inverse2(ax * ax + bx * bx, ax * ay + bx * by,
+                                       ax * ay + bx * by, ay * ay + by * by)
+    else:
+        i00, i01, i10, i11 = _inverse2(ax, ay, bx, by)
+    for g in range(n_gates):
+        c_first, c_second = measured + level_a * n_gates + g, measured + level_b * n_gates + g
+        if two:
+            for j in range(count):
+                c0, c1 = normal[c_first, j], normal[c_second, j]
+                r0 = ax * c0 + bx * c1
+                r1 = ay * c0 + by * c1
+                out[0, g, j] = i00 * r0 + i01 * r1
+                out[1, g, j] = i10 * r0 + i11 * r1
+                out[2, g, j] = 0.0
+        else:
+            for j in range(count):
+                up = out[2, g, j]
+                r0 = normal[c_first, j] - az * up
+                r1 = normal[c_second, j] - bz * up
+                out[0, g, j] = i00 * r0 + i01 * r1
+                out[1, g, j] = i10 * r0 + i11 * r1
+
+
+@_helper
 def _level_wind(consts, model, beams, work, normal, stored, measured, n_gates, count, out):
     """A tilted (nacelle) mount's horizontal wind of trials [0, count), at the end of
     :func:`reconstruct` (whose `normal` then holds the kept beams' believed beams from
@@ -967,6 +1034,10 @@ def _level_wind(consts, model, beams, work, normal, stored, measured, n_gates, c
     n_beams = int(consts[_N_BEAMS])
     level_a, level_b = int(consts[_LEVEL_FIRST]), int(consts[_LEVEL_SECOND])
     keep_all = consts[_MOUNTED] > 1         # the shear's beams too, and their lift
+    if model == NONE and not keep_all:      # the same believed beams in every trial
+        if level_a >= 0:
+            _level_wind_fixed(consts, beams, normal, measured, n_gates, count, out)
+        return
     if model != POINTWISE:                  # the scan's reading (_scan_correction's rows)
         full = model == FULL
         for b in range(n_beams):
@@ -1082,6 +1153,13 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
         measured_held + (n_beams * n_gates if held else 0)   # the held right-hand sides
     level_a, level_b = int(consts[_LEVEL_FIRST]), int(consts[_LEVEL_SECOND])
     keep_all = consts[_MOUNTED] > 1
+    level = stored > 0 and level_a >= 0     # a tilted mount's horizontal solve replaces
+    alone = level and n_beams == 2          # the 3-D one's (north, east); with 2 beams it
+    #                                         alone (their B^T B is singular). One reading
+    # per scan: the lidar-frame sums A^+ v it needs: none with 2 beams, the vertical alone
+    # with the level pair (unless `full`, whose up turns all three)
+    sums = 3 if model == POINTWISE or not level or (model == FULL and not alone) else \
+        (0 if alone else 1)
     normal[:6 + 3 * n_gates, :count] = 0.0          # the sums, not a tilted mount's kept
     #                                                 rows (each is written before read)
     if held:
@@ -1136,15 +1214,17 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                     normal[6 + 3 * g, j] += work[_BEAM, j] * corrected
                     normal[7 + 3 * g, j] += work[_BEAM + 1, j] * corrected
                     normal[8 + 3 * g, j] += work[_BEAM + 2, j] * corrected
-            else:                                       # A^+ v: the lidar-frame wind
+            elif sums == 3:                             # A^+ v: the lidar-frame wind
                 o0, o1, o2 = operator[0, b], operator[1, b], operator[2, b]
                 for j in range(count):
                     normal[6 + 3 * g, j] += o0 * work[_MEASURED, j]
                     normal[7 + 3 * g, j] += o1 * work[_MEASURED, j]
                     normal[8 + 3 * g, j] += o2 * work[_MEASURED, j]
-    level = stored > 0 and level_a >= 0     # a tilted mount's horizontal solve replaces
-    alone = level and n_beams == 2          # the 3-D one's (north, east); with 2 beams it
-    if model == POINTWISE and level and not alone:     # alone (their B^T B is singular);
+            elif sums == 1:                             # its vertical alone
+                o2 = operator[2, b]
+                for j in range(count):
+                    normal[8 + 3 * g, j] += o2 * work[_MEASURED, j]
+    if model == POINTWISE and level and not alone:     # (their B^T B is singular);
         _vertical_factor(normal, count)                # with the pair: w alone
     elif model == POINTWISE and not alone:
         _factor(normal, count)
@@ -1156,6 +1236,10 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
                 _substitute_vertical(normal, row, n_gates, count, into)
             elif not alone:
                 _substitute(normal, row, n_gates, count, into)
+        elif alone:                         # 2 beams: _level_wind's solve is all
+            _scan_reading(consts, model, work, count)
+        elif level:                         # the level pair's: the 3-D solve's w alone
+            _scan_vertical(consts, model, work, normal, row, n_gates, count, into)
         else:
             _scan_correction(consts, model, work, normal, row, n_gates, count, into)
         if stored:
