@@ -988,28 +988,40 @@ def _level_wind_fixed(consts, beams, normal, measured, n_gates, count, out):
     bx, by, bz = rotate(ch, sh, 1.0, 0.0, 1.0, 0.0, beams[level_b, 0], beams[level_b, 1],
                         beams[level_b, 2])
     two = int(consts[_N_BEAMS]) == 2
-    if two:                                 # the horizontal normal equations
-        i00, i01, i10, i11 = _inverse2(ax * ax + bx * bx, ax * ay + bx * by,
-                                       ax * ay + bx * by, ay * ay + by * by)
-    else:
-        i00, i01, i10, i11 = _inverse2(ax, ay, bx, by)
-    for g in range(n_gates):
+    for g in range(n_gates):                # (the inverse, loop-invariant, is hoisted)
         c_first, c_second = measured + level_a * n_gates + g, measured + level_b * n_gates + g
         if two:
             for j in range(count):
-                c0, c1 = normal[c_first, j], normal[c_second, j]
-                r0 = ax * c0 + bx * c1
-                r1 = ay * c0 + by * c1
-                out[0, g, j] = i00 * r0 + i01 * r1
-                out[1, g, j] = i10 * r0 + i11 * r1
+                out[0, g, j], out[1, g, j] = _horizontal_solve(
+                    ax, ay, bx, by, normal[c_first, j], normal[c_second, j])
                 out[2, g, j] = 0.0
         else:
             for j in range(count):
-                up = out[2, g, j]
-                r0 = normal[c_first, j] - az * up
-                r1 = normal[c_second, j] - bz * up
-                out[0, g, j] = i00 * r0 + i01 * r1
-                out[1, g, j] = i10 * r0 + i11 * r1
+                out[0, g, j], out[1, g, j] = _level_pair_solve(
+                    ax, ay, az, bx, by, bz, normal[c_first, j], normal[c_second, j],
+                    out[2, g, j])
+
+
+@_called
+def _horizontal_solve(n00, n01, n10, n11, c0, c1):
+    """2 beams: the horizontal least squares ``b_k,h . u_h = c_k`` (w = 0 assumed) of the
+    believed beams' horizontal parts (n00, n01), (n10, n11) and the corrected radial
+    velocities c0, c1: (north, east) [m s-1]."""
+    i00, i01, i10, i11 = _inverse2(n00 * n00 + n10 * n10, n00 * n01 + n10 * n11,
+                                   n00 * n01 + n10 * n11, n01 * n01 + n11 * n11)
+    r0 = n00 * c0 + n10 * c1
+    r1 = n01 * c0 + n11 * c1
+    return i00 * r0 + i01 * r1, i10 * r0 + i11 * r1
+
+
+@_called
+def _level_pair_solve(n00, n01, n02, n10, n11, n12, c0, c1, up):
+    """The level pair: the hub-height horizontal wind ``b_k,h . u_h = c_k - b_k,up w``
+    with the 3-D solve's w `up`: (north, east) [m s-1]."""
+    i00, i01, i10, i11 = _inverse2(n00, n01, n10, n11)
+    r0 = c0 - n02 * up
+    r1 = c1 - n12 * up
+    return i00 * r0 + i01 * r1, i10 * r0 + i11 * r1
 
 
 @_helper
@@ -1071,25 +1083,16 @@ def _level_wind(consts, model, beams, work, normal, stored, measured, n_gates, c
         c_first, c_second = measured + level_a * n_gates + g, measured + level_b * n_gates + g
         if n_beams == 2:                    # the horizontal normal equations
             for j in range(count):
-                n00, n01 = normal[first, j], normal[first + 1, j]
-                n10, n11 = rows[second, j], rows[second + 1, j]
-                i00, i01, i10, i11 = _inverse2(n00 * n00 + n10 * n10, n00 * n01 + n10 * n11,
-                                               n00 * n01 + n10 * n11, n01 * n01 + n11 * n11)
-                c0, c1 = normal[c_first, j], normal[c_second, j]
-                r0 = n00 * c0 + n10 * c1
-                r1 = n01 * c0 + n11 * c1
-                out[0, g, j] = i00 * r0 + i01 * r1
-                out[1, g, j] = i10 * r0 + i11 * r1
+                out[0, g, j], out[1, g, j] = _horizontal_solve(
+                    normal[first, j], normal[first + 1, j], rows[second, j],
+                    rows[second + 1, j], normal[c_first, j], normal[c_second, j])
                 out[2, g, j] = 0.0
         else:
             for j in range(count):
-                i00, i01, i10, i11 = _inverse2(normal[first, j], normal[first + 1, j],
-                                               rows[second, j], rows[second + 1, j])
-                up = out[2, g, j]
-                r0 = normal[c_first, j] - normal[first + 2, j] * up
-                r1 = normal[c_second, j] - rows[second + 2, j] * up
-                out[0, g, j] = i00 * r0 + i01 * r1
-                out[1, g, j] = i10 * r0 + i11 * r1
+                out[0, g, j], out[1, g, j] = _level_pair_solve(
+                    normal[first, j], normal[first + 1, j], normal[first + 2, j],
+                    rows[second, j], rows[second + 1, j], rows[second + 2, j],
+                    normal[c_first, j], normal[c_second, j], out[2, g, j])
 
 
 @_kernel(f"void({_CV}, {_IM}, {_CM}, {_CM}, {_CT}, {_CV}, {_CM}, {_CM}, {_CV}, "
