@@ -130,6 +130,22 @@ def test_nothing_is_pending_outside_the_command_line(python_sigint):
     interrupts.raise_if_stopped()
 
 
+def test_ctrl_c_during_a_library_write_is_not_left_pending(python_sigint, tmp_path):
+    """A write held back by Ctrl-C (uq.files.deferred_interrupt) outside the command line
+    raises KeyboardInterrupt and leaves no stop pending: a notebook's later writes go on,
+    and no watcher sends the signal again."""
+    target = tmp_path / "out.txt"
+    with pytest.raises(KeyboardInterrupt):
+        with atomic_file(target) as temporary:
+            os.kill(os.getpid(), signal.SIGINT)    # held back until the file is whole
+            temporary.write_text("result")
+    assert interrupts.pending() is None
+    later = tmp_path / "later.txt"
+    with atomic_file(later) as temporary:          # the next write is committed
+        temporary.write_text("result")
+    assert later.read_text() == "result"
+
+
 def test_a_foreign_sigint_handler_is_kept(python_sigint):
     """A program running ``main`` inside its own with its own Ctrl-C handler keeps it."""
     def own(number, frame):

@@ -33,7 +33,7 @@ from pathlib import Path
 
 from uq._version import __version__
 from uq.errors import OutputError
-from uq.interrupts import raise_if_stopped, stop
+from uq.interrupts import exception_for, raise_if_stopped, stop
 
 #: Text that marks a file as written by uq (in reports and figure metadata).
 SIGNATURE = "written by uq"
@@ -184,8 +184,9 @@ def atomic_file(path, source="-o", replace_any=False, *, checkpoint=False):
 @contextlib.contextmanager
 def deferred_interrupt():
     """Hold Ctrl-C (SIGINT) and SIGTERM back until the block is done, then raise
-    KeyboardInterrupt (:class:`~uq.errors.Terminated` for SIGTERM), pending until handled
-    (:func:`uq.interrupts.stop`).
+    KeyboardInterrupt (:class:`~uq.errors.Terminated` for SIGTERM); under the command
+    line's handler also pending until handled (:func:`uq.interrupts.stop`), never in a
+    library call (nothing is pending outside the command line).
 
     A KeyboardInterrupt in the middle of a netCDF write can leave the writer's internal
     (non-reentrant) lock held, and its clean-up then waits on it forever; a write takes
@@ -203,8 +204,11 @@ def deferred_interrupt():
     finally:
         for number, handler in previous.items():
             signal.signal(number, handler)
-    if received:                             # written down, then raised (SIGTERM first)
-        stop(signal.SIGTERM if signal.SIGTERM in received else signal.SIGINT)
+    if received:                             # SIGTERM first
+        number = signal.SIGTERM if signal.SIGTERM in received else signal.SIGINT
+        if previous[number] is stop:         # the command line's: written down, watched
+            stop(number)
+        raise exception_for(number)          # elsewhere (a library call) only raised
 
 
 def _full_disk(folder):
