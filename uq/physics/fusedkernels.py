@@ -41,7 +41,7 @@ from numba import njit, types
 
 from uq.constants import HYPOT_SAFE_MAX, HYPOT_SAFE_MIN, SMALL_ANGLE
 from uq.physics.kernelbase import (DEG as _DEG, FULL, NONE, TILT2D, YAW, hypot as _hypot,
-                                   taylor_cos_sin)
+                                   inverse2 as _inverse2, taylor_cos_sin)
 
 #: Columns of the scene table (:func:`uq.physics.fused.scene_table`), one row per scene:
 #: these scalars, then the cosines and the sines of TRIG, then the row of the scene's
@@ -742,16 +742,6 @@ def wind_pointwise(table, shapes, structure, ins, noise, cos_trig, sin_trig, bea
 #: the upper and lower beams (-1: none; :mod:`uq.physics.nacelle`).
 MOUNTED_STRUCTURE = STRUCTURE + ("want_shear", "level_first", "level_second", "upper",
                                  "lower")
-
-
-@_helper
-def _inverse2(a00, a01, a10, a11):
-    """The inverse of the 2 x 2 matrix ``[[a00, a01], [a10, a11]]`` (Cramer's rule: one
-    division; the systems solved here, the level beams' horizontal parts and the 2-beam
-    normal equations, have condition numbers of ~cot(half-cone) and its square, so the
-    solution is within ~1e-14 relative of LAPACK's pivoted elimination)."""
-    scale = 1.0 / (a00 * a11 - a01 * a10)
-    return a11 * scale, -a01 * scale, -a10 * scale, a00 * scale
 
 
 @_helper

@@ -51,7 +51,8 @@ from numba import njit
 from uq.constants import (HALF_PI_PARTS, HYPOT_SAFE_MAX, HYPOT_SAFE_MIN,
                           SINCOS_REDUCTION_LIMIT, SLERP_SERIES_LIMIT)
 from uq.physics.kernelbase import (COS_TAYLOR, DEG as _DEG, FULL, NONE, POINTWISE, SIN_TAYLOR,
-                                   YAW, horner as _horner, row_layout)
+                                   YAW, horner as _horner, inverse2 as _inverse2,
+                                   row_layout)
 
 _TWO_OVER_PI = 2.0 / math.pi
 _P1, _P2, _P3 = HALF_PI_PARTS
@@ -966,14 +967,6 @@ def _held_rows(work, held_noise, start, count, b, g, pointwise, operator, normal
             normal[row + 2, j] += o2 * measured
 
 
-@_called
-def _inverse2(a00, a01, a10, a11):
-    """The inverse of ``[[a00, a01], [a10, a11]]`` by Cramer's rule (the systems here are
-    well conditioned: ~cot(half-cone), :func:`uq.physics.fusedkernels._inverse2`)."""
-    scale = 1.0 / (a00 * a11 - a01 * a10)
-    return a11 * scale, -a01 * scale, -a10 * scale, a00 * scale
-
-
 @_helper
 def _level_wind_fixed(consts, beams, normal, measured, n_gates, count, out):
     """:func:`_level_wind` for ``none`` without the shear exponent: the believed beams
@@ -1161,8 +1154,7 @@ def reconstruct(consts, pairs, amplitudes, components, read_table, stamps, beams
     #                                         alone (their B^T B is singular). One reading
     # per scan: the lidar-frame sums A^+ v it needs: none with 2 beams, the vertical alone
     # with the level pair (unless `full`, whose up turns all three)
-    sums = 3 if model == POINTWISE or not level or (model == FULL and not alone) else \
-        (0 if alone else 1)
+    sums = 0 if alone else (1 if level and model != FULL else 3)    # (point-wise: unused)
     normal[:6 + 3 * n_gates, :count] = 0.0          # the sums, not a tilted mount's kept
     #                                                 rows (each is written before read)
     if held:

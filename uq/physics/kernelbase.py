@@ -1,7 +1,7 @@
 """What both compiled models share (:mod:`uq.physics.fusedkernels`,
 :mod:`uq.physics.fusedmotionkernels`): the degree factor, the Taylor coefficients of sine
-and cosine, Horner's rule, the guarded hypot, the correction codes and the layout of
-scratch rows.
+and cosine, Horner's rule, the guarded hypot, the 2 x 2 inverse, the correction codes and
+the layout of scratch rows.
 
 Every function here is ``inline="always"``: numba copies it into each kernel that calls
 it, so the kernels stay loops without calls (SIMD code).
@@ -52,6 +52,18 @@ def taylor_cos_sin(x):
     cos_x = c[0] + x2 * (c[1] + x2 * (c[2] + x2 * (c[3] + x2 * (c[4] + x2 * (
         c[5] + x2 * (c[6] + x2 * (c[7] + x2 * c[8])))))))
     return cos_x, sin_x
+
+
+@njit(inline="always")
+def inverse2(a00, a01, a10, a11):
+    """The inverse of the 2 x 2 matrix ``[[a00, a01], [a10, a11]]`` as (i00, i01, i10, i11)
+    (Cramer's rule: one division; the systems the kernels solve, the level beams'
+    horizontal parts and the 2-beam normal equations, have condition numbers of
+    ~cot(half-cone) and its square, so the solution is within ~1e-14 relative of
+    LAPACK's pivoted elimination). A zero determinant divides as the caller's error
+    model says (inlined: the caller's)."""
+    scale = 1.0 / (a00 * a11 - a01 * a10)
+    return a11 * scale, -a01 * scale, -a10 * scale, a00 * scale
 
 
 @njit(inline="always")
