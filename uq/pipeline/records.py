@@ -232,10 +232,9 @@ def spectral_key(settings):
     (``correction``, the INS, the motion) or in ``turbulence.intensity`` share one
     computation, scaled by the square of the intensities' ratio (the Mann tensor's
     alpha eps^(2/3) and the Kaimal spectra are proportional to (I U)^2, and the lidar's
-    variances linear in them); a zero intensity is a key of its own."""
+    variances linear in them; ``turbulence.intensity`` is validated positive)."""
     sections = {name: settings.get(name) for name in SPECTRAL_SECTIONS}
-    if sections["turbulence"]["intensity"] > 0:
-        sections["turbulence"] = {**sections["turbulence"], "intensity": None}
+    sections["turbulence"] = {**sections["turbulence"], "intensity": None}
     return json.dumps(sections, sort_keys=True, default=repr)
 
 
