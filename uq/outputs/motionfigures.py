@@ -24,7 +24,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
-from uq.outputs.samples import HISTOGRAM_TRIALS, trials_with  # noqa: E402
+from uq.outputs.samples import HISTOGRAM_TRIALS, scene_assignments, trials_with  # noqa: E402
 
 TILT_DIMENSIONS = ("motion_pitch_amplitude", "ship_pitch", "motion_roll_amplitude",
                    "ship_roll")
@@ -149,7 +149,8 @@ def correction_comparison(dataset, n_max=HISTOGRAM_TRIALS):
     quantities = [q for q in ("wind_speed", "vertical_wind") if f"{q}_mc_u" in dataset]
     figure, axes = plt.subplots(1, len(quantities), figsize=(5.2 * len(quantities), 4.0),
                                 constrained_layout=True, squeeze=False)
-    trials = {c: trials_with(dataset, {"correction": c}, tuple(quantities), n_max)
+    trials = {c: trials_with(dataset, scene_assignments(dataset, {"correction": c}),
+                                 tuple(quantities), n_max)
               for c in corrections}
     for ax, q in zip(axes[0], quantities):
         errors = {c: trials[c][q][:, 0] - float(_at(dataset, f"{q}_true", c))
