@@ -26,6 +26,7 @@ from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 from scipy.stats import norm  # noqa: E402
 
 from uq.constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, NUMERICAL_ZERO  # noqa: E402
+from uq.outputs import layout  # noqa: E402
 from uq.outputs.labels import (QUANTITIES, SWEEP_QUANTITIES, coordinate_label,  # noqa: E402
                                model_style, quantity_label)
 from uq.outputs.planning import models as available_models  # noqa: E402
@@ -303,15 +304,14 @@ def plot_beams(dataset, quantity="radial_velocity"):
 
 
 def legend_below(figure, ax, fontsize=7):
-    """The legend of `ax`'s lines under the panels, off the data."""
+    """The legend of `ax`'s lines under the panels, off the data, in as many columns as
+    fit the canvas (:func:`uq.outputs.layout.legend_below`)."""
     handles, labels = ax.get_legend_handles_labels()
-    if handles:
-        figure.legend(handles, labels, loc="outside lower center", fontsize=fontsize,
-                      ncols=min(len(handles), LEGEND_COLUMNS), frameon=False)
+    layout.legend_below(figure, handles, labels, fontsize=fontsize, longest=LEGEND_COLUMNS)
 
 
 #: Legend entry of the error bars on the Monte Carlo u: what they are, in the PNG.
-ERROR_BAR_LABEL = "MC u ±2 Monte Carlo standard errors"
+ERROR_BAR_LABEL = "Monte Carlo u ± 2 standard errors"
 
 
 def u_standard_error(dataset, quantity):
@@ -349,8 +349,10 @@ def plot_histogram(dataset, trials):
         values = trials[quantity].reshape(len(trials[quantity]), -1)[:, gate]
         _histogram_panel(ax, at, quantity, values, _gate_name(dataset, gate))
     n = len(next(iter(trials.values())))
-    figure.suptitle(f"Monte Carlo ({n:,} trials) against the GUM; each panel at the range "
-                    "gate where the GUM fails, else the middle one", fontsize=10)
+    gates = "; each panel at the range gate where the GUM fails, else the middle one" \
+        if "range" in dataset.dims and dataset.sizes["range"] > 1 else ""
+    layout.suptitle(figure, f"Monte Carlo ({n:,} trials) against the GUM{gates}",
+                    fontsize=10)
     return figure
 
 
@@ -450,7 +452,7 @@ def plot_against_sweep(dataset, dim=None, lines=None, panels=None):
             ax.set_title(title, fontsize=9)
         ax.grid(alpha=0.3)
     if lines is not None and "range" in dataset.dims:
-        figure.suptitle(middle_gate(dataset)[1], fontsize=9)
+        layout.suptitle(figure, middle_gate(dataset)[1], fontsize=9)
     if len(curves) > 1:          # colours for the lines, styles for the models: a short key
         _key_below(figure, [name for _, name in curves],
                    available_models(dataset, panels[0][0]))
@@ -470,8 +472,8 @@ def _key_below(figure, names, models):
     if "mc_u" in models:
         handles.append(Line2D([], [], color="k", marker="|", linestyle="none", markersize=8,
                               label=ERROR_BAR_LABEL))
-    figure.legend(handles=handles, loc="outside lower center", fontsize=7, frameon=False,
-                  ncols=min(len(handles), LEGEND_COLUMNS))
+    layout.legend_below(figure, handles, [h.get_label() for h in handles], fontsize=7,
+                        longest=LEGEND_COLUMNS)
 
 
 def _curves(dataset, lines):
@@ -545,7 +547,7 @@ def plot_maps(dataset, quantity, x, y, facet=None):
         bar = figure.colorbar(mesh, ax=axes, label=quantity_label(quantity))
         bar.formatter.set_useOffset(False)
     scale = "one colour scale" if shared else "one colour scale per panel"
-    figure.suptitle(f"u({QUANTITIES[quantity][0]}), {scale}"
+    layout.suptitle(figure, f"u({QUANTITIES[quantity][0]}), {scale}"
                     + (f", {gate_text}" if gate_text else ""), fontsize=10)
     return figure
 
@@ -670,7 +672,7 @@ def plot_probe_bias(dataset):
     axes[0, 0].set_ylabel("probe bias of " + QUANTITIES["wind_speed"][0] + " [m s$^{-1}$]")
     axes[1, 0].set_ylabel("probe bias / true " + QUANTITIES["wind_speed"][0] + " [%]")
     axes[0, 0].legend(fontsize=8, title="lidar.probe.kind", title_fontsize=8)
-    figure.suptitle("Systematic error of the wind speed from the probe volume "
+    layout.suptitle(figure, "Systematic error of the wind speed from the probe volume "
                     "(range weighting along the beams)", fontsize=10)
     return figure
 
