@@ -11,6 +11,7 @@ from scipy.stats import norm
 
 import uq
 from uq.errors import ScenarioError
+from uq.outputs import plots
 from uq.outputs.figures import figure_plan, make_figures, no_figure_reason
 from uq.outputs.plots import histogram_gate, plot_budget, plot_histogram, shared_scale
 from uq.outputs.samples import scene_trials
@@ -223,7 +224,7 @@ def test_a_small_sweep_draws_lines_not_maps(sweeps):
             lidar_misalignment=value).values)
         np.testing.assert_array_equal(lines[label].get_xdata(), ds["wind_direction"].values)
     texts = [t.get_text() for legend in figure.legends for t in legend.get_texts()]
-    assert "MC u ±2 Monte Carlo standard errors" in texts          # the bars say what they are
+    assert plots.ERROR_BAR_LABEL in texts                          # the bars say what they are
     plt.close(figure)
 
 

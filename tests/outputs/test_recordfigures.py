@@ -91,16 +91,17 @@ def test_spectra_figure_reads_what_the_run_stored_and_an_older_file_draws_it_aga
     import matplotlib.pyplot as plt
     from uq.pipeline.runner import run
     ds = run({**SMALL, "turbulence": {"intensity": 0.1}})
-    settings = recordfigures.file_settings(ds)
+    settings, chosen, words = recordfigures.shown_scene(ds, lines=("correction",))
+    assert chosen == {"turbulence_intensity": 0.1} and words == "turbulence.intensity = 0.1"
     stored = recordfigures.spectra_lines(recordfigures.record_spectra_data(ds, settings),
-                                         settings)
+                                         chosen, settings)
     np.testing.assert_array_equal(stored[1], ds["record_psd_u_true"].sel(
         turbulence_intensity=0.1).values)
     assert list(stored[2]) == ["lidar, fixed"]
     assert capsys.readouterr().err == ""
     older = ds.drop_vars([name for name in ds.variables if name.startswith("record_")])
     again = recordfigures.spectra_lines(recordfigures.record_spectra_data(older, settings),
-                                        settings)
+                                        chosen, settings)
     assert "no stored record spectra" in capsys.readouterr().err
     for one, two in zip(stored, again):
         if isinstance(one, dict):
@@ -108,3 +109,25 @@ def test_spectra_figure_reads_what_the_run_stored_and_an_older_file_draws_it_aga
             one, two = list(one.values()), list(two.values())
         np.testing.assert_array_equal(one, two)
     plt.close(recordfigures.record_spectra(ds))
+
+
+def test_record_figures_draw_the_selected_scene():
+    """`uq plot --select turbulence_intensity=0.05`: the spectra are that scene's stored
+    ones and the budget that scene's (not the file's intensity, 0.1), and the titles
+    say which scene they draw."""
+    import matplotlib.pyplot as plt
+    from uq.outputs.figures import select_scenes
+    ds = uq.run({**SMALL, "turbulence": {"intensity": 0.1}})
+    at = select_scenes(ds, {"turbulence_intensity": "0.05"})
+    settings, chosen, words = recordfigures.shown_scene(at, lines=("correction",))
+    assert settings["turbulence"]["intensity"] == 0.05 and chosen == {}
+    lines = recordfigures.spectra_lines(recordfigures.record_spectra_data(at, settings),
+                                        chosen, settings)
+    np.testing.assert_array_equal(lines[1], ds["record_psd_u_true"].sel(
+        turbulence_intensity=0.05).values)
+    for function in (recordfigures.record_spectra, recordfigures.ti_budget):
+        figure = function(at)
+        titles = [figure._suptitle.get_text() if figure._suptitle else ""] + \
+            [ax.get_title() for ax in figure.axes]
+        assert any("turbulence.intensity = 0.05" in t.replace("\n", " ") for t in titles)
+        plt.close(figure)

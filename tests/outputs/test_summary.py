@@ -66,7 +66,7 @@ def test_report_states_the_apparent_turbulence_intensity():
                  "sampling": {"n": 500, "seed": 1}, "correction": "none"})
     ti = float(ds["wind_speed_motion_ti"])
     page = render_report(ds, true_ti=0.05)
-    assert "Apparent turbulence intensity" in page and "5 %" in page
+    assert "The motion's turbulence-intensity increment" in page and "5 %" in page
     assert f"{100 * np.hypot(0.05, ti):.2f} %" in page
 
 

@@ -34,6 +34,7 @@ from uq.pipeline.records import turbulence_model
 from uq.pipeline.scenario import load_scenario
 from uq.pipeline.turbulencesection import scan_geometry
 from uq.outputs import layout
+from uq.outputs.samples import scene_assignments
 from uq.outputs.scenes import swept_keys, value_text
 
 
@@ -65,22 +66,19 @@ def shown_scene(dataset, lines=()):
     raw = yaml.safe_load(dataset.attrs["scenario"])
     raw.pop("sweep", None)
     file_values = load_scenario(raw).settings
-    assignments, chosen, words = {}, {}, []
-    for dim, key in swept_keys(dataset).items():
-        coordinate = dataset[dim]
-        if dim in lines and coordinate.ndim:
+    keys = swept_keys(dataset)
+    chosen = {}
+    for dim, key in keys.items():
+        if dim in lines:
             continue
-        if coordinate.ndim:
-            own = _get(file_values, key)
-            values = [v.item() if hasattr(v, "item") else v for v in coordinate.values]
-            value = own if own in values else values[0]
-            chosen[dim] = value
-        else:
-            value = coordinate.values.item()
-        value = value.decode() if isinstance(value, bytes) else value
-        assignments[key] = value
-        words.append(f"{key} = {value_text(value)}")
-    return load_scenario(raw, assignments).settings, chosen, ", ".join(words)
+        own = _get(file_values, key)
+        values = [v.item() if hasattr(v, "item") else v for v in dataset[dim].values]
+        chosen[dim] = own if own in values else values[0]
+    fixed = {keys[d]: _get(file_values, keys[d]) for d in lines if d in keys}
+    assignments = scene_assignments(dataset.sel(chosen), fixed)
+    words = ", ".join(f"{key} = {value_text(value)}" for key, value in assignments.items()
+                      if key not in fixed)
+    return load_scenario(raw, assignments).settings, chosen, words
 
 
 def _get(settings, dotted):

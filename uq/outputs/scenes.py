@@ -49,15 +49,27 @@ def value_text(value):
         else str(value)
 
 
+def gate_words(dataset):
+    """What a range gate is called: a nacelle lidar's (a tilted mount, ``lidar.mount``)
+    is a preview distance along its boresight, an upward lidar's a range gate."""
+    try:
+        lidar = (yaml.safe_load(dataset.attrs.get("scenario", "")) or {}).get("lidar") or {}
+    except yaml.YAMLError:
+        lidar = {}
+    tilt = (lidar.get("mount") or {}).get("tilt", 0) if isinstance(lidar, dict) else 0
+    return "preview distance" if tilt else "range gate"
+
+
 def scene_values(dataset, index):
     """``[(dotted key or "range gate [m]", value text), ...]`` of one scene (and gate)."""
     keys = swept_keys(dataset)
-    return [("range gate [m]" if dim == "range" else keys[dim],
+    return [(f"{gate_words(dataset)} [m]" if dim == "range" else keys[dim],
              value_text(dataset[dim].values[position])) for dim, position in index.items()]
 
 
 def where_text(dataset, index):
     """``wind.direction = 90, range gate 80 m``: a scene (and gate) in words."""
-    parts = [f"range gate {value} m" if key == "range gate [m]" else f"{key} = {value}"
+    gate = f"{gate_words(dataset)} [m]"
+    parts = [f"{gate[:-4]} {value} m" if key == gate else f"{key} = {value}"
              for key, value in scene_values(dataset, index)]
     return ", ".join(parts) or "the one scene"

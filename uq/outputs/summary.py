@@ -13,7 +13,7 @@ from uq.constants import FULL_CIRCLE_DEG, NUMERICAL_ZERO
 from uq.outputs import verdicts
 from uq.outputs.planning import fixed_phase_note
 from uq.outputs.planning import uncertain as planning_uncertain
-from uq.outputs.scenes import (scene_count, scene_indices, scene_values, sweep_dimensions,
+from uq.outputs.scenes import (gate_words, scene_count, scene_indices, scene_values, sweep_dimensions,
                                swept_keys, where_text)
 from uq.pipeline.metadata import QUANTITIES
 
@@ -119,7 +119,8 @@ def _extent_lines(dataset, q, judged, has_gates):
     lines = []
     for gate in (range(dataset.sizes["range"]) if has_gates else [None]):
         at = dataset if gate is None else dataset.isel(range=gate)
-        title = q if gate is None else f"{q} at range gate {float(at['range']):g} m"
+        title = q if gate is None else \
+            f"{q} at {gate_words(dataset)} {float(at['range']):g} m"
         rows = []
         for column in _EXTENT_COLUMNS:
             name = f"{q}_{column}"
@@ -184,10 +185,11 @@ def _record_table(dataset, per_scene):
         keys = [key for key, _ in scene_values(dataset, scene_indices(
             dataset, gates=has_gates)[0])]
     else:
-        rows, keys = [], (["range gate [m]"] if has_gates else [])
+        gate_key = f"{gate_words(dataset)} [m]"
+        rows, keys = [], ([gate_key] if has_gates else [])
         for gate in (range(dataset.sizes["range"]) if has_gates else [None]):
             at = dataset if gate is None else dataset.isel(range=gate)
-            cells = {} if gate is None else {"range gate [m]": f"{float(at['range']):g}"}
+            cells = {} if gate is None else {gate_key: f"{float(at['range']):g}"}
             cells.update({h: _percent_extent(at, n) for h, n in present.items()})
             if valid is not None:
                 v = at["turbulence_intensity_spectral_valid"].values
