@@ -7,8 +7,6 @@ the canvas edge. Widths are measured with matplotlib's own text metrics (the fon
 figure uses), so a wrapped title or a legend's columns fit on the canvas whatever the
 words.
 """
-import math
-
 from matplotlib.font_manager import FontProperties
 from matplotlib.textpath import TextToPath
 
@@ -68,8 +66,10 @@ def legend_columns(figure, labels, fontsize, longest=None):
               for label in labels]
     limit = usable_width(figure)
     for columns in range(min(longest or len(labels), len(labels)), 0, -1):
-        rows = math.ceil(len(labels) / columns)
-        parts = [widths[start:start + rows] for start in range(0, len(widths), rows)]
+        rows, large = divmod(len(labels), columns)      # as matplotlib's Legend splits
+        counts = [rows + 1] * large + [rows] * (columns - large)
+        starts = [sum(counts[:k]) for k in range(columns)]
+        parts = [widths[start:start + count] for start, count in zip(starts, counts)]
         total = sum(max(part) for part in parts) + COLUMN_SPACING * fontsize * (
             len(parts) - 1) + 2 * BORDER * fontsize
         if total <= limit:
