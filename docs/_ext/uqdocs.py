@@ -221,6 +221,7 @@ def performance_page(path):
 
 # --- Sphinx -----------------------------------------------------------------------------
 _LITERAL = re.compile(r"``.*?``")
+_BOLD = re.compile(r"\*\*[^*\s]+\*\*")
 _LONE_STAR = re.compile(r"(?<![*\\])\*(?![*\s])")
 
 
@@ -229,12 +230,12 @@ def escape_lone_stars(lines):
     place): reStructuredText reads it as the start of an emphasis. Only lines with an odd
     number of stars outside ``literals`` are touched (a pair is a real emphasis)."""
     for index, line in enumerate(lines):
-        outside = _LITERAL.sub("", line)
-        if outside.count("*") % 2 == 0 or "**" in outside:
+        outside = _BOLD.sub("", _LITERAL.sub("", line))      # numpydoc bolds names: **x**
+        if outside.count("*") % 2 == 0:
             continue
-        parts = re.split(r"(``.*?``)", line)
-        lines[index] = "".join(part if part.startswith("``") else _LONE_STAR.sub(r"\\*", part)
-                               for part in parts)
+        parts = re.split(r"(``.*?``|\*\*[^*\s]+\*\*)", line)
+        lines[index] = "".join(part if part.startswith(("``", "**")) else
+                               _LONE_STAR.sub(r"\\*", part) for part in parts)
 
 
 def _process_docstring(app, what, name, obj, options, lines):
