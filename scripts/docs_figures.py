@@ -143,8 +143,8 @@ def table_nacelle(folder):
     preview distance."""
     floating, fixed = _open(folder, "n.nc"), _open(folder, "nf.nc")
     near, far = float(floating["range"].min()), float(floating["range"].max())
-    lines = [_row("", f"u(Vh) [m/s] at {near:g} / {far:g} m",
-                  f"u(yaw misalignment) [deg]", f"u(shear exponent)"),
+    lines = [_row(f"preview distance {near:g} / {far:g} m", "u(Vh) [m/s]",
+                  "u(yaw misalignment) [deg]", "u(shear exponent)"),
              _row("---", "---", "---", "---")]
     rows = [(f"floating, `{c}`", floating.sel(correction=c)) for c in floating["correction"].values]
     rows.append(("fixed turbine", fixed))
@@ -201,7 +201,7 @@ TABLES = {
     "golden_campaign": (["golden"], table_golden),
 }
 
-BLOCK = re.compile(r"(<!-- table: (?P<name>[\w.-]+) -->\n)(?P<body>.*?)(\n<!-- end table -->)",
+BLOCK = re.compile(r"(<!-- table: (?P<name>[\w.-]+) -->\n)(?P<body>.*?)(\n?<!-- end table -->)",
                    re.S)
 
 
@@ -216,7 +216,7 @@ def replace_tables(text, tables):
         name = match.group("name")
         if name not in tables:
             return match.group(0)
-        return match.group(1) + tables[name] + match.group(4)
+        return match.group(1) + tables[name].strip("\n") + "\n<!-- end table -->"
     return BLOCK.sub(swap, text)
 
 
