@@ -184,8 +184,9 @@ def performance_page(path):
              f"Every number on this page is read from one `uq bench` result file, "
              f"`{relative}`, written by `{result.command}`; each ratio divides two times "
              "measured in that run. Times depend on the machine and on what else runs on "
-             "it: compare ratios, not seconds, with your own run (`uq bench --quick`, about "
-             "a minute; `uq bench`, several).", "",
+             "it: compare ratios, not seconds, with your own run (`uq bench --quick`, fewer "
+             "sizes and no end-to-end runs, or the full `uq bench`). Each target's figure "
+             "and what it times: `uq.bench.targets`.", "",
              f"- **machine**: {result.machine}",
              f"- **load average** (1, 5, 15 min) before and after the run: {result.load}",
              f"- **measured**: {result.date}", "",
