@@ -198,7 +198,11 @@ def test_readme_table_is_what_its_commands_give(name, tmp_path):
             assert result.returncode == 0, child_failure(result)
     written = figures.readme_tables(README.read_text())[name].strip()
     assert written, f"empty README table {name}: python scripts/docs_figures.py"
-    _same_numbers(written, render(tmp_path).strip())
+    try:
+        _same_numbers(written, render(tmp_path).strip())
+    except AssertionError as error:
+        raise AssertionError(f"README table {name} is not what its commands give now: "
+                             f"python scripts/docs_figures.py --only {name}\n{error}") from None
 
 
 def test_the_number_comparison_fails_on_a_changed_number():
