@@ -123,6 +123,16 @@ def test_report_states_the_finding_with_numbers(campaign):
     assert (f"the deviation term of flsa is {row['deviation_golden']:.4f} m/s with flsb as "
             f"reference and {row['deviation_mast']:.4f} m/s with the mast") in text
     assert "The chain keeps both classification terms" in text
+    # the question "does a golden lidar lower the unit's calibration uncertainty", answered
+    # from the stored per-bin values (bins required and sufficient in both comparisons)
+    at = ds.sel(height=80.0, framework="iec")
+    bins = (at["required"] & at["sufficient"].sel(comparison="flsa-flsb")
+            & at["sufficient"].sel(comparison="flsa-mast")).values
+    golden = float(at["calibration"].sel(comparison="flsa-flsb")[bins].mean())
+    mast = float(at["calibration"].sel(comparison="flsa-mast")[bins].mean())
+    verb = "lowers" if golden < mast else "does not lower"
+    assert (f"**IEC 61400-12-1: the golden lidar {verb} flsa's calibration uncertainty** at "
+            f"80 m: {golden:.4f} m/s with flsb as reference against {mast:.4f} m/s") in text
     assert "<img src='data:image/png;base64," in (folder / "report.html").read_text()
 
 

@@ -151,6 +151,13 @@ def _finding_blocks(ds, height):
     blocks = [("h2", f"Golden lidar: {unit} against {golden} and against {mast}")]
     for r in rows:
         fw = "IEC 61400-12-1" if r["framework"] == "iec" else "LUSR"
+        lower = r["calibration_golden"] < r["calibration_mast"]
+        blocks.append(("p", (
+            f"**{fw}: the golden lidar {'lowers' if lower else 'does not lower'} {unit}'s "
+            f"calibration uncertainty** at {height:g} m: {r['calibration_golden']:.4f} m/s "
+            f"with {golden} as reference against {r['calibration_mast']:.4f} m/s with the "
+            f"{mast} (mean over {r['bins']} bins; lower in "
+            f"{r['bins_calibration_smaller']} of them).")))
         blocks.append(("p", (
             f"{fw}, {height:g} m, {r['bins']} bins: the deviation term of {unit} is "
             f"{r['deviation_golden']:.4f} m/s with {golden} as reference and "
@@ -292,7 +299,7 @@ def render_html(blocks):
         if kind in ("h1", "h2", "h3"):
             parts.append(f"<{kind}>{_e(block[1])}</{kind}>")
         elif kind == "p" and block[1]:
-            parts.append(f"<p>{_e(block[1])}</p>")
+            parts.append(f"<p>{_strong(_e(block[1]))}</p>")
         elif kind == "table":
             head = "".join(f"<th>{_e(h)}</th>" for h in block[1])
             body = "".join("<tr>" + "".join(f"<td>{_e(c)}</td>" for c in row) + "</tr>"
@@ -304,6 +311,12 @@ def render_html(blocks):
                          f"<figcaption>{_e(block[2])}</figcaption></figure>")
     parts.append("</body></html>")
     return "\n".join(parts)
+
+
+def _strong(text):
+    """Markdown's ``**bold**`` as HTML's ``<b>bold</b>`` (in escaped text)."""
+    parts = text.split("**")
+    return "".join(f"<b>{p}</b>" if k % 2 else p for k, p in enumerate(parts))
 
 
 def _e(text):
