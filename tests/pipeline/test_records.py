@@ -172,7 +172,8 @@ def test_a_reused_unit_record_is_the_one_drawn_again():
     again = _record(settings)
     records._UNIT_RECORDS.clear()
     drawn = _record(settings)
-    for one, two, three in zip(fresh, again, drawn):
+    for name in ("speed", "lateral", "vertical", "reference", "kept"):
+        one, two, three = (getattr(r, name) for r in (fresh, again, drawn))
         np.testing.assert_array_equal(one, two)
         np.testing.assert_array_equal(one, three)
 
@@ -235,8 +236,9 @@ def test_the_field_scales_with_the_intensity():
     high = load_scenario({**SMALL, "turbulence": {"intensity": 0.2}}).settings
     assert records.field_scale(high) == pytest.approx(2 * records.field_scale(low), rel=1e-14)
     one, two = _record(low), _record(high)
-    np.testing.assert_allclose(two[1] - 10.0, 2 * (one[1] - 10.0), rtol=1e-12, atol=0)
-    assert two[2] == pytest.approx(one[2], rel=1e-14)          # the box keeps the same share
+    np.testing.assert_allclose(two.reference - [10.0, 0, 0], 2 * (one.reference - [10.0, 0, 0]),
+                               rtol=1e-12, atol=0)
+    assert two.kept == pytest.approx(one.kept, rel=1e-14)      # the box keeps the same share
 
 
 def test_same_results_from_an_empty_and_a_warm_cache_and_any_chunking():
@@ -275,10 +277,10 @@ def test_stored_spectra_hold_the_records_variance():
     settings = load_scenario(SMALL).settings
     series = [_record(settings, r) for r in range(3)]
     step = float(frequency[1] - frequency[0])
-    expected = np.mean([vh.var(axis=0) for vh, *_ in series], axis=0)
+    expected = np.mean([r.speed.var(axis=0) for r in series], axis=0)
     np.testing.assert_allclose(ds["record_psd_wind_speed"].sum("record_frequency") * step,
                                expected, rtol=1e-12)
-    expected = np.mean([reference.var() for _, reference, *_ in series])
+    expected = np.mean([r.reference[:, 0].var() for r in series])
     assert float(ds["record_psd_u_true"].sum() * step) == pytest.approx(expected, rel=1e-12)
     assert records.spectrum_axis(settings) == (2.0, 15)
 
@@ -292,14 +294,16 @@ def test_scenes_differing_only_outside_the_spectral_path_share_its_computation(m
               {**base, "wind": {**base["wind"], "direction": 300.0}}]
     computed, original = [], records.spectral_variances
     monkeypatch.setattr(records, "_SPECTRAL_PATHS", type(records._SPECTRAL_PATHS)())
-    monkeypatch.setattr(records, "spectral_variances",
-                        lambda settings: (computed.append(settings), original(settings))[1])
-    lidar, true = records.scene_spectral_paths(scenes, len(base["lidar"]["ranges"]))
+    monkeypatch.setattr(records, "spectral_variances", lambda settings, intensity=None: (
+        computed.append(settings), original(settings, intensity))[1])
+    paths = records.scene_spectral_paths(scenes, len(base["lidar"]["ranges"]))
     assert [s is base for s in computed] == [True, False] and computed[1] is scenes[2]
     # the shared computation gives the second scene exactly what its own would
-    alone = original(scenes[1])[0]
-    assert np.array_equal(lidar[1], alone.lidar[:, 0]) and true[1] == alone.true[0]
-    assert np.array_equal(lidar[0], lidar[1])
+    alone = original(scenes[1], 1.0)[0]
+    square = base["turbulence"]["intensity"] ** 2
+    assert np.array_equal(paths["lidar"][1], alone.lidar * square)
+    assert np.array_equal(paths["true"][1], alone.true * square)
+    assert np.array_equal(paths["lidar"][0], paths["lidar"][1])
 
 
 @pytest.mark.parametrize("model", ["mann", "kaimal"])
@@ -315,11 +319,11 @@ def test_a_scene_s_spectral_path_scaled_from_another_intensity_equals_its_own(mo
     other = {**base, "turbulence": {**base["turbulence"], "intensity": 0.17}}
     monkeypatch.setattr(records, "_SPECTRAL_PATHS", type(records._SPECTRAL_PATHS)())
     n_gates = len(base["lidar"]["ranges"])
-    lidar, true = records.scene_spectral_paths([base, other], n_gates)
+    paths = records.scene_spectral_paths([base, other], n_gates)
     own = records.spectral_variances(other)[0]
-    np.testing.assert_allclose(lidar[1], own.lidar[:, 0], rtol=1e-13)
-    np.testing.assert_allclose(true[1], own.true[0], rtol=1e-13)
-    assert not np.allclose(lidar[0], lidar[1])          # the intensity does matter
+    np.testing.assert_allclose(paths["lidar"][1], own.lidar, rtol=1e-13)
+    np.testing.assert_allclose(paths["true"][1], own.true, rtol=1e-13)
+    assert not np.allclose(paths["lidar"][0], paths["lidar"][1])   # the intensity matters
 
 
 def test_the_spectral_path_is_computed_once_for_a_run_s_chunks(monkeypatch):
@@ -329,8 +333,8 @@ def test_the_spectral_path_is_computed_once_for_a_run_s_chunks(monkeypatch):
     monkeypatch.setattr(records, "_SPECTRAL_PATHS", type(records._SPECTRAL_PATHS)())
     base = load_scenario(scenario_path("sathe2011_ti"), {"lidar.ranges": [100.0]}).settings
     computed, original = [], records.spectral_variances
-    monkeypatch.setattr(records, "spectral_variances",
-                        lambda settings: (computed.append(settings), original(settings))[1])
+    monkeypatch.setattr(records, "spectral_variances", lambda settings, intensity=None: (
+        computed.append(settings), original(settings, intensity))[1])
     for intensity in (0.05, 0.1):                   # two chunks, one scene each
         other = {**base, "turbulence": {**base["turbulence"], "intensity": intensity}}
         records.scene_spectral_paths([other], 1)

@@ -35,6 +35,7 @@ import functools
 import hashlib
 import json
 import math
+import logging
 import threading
 
 import numpy as np
@@ -45,8 +46,11 @@ from uq.physics.spectraltensor import KaimalSpectra, mann_tensor_for_intensity
 from uq.pipeline import probesection
 from uq.constants import KAIMAL_LENGTH_FACTOR as LENGTH_FACTORS_KAIMAL
 from uq.constants import (RECORD_BOX_SLAB_CELLS, RECORD_FFT_WORKERS, RECORD_SPECTRA_BYTES,
+                          SPECTRAL_REFINEMENTS, SPECTRAL_TOLERANCE,
                           SPECTRAL_PATHS_KEPT, UNIT_RECORD_CACHE_BYTES)
-from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
+from uq.pipeline.turbulencesection import scan_geometry, scans_per_record, slant_ranges
+
+log = logging.getLogger(__name__)
 
 #: Attributes of the record-mode variables.
 RECORD_ATTRIBUTES = {
@@ -93,6 +97,56 @@ RECORD_ATTRIBUTES = {
     "turbulence_intensity_u_ratio": {
         "units": "1", "long_name": "u-variance ratio of the lidar's filtered turbulence to "
         "the field's at the reference point over the record (spectral path)"},
+    "turbulence_v_ratio": {
+        "units": "1", "long_name": "lateral (v) variance ratio of the lidar's filtered "
+        "turbulence to the field's at the reference point over the record (spectral "
+        "path; v across the mean wind, horizontal)"},
+    "turbulence_w_ratio": {
+        "units": "1", "long_name": "vertical (w) variance ratio of the lidar's filtered "
+        "turbulence to the field's at the reference point over the record (spectral path)"},
+    "turbulence_intensity_u_ratio_error": {
+        "units": "1", "long_name": "numerical error estimate of turbulence_intensity_u_ratio "
+        "(the spectral path's quadrature against one with fewer nodes: an overstatement)"},
+    "turbulence_v_ratio_error": {
+        "units": "1", "long_name": "numerical error estimate of turbulence_v_ratio (the "
+        "spectral path's quadrature against one with fewer nodes: an overstatement)"},
+    "turbulence_w_ratio_error": {
+        "units": "1", "long_name": "numerical error estimate of turbulence_w_ratio (the "
+        "spectral path's quadrature against one with fewer nodes: an overstatement)"},
+    "turbulence_intensity_spectral_error": {
+        "units": "1", "long_name": "numerical error estimate of "
+        "turbulence_intensity_spectral (the spectral path's quadrature)"},
+    "turbulence_intensity_true_error": {
+        "units": "1", "long_name": "numerical error estimate of turbulence_intensity_true "
+        "(the spectral path's quadrature)"},
+    "turbulence_intensity_v_true": {
+        "units": "1", "long_name": "lateral turbulence intensity sigma_v / U of the field at "
+        "the reference point over a record (expected, spectral; the record's high-pass)"},
+    "turbulence_intensity_w_true": {
+        "units": "1", "long_name": "vertical turbulence intensity sigma_w / U of the field "
+        "at the reference point over a record (expected, spectral; the record's high-pass)"},
+    "turbulence_intensity_v_spectral": {
+        "units": "1", "long_name": "apparent lateral turbulence intensity std(v) / U the "
+        "lidar reports over a record from the filtered turbulence alone (spectral path)"},
+    "turbulence_intensity_w_spectral": {
+        "units": "1", "long_name": "apparent vertical turbulence intensity std(w) / U the "
+        "lidar reports over a record from the filtered turbulence alone (spectral path)"},
+    "turbulence_spectral_converged": {
+        "units": "1", "long_name": "the spectral path reached its tolerance (each ratio's "
+        "estimated relative error within uq.constants.SPECTRAL_TOLERANCE)"},
+    "turbulence_intensity_v_mc_mean": {
+        "units": "1", "long_name": "Monte Carlo mean over records of the apparent lateral "
+        "turbulence intensity std(v) / mean(Vh) of a record (v: the reconstructed wind "
+        "across the record's mean direction; the scans' errors included)"},
+    "turbulence_intensity_w_mc_mean": {
+        "units": "1", "long_name": "Monte Carlo mean over records of the apparent vertical "
+        "turbulence intensity std(w) / mean(Vh) of a record (the scans' errors included)"},
+    "turbulence_intensity_v_true_mc_mean": {
+        "units": "1", "long_name": "Monte Carlo mean over records of the field's std(v) / "
+        "mean(u) at the reference point, sampled once a scan"},
+    "turbulence_intensity_w_true_mc_mean": {
+        "units": "1", "long_name": "Monte Carlo mean over records of the field's std(w) / "
+        "mean(u) at the reference point, sampled once a scan"},
 }
 
 
@@ -106,16 +160,31 @@ def turbulence_model(turbulence, speed):
     return KaimalSpectra.iec(turbulence["intensity"], speed, turbulence["length_scale"])
 
 
-def spectral_variances(settings):
-    """The :class:`~uq.physics.lidarspectral.SpectralVariances` of validated `settings`:
-    the probe's own transfer function (:func:`~uq.physics.lidarspectral.
-    probe_transfer_for`) at the slanted beams' focus of each gate."""
+def spectral_variances(settings, intensity=None):
+    """The :class:`~uq.physics.lidarspectral.SpectralVariances` of validated `settings`
+    (their lidar's u, v, w variance ratios: ``.ratios()``; their numerical errors:
+    ``.ratio_errors()``), and the scan geometry: the probe's own transfer function
+    (:func:`~uq.physics.lidarspectral.probe_transfer_for`) at each gate's slant
+    distance; the field at `intensity` [1] (default the scene's ``turbulence.
+    intensity``: the variances are proportional to its square)."""
     geometry = scan_geometry(settings)
     lidar = settings["lidar"]
-    focus = np.asarray(lidar["ranges"], float) / math.cos(math.radians(lidar["half_cone"]))
-    transfer = probe_transfer_for(probesection.make_probe(lidar.get("probe")), focus)
-    model = turbulence_model(settings["turbulence"], settings["wind"]["speed"])
+    transfer = probe_transfer_for(probesection.make_probe(lidar.get("probe")),
+                                  slant_ranges(lidar))
+    turbulence = dict(settings["turbulence"])
+    if intensity is not None:
+        turbulence["intensity"] = intensity
+    model = turbulence_model(turbulence, settings["wind"]["speed"])
     return lidar_variances(geometry, model, transfer), geometry
+
+
+def spectral_ratios(settings):
+    """The lidar's (u, v, w) variance ratios to the field's at the reference point over a
+    record of validated `settings` [1], shape (n_gates, 3), and their numerical errors
+    [1] (the same shape): the spectral path, computed once per lidar and record
+    (:func:`unit_spectral_variances`; the ratios do not depend on the intensity)."""
+    unit = unit_spectral_variances(settings)
+    return unit.ratios(), unit.ratio_errors()
 
 
 def chunk_fields(scenario, plan, chunk):
@@ -154,18 +223,40 @@ def record_variables(scenario, fields, dataset, seed=0, compiled=True, spectra_o
     `prepared`: :func:`prepare_records` of the same arguments (else done here)."""
     scenes = scene_settings(scenario, fields)
     n_gates = len(scenario.settings["lidar"]["ranges"])
-    lidar, true = prepared if prepared is not None else scene_spectral_paths(scenes, n_gates)
+    paths = prepared if prepared is not None else scene_spectral_paths(scenes, n_gates)
     speeds = np.array([s["wind"]["speed"] for s in scenes])
     truth = dataset["wind_speed_true"].values.reshape(len(scenes), n_gates)
     u_scan = _scan_uncertainty(dataset).reshape(len(scenes), n_gates)
-    out = {
-        "turbulence_intensity_true": (("scene",), np.sqrt(true) / speeds),
-        "turbulence_intensity_spectral": (("scene", "range"),
-                                          np.sqrt(lidar + u_scan ** 2) / truth),
-        "turbulence_intensity_spectral_turbulence": (("scene", "range"),
-                                                     np.sqrt(lidar) / truth),
-        "turbulence_intensity_u_ratio": (("scene", "range"), lidar / true[:, None]),
-    }
+    lidar, true = paths["lidar"], paths["true"]
+    lidar_error, true_error = paths["lidar_error"], paths["true_error"]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratios = lidar / true[:, None, :]
+        ratio_errors = (np.abs(lidar_error) + np.abs(ratios) * true_error[:, None, :]) \
+            / true[:, None, :]
+        spectral = np.sqrt(lidar[..., 0] + u_scan ** 2) / truth
+        out = {
+            "turbulence_intensity_true": (("scene",), np.sqrt(true[:, 0]) / speeds),
+            "turbulence_intensity_true_error": (("scene",), true_error[:, 0] / (
+                2 * np.sqrt(true[:, 0]) * speeds)),
+            "turbulence_intensity_spectral": (("scene", "range"), spectral),
+            "turbulence_intensity_spectral_error": (("scene", "range"), lidar_error[..., 0] / (
+                2 * spectral * truth ** 2)),
+            "turbulence_intensity_spectral_turbulence": (("scene", "range"),
+                                                         np.sqrt(lidar[..., 0]) / truth),
+            "turbulence_intensity_u_ratio": (("scene", "range"), ratios[..., 0]),
+            "turbulence_v_ratio": (("scene", "range"), ratios[..., 1]),
+            "turbulence_w_ratio": (("scene", "range"), ratios[..., 2]),
+            "turbulence_intensity_u_ratio_error": (("scene", "range"), ratio_errors[..., 0]),
+            "turbulence_v_ratio_error": (("scene", "range"), ratio_errors[..., 1]),
+            "turbulence_w_ratio_error": (("scene", "range"), ratio_errors[..., 2]),
+            "turbulence_intensity_v_true": (("scene",), np.sqrt(true[:, 1]) / speeds),
+            "turbulence_intensity_w_true": (("scene",), np.sqrt(true[:, 2]) / speeds),
+            "turbulence_intensity_v_spectral": (("scene", "range"),
+                                                np.sqrt(lidar[..., 1]) / truth),
+            "turbulence_intensity_w_spectral": (("scene", "range"),
+                                                np.sqrt(lidar[..., 2]) / truth),
+            "turbulence_spectral_converged": (("scene",), paths["converged"]),
+        }
     if scenario.sampling["method"] != "none":
         out.update(monte_carlo_variables(
             scenes, truth, seed, compiled, out["turbulence_intensity_spectral"][1],
@@ -186,16 +277,30 @@ def prepare_records(scenario, fields, seed, spectra_of=None):
 
 
 def scene_spectral_paths(scenes, n_gates):
-    """The spectral path of each scene's settings (:func:`spectral_variances`): the
-    lidar's filtered u-variance per gate (n_scenes, n_gates) and the field's at the
-    reference point (n_scenes,) [m2 s-2]; NaN without a mean wind (no frozen field)."""
-    lidar, true = np.full((len(scenes), n_gates), np.nan), np.full(len(scenes), np.nan)
+    """The spectral path of each scene's settings (:func:`unit_spectral_variances`
+    times the square of its intensity): a dict of the lidar's filtered (u, v, w)
+    variances per gate ``lidar`` (n_scenes, n_gates, 3) and their errors
+    ``lidar_error``, the field's at the reference point ``true`` (n_scenes, 3) and
+    ``true_error`` [m2 s-2], and ``converged`` (n_scenes,); NaN without a mean wind (no
+    frozen field).
+
+    Each lidar is computed once at unit intensity and scaled by the square of the
+    scene's, the same bits whichever scenes a process computes first (a run resumed
+    after any chunk gives the uninterrupted run's numbers)."""
+    out = {"lidar": np.full((len(scenes), n_gates, 3), np.nan),
+           "lidar_error": np.full((len(scenes), n_gates, 3), np.nan),
+           "true": np.full((len(scenes), 3), np.nan),
+           "true_error": np.full((len(scenes), 3), np.nan),
+           "converged": np.ones(len(scenes), dtype=bool)}
     for i, settings in enumerate(scenes):
         if settings["wind"]["speed"] > 0:
-            gates, point, computed_at = _spectral_path(settings)
-            factor = (settings["turbulence"]["intensity"] / computed_at) ** 2  # (I U)^2
-            lidar[i], true[i] = gates * factor, point * factor
-    return lidar, true
+            unit = unit_spectral_variances(settings)
+            square = settings["turbulence"]["intensity"] ** 2
+            out["lidar"][i], out["lidar_error"][i] = unit.lidar * square, \
+                unit.lidar_error * square
+            out["true"][i], out["true_error"][i] = unit.true * square, unit.true_error * square
+            out["converged"][i] = unit.converged
+    return out
 
 
 #: Spectral paths kept for the run's other chunks, by :func:`spectral_key` (the oldest
@@ -204,17 +309,22 @@ _SPECTRAL_PATHS = collections.OrderedDict()
 _SPECTRAL_PATHS_LOCK = threading.Lock()
 
 
-def _spectral_path(settings):
-    """(lidar u-variance per gate (n_gates,), the field's at the reference point,
-    the intensity they were computed at) of `settings`' key, computed once per key."""
+def unit_spectral_variances(settings):
+    """The :class:`~uq.physics.lidarspectral.SpectralVariances` of `settings` at unit
+    ``turbulence.intensity``, computed once per :func:`spectral_key` in a process (the
+    variances of any intensity are these times its square, exactly: Mann's alpha
+    eps^(2/3) and the Kaimal spectra are proportional to (I U)^2, the lidar's variances
+    linear in them)."""
     key = spectral_key(settings)
     with _SPECTRAL_PATHS_LOCK:
         if key in _SPECTRAL_PATHS:
             _SPECTRAL_PATHS.move_to_end(key)
             return _SPECTRAL_PATHS[key]
-    variances = spectral_variances(settings)[0]
-    found = (variances.lidar[:, 0].copy(), float(variances.true[0]),
-             settings["turbulence"]["intensity"])
+    found = spectral_variances(settings, intensity=1.0)[0]
+    if not found.converged:
+        log.warning("%s: the spectral path did not reach its tolerance (%g) in %d "
+                    "refinements; its stated errors say by how much",
+                    settings.get("name", "scenario"), SPECTRAL_TOLERANCE, SPECTRAL_REFINEMENTS)
     with _SPECTRAL_PATHS_LOCK:
         _SPECTRAL_PATHS[key] = found
         while len(_SPECTRAL_PATHS) > SPECTRAL_PATHS_KEPT:
@@ -232,7 +342,8 @@ def spectral_key(settings):
     (``correction``, the INS, the motion) or in ``turbulence.intensity`` share one
     computation, scaled by the square of the intensities' ratio (the Mann tensor's
     alpha eps^(2/3) and the Kaimal spectra are proportional to (I U)^2, and the lidar's
-    variances linear in them; ``turbulence.intensity`` is validated positive)."""
+    variances linear in them; ``turbulence.intensity`` is validated positive:
+    :func:`unit_spectral_variances`)."""
     sections = {name: settings.get(name) for name in SPECTRAL_SECTIONS}
     sections["turbulence"] = {**sections["turbulence"], "intensity": None}
     return json.dumps(sections, sort_keys=True, default=repr)
@@ -556,13 +667,50 @@ def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True, spectra=
         + scale * unit.radial
     if phases is not None:
         errors["motion_phases"] = phases
-    result = measurement_model(scene, ("wind_speed",), compiled=compiled, **errors)
+    result = measurement_model(scene, ("wind_speed", "wind_direction", "vertical_wind"),
+                               compiled=compiled, **errors)
     speed = np.real(result["wind_speed"]).reshape(n_scans, -1)
-    found = (speed, geometry.speed + scale * unit.reference[:, 0], unit.kept)
-    if spectra is not None:
-        found += (record_spectra_series(settings, scene, errors, unit, scale, n_scans,
-                                        spectra, compiled),)
-    return found
+    reference = scale * unit.reference
+    reference[:, 0] += geometry.speed
+    return RecordSeries(
+        speed, lateral_series(speed, np.real(result["wind_direction"]).reshape(n_scans, -1)),
+        np.real(result["vertical_wind"]).reshape(n_scans, -1), reference, unit.kept,
+        None if spectra is None else record_spectra_series(
+            settings, scene, errors, unit, scale, n_scans, spectra, compiled))
+
+
+@dataclasses.dataclass(frozen=True)
+class RecordSeries:
+    """One Monte Carlo record (:func:`monte_carlo_record`), once a scan.
+
+    Attributes
+    ----------
+    speed, lateral, vertical : ndarray, shape (n_scans, n_gates)
+        The lidar's horizontal speed, its wind across the record's mean direction
+        (:func:`lateral_series`) and its vertical wind [m s-1].
+    reference : ndarray, shape (n_scans, 3)
+        The field's (u, v, w) at the reference point, the mean speed in u [m s-1].
+    kept : float
+        The u-variance fraction the box keeps [1] (``turbulence_intensity_box_kept``).
+    spectra : dict or None
+        The series the record spectra are taken of (:func:`record_spectra_series`).
+    """
+
+    speed: np.ndarray
+    lateral: np.ndarray
+    vertical: np.ndarray
+    reference: np.ndarray
+    kept: float
+    spectra: object = None
+
+
+def lateral_series(speed, direction):
+    """The wind across the record's mean direction [m s-1], ``Vh sin(D - D_mean)`` (D the
+    meteorological direction [deg], its circular mean over the record per gate): the
+    lateral component v of the mean-wind frame, to first order."""
+    radians = np.radians(direction)
+    mean = np.arctan2(np.sin(radians).mean(axis=0), np.cos(radians).mean(axis=0))
+    return speed * np.sin(radians - mean)
 
 
 def record_motion(settings, geometry, n_scans, rng):
@@ -621,7 +769,8 @@ def spectra_variables(scenes, seed, compiled=True, moving=False):
             found = monte_carlo_record(settings, geometry, spectra.n_scans,
                                        record_generator(seed, r), compiled,
                                        rest_generator(seed, r))
-            spectra.add(i, {"wind_speed": found[0], "u_true": found[1], **found[3]}, count)
+            spectra.add(i, {"wind_speed": found.speed, "u_true": found.reference[:, 0],
+                            **found.spectra}, count)
     return spectra.variables(moving)
 
 
@@ -689,7 +838,8 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral, axis=None, mo
     count = records[0]["count"]
     n_gates = truth.shape[1]
     apparent = np.full((len(scenes), count, n_gates), np.nan)
-    true_ti = np.full((len(scenes), count), np.nan)
+    components = np.full((len(scenes), count, n_gates, 2), np.nan)     # v, w
+    true_ti = np.full((len(scenes), count, 3), np.nan)
     error = np.full((len(scenes), count, n_gates), np.nan)
     kept = np.full(len(scenes), np.nan)
     spectra = RecordSpectra(axis, len(scenes), n_gates) if axis else None
@@ -702,12 +852,16 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral, axis=None, mo
         for r in range(count):
             found = monte_carlo_record(settings, geometry, n_scans, record_generator(seed, r),
                                        compiled, rest_generator(seed, r) if wanted else None)
-            vh, reference, kept[i] = found[:3]
-            apparent[i, r] = vh.std(axis=0, ddof=1) / vh.mean(axis=0)
-            true_ti[i, r] = reference.std(ddof=1) / reference.mean()
-            error[i, r] = vh.mean(axis=0) - truth[i] - (reference.mean() - settings["wind"]["speed"])
+            vh, reference, kept[i] = found.speed, found.reference, found.kept
+            mean = vh.mean(axis=0)
+            apparent[i, r] = vh.std(axis=0, ddof=1) / mean
+            components[i, r, :, 0] = found.lateral.std(axis=0, ddof=1) / mean
+            components[i, r, :, 1] = found.vertical.std(axis=0, ddof=1) / mean
+            true_ti[i, r] = reference.std(axis=0, ddof=1) / reference[:, 0].mean()
+            error[i, r] = mean - truth[i] - (reference[:, 0].mean() - settings["wind"]["speed"])
             if wanted:
-                spectra.add(i, {"wind_speed": vh, "u_true": reference, **found[3]}, count)
+                spectra.add(i, {"wind_speed": vh, "u_true": reference[:, 0], **found.spectra},
+                            count)
     squares = apparent ** 2
     z = (spectral ** 2 - squares.mean(axis=1)) / (squares.std(axis=1, ddof=1) / np.sqrt(count))
     low, high = np.quantile(apparent, [0.025, 0.975], axis=1)
@@ -716,7 +870,11 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral, axis=None, mo
         "turbulence_intensity_mc_u": (("scene", "range"), apparent.std(axis=1, ddof=1)),
         "turbulence_intensity_mc_low": (("scene", "range"), low),
         "turbulence_intensity_mc_high": (("scene", "range"), high),
-        "turbulence_intensity_true_mc_mean": (("scene",), true_ti.mean(axis=1)),
+        "turbulence_intensity_true_mc_mean": (("scene",), true_ti[..., 0].mean(axis=1)),
+        "turbulence_intensity_v_true_mc_mean": (("scene",), true_ti[..., 1].mean(axis=1)),
+        "turbulence_intensity_w_true_mc_mean": (("scene",), true_ti[..., 2].mean(axis=1)),
+        "turbulence_intensity_v_mc_mean": (("scene", "range"), components[..., 0].mean(axis=1)),
+        "turbulence_intensity_w_mc_mean": (("scene", "range"), components[..., 1].mean(axis=1)),
         "turbulence_intensity_spectral_z": (("scene", "range"), z),
         "turbulence_intensity_spectral_valid": (("scene", "range"), np.abs(z) <= VALID_Z),
         "turbulence_intensity_box_kept": (("scene",), kept),

@@ -36,6 +36,7 @@ from uq.constants import (KAIMAL_LENGTH_FACTOR, MANN_ANISOTROPY, MANN_LENGTH_FAC
                           MAX_ANISOTROPY, MAX_LENGTH_SCALE, MAX_RECORD_DURATION,
                           MAX_RECORD_SCANS, MAX_RECORDS, MAX_TURBULENCE_INTENSITY,
                           DEFAULT_RECORDS, TURBULENCE_PROBE_NODES)
+from uq.physics import nacelle
 from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
 from uq.physics.probe import legendre
 from uq.physics.rotation import attitude_matrix, rotate_vectors
@@ -43,6 +44,7 @@ from uq.physics.scangeometry import ScanGeometry, earth_to_wind_frame
 from uq.physics.spectraltensor import iec_scale_parameter
 from uq.pipeline import probesection
 from uq.pipeline.motionsection import SCAN_DEFAULTS
+from uq.pipeline.mountsection import tilt_of
 
 #: Turbulence models (``turbulence.model``).
 TURBULENCE_MODELS = ("mann", "kaimal")
@@ -132,9 +134,13 @@ def scan_geometry(settings):
       gates' nodes differ (a CW focus), the nodes of every gate side by side, each gate
       weighting only its own. The vertical beam takes its gate's weighting (for a CW
       lidar its Rayleigh length is cos^2(half_cone) times the slanted beams').
-    * reconstruction: the least-squares pseudo-inverse of the directions, the same at
-      every gate: the wind of a scan at rest, which every correction model reconstructs
-      for a lidar at rest and level.
+    * reconstruction: the operator the lidar's software applies to a scan at rest, the
+      same at every gate (:func:`reconstruction_operator`: the least-squares
+      pseudo-inverse of the directions; a tilted mount's hub-height wind or its two
+      beams' horizontal wind).
+    * a tilted mount (``lidar.mount.tilt``, a nacelle lidar): its beams about the tilted
+      boresight (clock positions, :mod:`uq.physics.beams`), its ranges preview distances
+      along the boresight, each gate ``range / cos(half_cone)`` along its beam.
     * speed: ``wind.speed`` (at the reference height); ``record_duration``:
       ``record.duration``, or inf without a record.
     """
@@ -147,9 +153,8 @@ def scan_geometry(settings):
     centres = slant[..., None] * directions[:, None, :] + np.array([0.0, 0.0, lift])
     scan = {**SCAN_DEFAULTS, **lidar.get("scan", {})}
     duration = scan["beam_duration"]
-    focus = np.asarray(lidar["ranges"], dtype=float) / math.cos(math.radians(lidar["half_cone"]))
-    offsets, weights = probe_quadrature(lidar.get("probe"), focus)
-    operator = least_squares_operator(directions)
+    offsets, weights = probe_quadrature(lidar.get("probe"), slant_ranges(lidar))
+    operator = reconstruction_operator(directions, lidar)
     record = settings.get("record")
     return ScanGeometry(
         directions=directions, gate_centres=centres,
@@ -160,11 +165,54 @@ def scan_geometry(settings):
         speed=wind["speed"], record_duration=record["duration"] if record else np.inf)
 
 
+def slant_ranges(lidar):
+    """Each gate's distance from the lens along its slanted beams [m], shape (n_gates,):
+    ``range / cos(half_cone)`` (a range is a height above an upward lidar, a preview
+    distance along a tilted one's boresight); a CW lidar's focus."""
+    return np.asarray(lidar["ranges"], dtype=float) / math.cos(math.radians(lidar["half_cone"]))
+
+
+def reconstruction_operator(directions, lidar):
+    """The linear operator (3, n_beams) from a scan's radial velocities to the wind its
+    software reconstructs at rest [1], for beams `directions` (n_beams, 3) in a frame
+    with z up (a turn about z commutes with it):
+
+    * an upward lidar, or a tilted mount's beams that determine the 3-D wind without a
+      level pair: the least-squares pseudo-inverse ``(D^T D)^-1 D^T``;
+    * a tilted mount with two beams: the horizontal least squares with w = 0 assumed
+      (:func:`uq.physics.nacelle.horizontal_least_squares`: ``[(D_h^T D_h)^-1 D_h^T;
+      0]``);
+    * a tilted mount with its level pair (clock positions 90 and 270): w from the full
+      least squares, the horizontal wind from the pair less its vertical part
+      (:func:`uq.physics.nacelle.hub_height_wind`: ``u_h = D_p,h^-1 (v_p - d_p,z w)``).
+    """
+    directions = np.asarray(directions, dtype=float)
+    full = least_squares_operator(directions)
+    if tilt_of(lidar) == 0:
+        return full
+    if len(lidar["azimuths"]) == 2:                   # w = 0 assumed: two beams
+        out = np.zeros_like(full)
+        out[:2] = np.linalg.pinv(directions[:, :2])
+        return out
+    pair = nacelle.level_pair(np.radians(lidar["azimuths"]))
+    if pair is None:
+        return full
+    pair = list(pair)
+    select = np.zeros((2, directions.shape[0]))
+    select[[0, 1], pair] = 1.0
+    vertical = full[2]                                          # w: full least squares
+    horizontal = np.linalg.solve(directions[pair, :2],
+                                 select - np.outer(directions[pair, 2], vertical))
+    return np.vstack([horizontal, vertical])
+
+
 def _beam_directions(lidar, ship, direction):
-    """Unit vectors of the beams at the static attitude, in the mean-wind frame."""
+    """Unit vectors of the beams at the static attitude, in the mean-wind frame (a tilted
+    mount's about its boresight)."""
     ship_frame = beam_unit_vectors(math.radians(lidar["half_cone"]),
                                    np.radians(lidar["azimuths"]),
-                                   math.radians(lidar["misalignment"]), lidar["vertical_beam"])
+                                   math.radians(lidar["misalignment"]), lidar["vertical_beam"],
+                                   math.radians(tilt_of(lidar)))
     attitude = attitude_matrix(*np.radians([ship["heading"], ship["pitch"], ship["roll"]]))
     return earth_to_wind_frame(rotate_vectors(attitude, ship_frame), direction)
 
