@@ -441,6 +441,11 @@ MANN_LENGTH_SCALE_IEC = MANN_LENGTH_FACTOR * IEC_SCALE_PARAMETER
 #: Taylor's frozen-turbulence hypothesis (it needs sigma_u << U; Willis and Deardorff
 #: 1976, J. Atmos. Sci. 33, 1530, find it holds to sigma_u / U ~ 0.5) that both paths use.
 MAX_TURBULENCE_INTENSITY = 0.5
+#: Smallest turbulence intensity a scenario accepts [1]: sigma_u = 1e-6 U is 1e-5 m s-1 at
+#: 10 m s-1, three orders below any lidar's radial-velocity resolution (~1 cm s-1); far
+#: below it the records' variances (~(I U)^2) underflow float64 (a TI of 1e-300 has a
+#: variance of 1e-598 m2 s-2, which is 0) and their ratios are 0 / 0.
+MIN_TURBULENCE_INTENSITY = 1e-6
 #: Longest length scale a scenario accepts [m]: 10 km, beyond any atmospheric surface
 #: layer's integral length (the Kaimal L_u of IEC 61400-1 is 340 m).
 MAX_LENGTH_SCALE = 10_000.0
@@ -454,6 +459,14 @@ MAX_RECORD_DURATION = 3600.0
 #: allocated (2^20 scans of a 5-beam DBS is 5 x 2^20 lines of sight: 40 MB per gate and
 #: probe node in float64); a 600-s record of 1-ms beams of a 5-beam DBS has 120 000.
 MAX_RECORD_SCANS = 2**20
+#: Standard deviations of a random-phase motion's displacement taken for its reach in a
+#: record at validation [1] (uq.pipeline.turbulencesection.motion_reach: the box a record
+#: needs is counted before any record is drawn): a sum of many harmonics is near
+#: Gaussian, and over a ten-minute record of a 7-s sea (~90 cycles) its largest value is
+#: ~sqrt(2 ln 90) = 3.0 sigma (floating_lidar_ti's records reach 1.8-2.0 sigma). A record
+#: that reaches further and needs a box above the limit is refused in one line when its
+#: box is counted, before anything is allocated.
+MOTION_REACH_SIGMAS = 3.0
 #: Default Monte Carlo records per scene (``record.count``) [1]: each record costs a
 #: turbulence box (~7 s CPU for a 600-s record of a 5-beam DBS at 10 m s-1, L = 33.6 m, on
 #: one core here); with 20 records the standard error of the mean apparent TI is its

@@ -34,7 +34,8 @@ def test_absent_sections_leave_the_settings_as_they_were():
 
 @pytest.mark.parametrize("raw, key, allowed", [
     ({"turbulence": {}}, "turbulence.intensity", "sigma_u / U"),
-    ({"turbulence": {"intensity": 0.7}}, "turbulence.intensity", "(0, 0.5]"),
+    ({"turbulence": {"intensity": 0.7}}, "turbulence.intensity", "[1e-06, 0.5]"),
+    ({"turbulence": {"intensity": 1e-300}}, "turbulence.intensity", "[1e-06, 0.5]"),
     ({"turbulence": {"intensity": 0.1, "model": "vonkarman"}}, "turbulence.model", "mann"),
     ({"turbulence": {"intensity": 0.1, "length": 3}}, "turbulence.length", "length_scale"),
     ({"record": {"duration": 600}}, "record", "add a turbulence section"),
@@ -49,6 +50,53 @@ def test_bad_input_names_the_key_and_what_is_allowed(raw, key, allowed):
         load_scenario(raw)
     assert error.value.key == key and allowed in str(error.value)
     assert "\n" not in str(error.value)
+
+
+RECORDS = {"wind": {"speed": 10.0, "reference_height": 100.0},
+           "lidar": {"height": 0.0, "ranges": [100.0], "half_cone": 30.0,
+                     "scan": {"beam_duration": 1.0}},
+           "turbulence": {"intensity": 0.1}, "record": {"duration": 60, "count": 3},
+           "sampling": {"n": 256, "seed": 1}, "outputs": ["wind_speed"]}
+
+
+@pytest.mark.parametrize("changes, key, allowed", [
+    # a box of 51840 x 80 x 50 cells (2.1e8, 1.6 GB of float64 a component): the longest
+    # record that fits at that speed (the box grows with it along the wind)
+    ({"wind": {"speed": 60.0}, "record": {"duration": 3600}}, "record.duration",
+     "record.duration <= 284.6 s"),
+    # cells of 1.25e-10 m: 2.7e26 cells, where the box's frequencies alone would need
+    # 42 TiB (the former limit's product overflowed int64 and let it through)
+    ({"turbulence": {"length_scale": 1e-9}}, "turbulence.length_scale",
+     "turbulence.length_scale >= 4.46 m"),
+    ({"turbulence": {"length_scale": 0.5}}, "turbulence.length_scale",
+     "turbulence.length_scale >= 4.46 m"),
+    ({"turbulence": {"model": "kaimal", "length_scale": 1.0}}, "turbulence.length_scale",
+     "1024 points across the wind"),
+    ({"wind": {"speed": 0.0}}, "wind.speed", "wind.speed > 0"),
+])
+def test_records_the_model_cannot_take_are_refused_at_validation(changes, key, allowed):
+    # one line naming the key and how far it may go, before anything is made
+    raw = {name: {**RECORDS.get(name, {}), **value} for name, value in changes.items()}
+    with pytest.raises(ScenarioError) as error:
+        load_scenario({**RECORDS, **raw})
+    assert error.value.key == key and allowed in str(error.value)
+    assert "\n" not in str(error.value)
+
+
+def test_the_spectral_path_alone_takes_any_length_scale():
+    # sampling.method none makes no box: a length scale of 1e-9 m (and one of 1 m) runs;
+    # the spectral path's rules are in units of 1 / L, its cost does not grow with 1 / L,
+    # and so small a field's eddies are all inside the probe: the lidar sees nothing of
+    # it (a ratio below 1e-3)
+    from uq.pipeline.runner import run
+    for length in (1e-9, 1.0):
+        ds = run({**RECORDS, "turbulence": {"intensity": 0.1, "length_scale": length},
+                  "lidar": {**RECORDS["lidar"], "probe": {
+                      "kind": "pulsed", "gate_length": 18.75, "pulse_fwhm": 24.75}},
+                  "sampling": {"method": "none"}})
+        ratio = float(ds["turbulence_intensity_u_ratio"])
+        assert 0 <= ratio < (1e-3 if length < 1e-3 else 0.5)
+        assert float(ds["turbulence_intensity_true"]) == pytest.approx(0.1, rel=0.05)
 
 
 def test_scans_per_record():

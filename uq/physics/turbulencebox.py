@@ -85,6 +85,7 @@ References
    the exponential coherence model), 6.3.1 (Lambda_1).
 .. [4] Veers, P. S. (1988). Three-dimensional wind simulation. SAND88-0152, Sandia.
 """
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -160,7 +161,7 @@ class BoxGrid:
 
 def check_cells(shape, max_cells=constants.MAX_BOX_CELLS):
     """Raise ValueError (one line) if a box of ``shape`` cells is above ``max_cells``."""
-    cells = int(np.prod([int(n) for n in shape]))
+    cells = math.prod(int(n) for n in shape)           # Python integers: no overflow
     if cells > max_cells:
         raise ValueError(
             f"turbulence box of {' x '.join(str(int(n)) for n in shape)} = {cells} cells is "
@@ -722,6 +723,31 @@ def kaimal_box(grid, sigma_u, speed, scale_parameter, rng, xp=np,
     return TurbulenceBox(grid=grid, velocity=velocity)
 
 
+def box_extent(geometry, length_scale, model="mann", spacing=None, record_duration=None,
+               motion_margin=0.0, margin=constants.BOX_MARGIN_LENGTH_SCALES):
+    """The cells of :func:`box_for`'s box, counted without allocating anything: (shape,
+    spacing [m], (low, high) corners of the probe points with the motion's margin [m],
+    record duration [s]). Parameters as :func:`box_for`; the shape is that of a box of
+    any size (:func:`check_cells` refuses it)."""
+    if model not in ("mann", "kaimal"):
+        raise ValueError(f"box_for: model must be 'mann' or 'kaimal', not {model!r}")
+    duration = geometry.record_duration if record_duration is None else record_duration
+    if not np.isfinite(duration) or duration <= 0:
+        raise ValueError("box_for: a record needs a finite duration > 0 [s]")
+    step = length_scale / constants.BOX_DEFAULT_CELLS_PER_LENGTH if spacing is None else spacing
+    points = np.asarray(geometry.probe_points()).reshape(-1, 3)
+    low, high = points.min(axis=0) - motion_margin, points.max(axis=0) + motion_margin
+    pad = margin * length_scale if model == "mann" else step
+    advected = geometry.speed * (duration + geometry.dwell) + (high[0] - low[0]) + 2 * step
+    extent = np.array([advected, high[1] - low[1] + 2 * pad, high[2] - low[2] + 2 * pad])
+    cells = np.ceil(extent / step) + 1
+    if np.any(cells > 2.0 ** 52):              # beyond any box: no fast length looked for
+        shape = tuple(float(c) for c in cells)
+    else:
+        shape = tuple(int(scipy.fft.next_fast_len(int(c), real=True)) for c in cells)
+    return shape, step, (low, high), duration
+
+
 def box_for(geometry, length_scale, model="mann", spacing=None, record_duration=None,
             motion_margin=0.0, margin=constants.BOX_MARGIN_LENGTH_SCALES,
             max_cells=constants.MAX_BOX_CELLS):
@@ -762,19 +788,8 @@ def box_for(geometry, length_scale, model="mann", spacing=None, record_duration=
     ValueError
         One line naming the box's size and the limit, before anything is allocated.
     """
-    if model not in ("mann", "kaimal"):
-        raise ValueError(f"box_for: model must be 'mann' or 'kaimal', not {model!r}")
-    duration = geometry.record_duration if record_duration is None else record_duration
-    if not np.isfinite(duration) or duration <= 0:
-        raise ValueError("box_for: a record needs a finite duration > 0 [s]")
-    step = length_scale / constants.BOX_DEFAULT_CELLS_PER_LENGTH if spacing is None else spacing
-    points = np.asarray(geometry.probe_points()).reshape(-1, 3)
-    low, high = points.min(axis=0) - motion_margin, points.max(axis=0) + motion_margin
-    pad = margin * length_scale if model == "mann" else step
-    advected = geometry.speed * (duration + geometry.dwell) + (high[0] - low[0]) + 2 * step
-    extent = np.array([advected, high[1] - low[1] + 2 * pad, high[2] - low[2] + 2 * pad])
-    shape = tuple(int(scipy.fft.next_fast_len(int(np.ceil(e / step)) + 1, real=True))
-                  for e in extent)
+    shape, step, (low, high), duration = box_extent(geometry, length_scale, model, spacing,
+                                                    record_duration, motion_margin, margin)
     check_cells(shape, max_cells)
     if model == "kaimal":
         check_kaimal_points(shape[1] * shape[2])

@@ -409,8 +409,7 @@ def unit_box(settings, geometry, rng, motion_margin=0.0, window=True):
     from uq.physics import turbulencebox
     turbulence = settings["turbulence"]
     if turbulence["model"] == "mann" and not window:
-        grid = turbulencebox.box_for(geometry, turbulence["length_scale"], "mann",
-                                     motion_margin=motion_margin)
+        grid = record_grid(settings, geometry, motion_margin)
         kept = _unit_kept(settings, grid)
         return turbulencebox.mann_box(grid, 1.0, turbulence["length_scale"],
                                       turbulence["anisotropy"], rng,
@@ -428,8 +427,7 @@ def unit_box_parts(settings, geometry, rng, motion_margin=0.0):
     from uq.physics import turbulencebox
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
     if turbulence["model"] == "mann":
-        grid = turbulencebox.box_for(geometry, turbulence["length_scale"], "mann",
-                                     motion_margin=motion_margin)
+        grid = record_grid(settings, geometry, motion_margin)
         kept = _unit_kept(settings, grid)            # (kept first: not beside the box)
         points = np.vstack([np.asarray(geometry.probe_points()).reshape(-1, 3), np.zeros(3)])
         nx, ny, nz = grid.shape
@@ -439,8 +437,29 @@ def unit_box_parts(settings, geometry, rng, motion_margin=0.0):
             turbulencebox.box_window(grid, points, motion_margin), parts,
             slab_cells=RECORD_BOX_SLAB_CELLS, workers=RECORD_FFT_WORKERS), kept
     scale = turbulence["length_scale"] / LENGTH_FACTORS_KAIMAL
-    grid = turbulencebox.box_for(geometry, scale, "kaimal", motion_margin=motion_margin)
+    grid = record_grid(settings, geometry, motion_margin)
     return [turbulencebox.kaimal_box(grid, 1.0, speed, scale, rng)], np.nan
+
+
+def record_grid(settings, geometry, motion_margin=0.0):
+    """The grid of a record's box (:func:`uq.physics.turbulencebox.box_for`: Mann's L,
+    or the Kaimal model's Lambda_1 = L_u / 8.1), the probe points moved by up to
+    `motion_margin` [m]. A record whose motion reached further than its validation
+    allowed for (:func:`uq.pipeline.turbulencesection.motion_reach`) and whose box is
+    above the limit is refused in one line (:class:`uq.errors.ScenarioError`), before
+    anything is allocated."""
+    from uq.errors import ScenarioError
+    from uq.physics import turbulencebox
+    turbulence = settings["turbulence"]
+    mann = turbulence["model"] == "mann"
+    scale = turbulence["length_scale"] / (1.0 if mann else LENGTH_FACTORS_KAIMAL)
+    try:
+        return turbulencebox.box_for(geometry, scale, turbulence["model"],
+                                     motion_margin=motion_margin)
+    except ValueError as error:
+        raise ScenarioError(settings.get("name", "scenario"), "record.duration",
+                            f"a record's motion moved the probes {motion_margin:.3g} m, "
+                            f"further than validation allowed for, and {error}") from None
 
 
 def _unit_kept(settings, grid):

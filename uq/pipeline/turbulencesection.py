@@ -33,9 +33,10 @@ import math
 import numpy as np
 
 from uq.constants import (KAIMAL_LENGTH_FACTOR, MANN_ANISOTROPY, MANN_LENGTH_FACTOR,
-                          MAX_ANISOTROPY, MAX_LENGTH_SCALE, MAX_RECORD_DURATION,
-                          MAX_RECORD_SCANS, MAX_RECORDS, MAX_TURBULENCE_INTENSITY,
-                          DEFAULT_RECORDS, TURBULENCE_PROBE_NODES)
+                          MAX_ANISOTROPY, MAX_BOX_CELLS, MAX_KAIMAL_POINTS, MAX_LENGTH_SCALE,
+                          MAX_RECORD_DURATION, MAX_RECORD_SCANS, MAX_RECORDS,
+                          MAX_TURBULENCE_INTENSITY, MIN_TURBULENCE_INTENSITY,
+                          MOTION_REACH_SIGMAS, DEFAULT_RECORDS, TURBULENCE_PROBE_NODES)
 from uq.physics import nacelle
 from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
 from uq.physics.probe import legendre
@@ -73,8 +74,9 @@ def validate_turbulence(check, value, reference_height):
     model = check.choice(value.get("model", "mann"), "turbulence.model", TURBULENCE_MODELS)
     length = value.get("length_scale", default_length_scale(model, reference_height))
     return {"model": model,
-            "intensity": check.number(value["intensity"], "turbulence.intensity", low=0.0,
-                                      high=MAX_TURBULENCE_INTENSITY, low_open=True),
+            "intensity": check.number(value["intensity"], "turbulence.intensity",
+                                      low=MIN_TURBULENCE_INTENSITY,
+                                      high=MAX_TURBULENCE_INTENSITY),
             "length_scale": check.number(length, "turbulence.length_scale", low=0.0,
                                          high=MAX_LENGTH_SCALE, low_open=True),
             "anisotropy": check.number(value.get("anisotropy", MANN_ANISOTROPY),
@@ -100,6 +102,100 @@ def validate_record(check, value, n_beams, lidar):
     count = check.integer(value.get("count", DEFAULT_RECORDS), "record.count", low=2,
                           high=MAX_RECORDS)
     return {"duration": duration, "count": count}
+
+
+def check_record_cost(check, settings):
+    """Refuse, before anything is made, a record mode the model cannot take: no mean wind
+    to carry the frozen field (``wind.speed`` 0), or Monte Carlo records whose turbulence
+    box (:func:`uq.physics.turbulencebox.box_extent`: the record's advected length by the
+    scan's width and height with its margins, at the spacing of the length scale, and
+    the largest displacement the platform's motion can give a probe point,
+    :func:`motion_reach`) is above :data:`~uq.constants.MAX_BOX_CELLS` cells, or, for
+    Kaimal, above :data:`~uq.constants.MAX_KAIMAL_POINTS` points across the wind. One
+    line naming the key to change and how far: the longest ``record.duration`` at this
+    wind speed, else the smallest ``turbulence.length_scale`` for this lidar. Counted,
+    not allocated; ``sampling.method: none`` makes no box."""
+    from uq.physics import turbulencebox
+    if not settings["wind"]["speed"] > 0:
+        check.fail("wind.speed", f"{settings['wind']['speed']:g} m/s with a turbulence "
+                   "section: a frozen turbulent field needs a mean wind to carry it past "
+                   "the lidar (Taylor); allowed: wind.speed > 0")
+    if settings["sampling"]["method"] == "none":
+        return
+    geometry = scan_geometry(settings)
+    turbulence = settings["turbulence"]
+    model = turbulence["model"]
+    margin = motion_reach(settings, geometry)
+
+    def box(length, duration):
+        scale = length if model == "mann" else length / KAIMAL_LENGTH_FACTOR
+        return turbulencebox.box_extent(geometry, scale, model, record_duration=duration,
+                                        motion_margin=margin)[0]
+
+    def fits(length, duration):
+        shape = box(length, duration)
+        across = shape[1] * shape[2]
+        return (math.prod(int(n) for n in shape) <= MAX_BOX_CELLS
+                and (model == "mann" or across <= MAX_KAIMAL_POINTS))
+    length, duration = turbulence["length_scale"], settings["record"]["duration"]
+    if fits(length, duration):
+        return
+    shape = box(length, duration)
+    size = (f"a turbulence box of {' x '.join(f'{n:.0f}' for n in shape)} = "
+            f"{float(math.prod(int(n) for n in shape)):.3g} cells" + (
+                f" ({shape[1] * shape[2]:.0f} points across the wind)" if model == "kaimal"
+                else ""))
+    limit = (f"at most {MAX_BOX_CELLS} cells" + (
+        f" and {MAX_KAIMAL_POINTS} points across the wind" if model == "kaimal" else ""))
+    period = geometry.scan_period
+    larger = (f"turbulence.length_scale >= "
+              f"{_bisect(lambda L: fits(L, duration), MAX_LENGTH_SCALE, length, log=True):.3g} "
+              "m (a cell is L / 8)" if fits(MAX_LENGTH_SCALE, duration) else None)
+    if fits(length, period):
+        longest = _bisect(lambda d: fits(length, d), period, duration)
+        check.fail("record.duration", f"{duration:g} s at wind.speed "
+                   f"{settings['wind']['speed']:g} m/s needs {size}; allowed: {limit}, i.e. "
+                   f"record.duration <= {longest:.4g} s at this wind speed (or a lower "
+                   "wind.speed" + (f", or {larger}" if larger else "") + ", or "
+                   "sampling.method: none for the spectral path alone)")
+    check.fail("turbulence.length_scale", f"{length:g} m needs {size} (a cell is L / 8); "
+               f"allowed: {limit}, i.e. {larger or 'a shorter record.duration'} for this "
+               "lidar (or sampling.method: none for the spectral path alone)")
+
+
+def _bisect(inside, good, bad, log=False, steps=60):
+    """The boundary [unit of good] between `good` (inside) and `bad` (not) by bisection
+    (geometric where `log`): the last value found inside."""
+    if inside(bad):
+        return bad
+    for _ in range(steps):
+        middle = math.sqrt(good * bad) if log else (good + bad) / 2
+        good, bad = (middle, bad) if inside(middle) else (good, middle)
+    return good
+
+
+def motion_reach(settings, geometry):
+    """How far the platform's motion moves a probe point within a record [m], a bound
+    (:func:`uq.pipeline.beammotion.motion_margin` is the record's own): per axis of
+    translation (surge, sway, heave) and for the rotation angle theta (all rotational
+    amplitudes) the smaller of the amplitudes' sum (the most the harmonics can add to)
+    and :data:`~uq.constants.MOTION_REACH_SIGMAS` standard deviations ``sqrt(sum A^2 /
+    2)`` (the most a sum of many random-phase harmonics reaches in a record); the
+    rotation turns the lever arm r and the beams out to their farthest probe point,
+    ``|(R - R_static) x| <= |x| min(theta, 2)``; 0 without motion."""
+    from uq.pipeline.motionsection import time_resolved
+    resolved = time_resolved(settings)
+    if resolved is None or not resolved.motion.components:
+        return 0.0
+    amplitudes = np.abs(np.array([c.amplitudes for c in resolved.motion.components]))
+
+    def reach(a):              # a: (K, n) amplitudes of n axes added, or of one angle
+        return min(float(a.sum()), MOTION_REACH_SIGMAS * math.sqrt(float(np.sum(a ** 2)) / 2))
+    translation = math.sqrt(sum(reach(amplitudes[:, d]) ** 2 for d in range(3, 6)))
+    angle = min(reach(amplitudes[:, :3]), 2.0)
+    reach = float(np.max(slant_ranges(settings["lidar"]))) + float(
+        np.max(np.abs(geometry.probe_offsets)))
+    return translation + (float(np.linalg.norm(resolved.motion.lever_arm)) + reach) * angle
 
 
 def beam_duration(lidar):
