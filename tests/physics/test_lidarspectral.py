@@ -49,10 +49,9 @@ def test_record_filter_is_the_expected_sample_variance():
 
 def test_point_probe_simultaneous_colocated_beams_see_the_true_variance(tensor):
     # a point probe, beams at one instant, all at the reference point: the reconstruction
-    # inverts the directions exactly, so each component's variance is the field's: the same
-    # quadrature on both sides, but the lidar's sum leaves out the points below
-    # SPECTRAL_PRUNE, which move var_c by < (sum_b |R_cb|)^2 3e-6 tr(Phi) (< 5e-5 of
-    # sigma_v^2, the worst component here): 1e-4
+    # inverts the directions exactly, so each component's variance is the field's (the
+    # colocated pairs are the point tensor's 1-D spectra on both sides: to rounding; 1e-4
+    # leaves room for the reconstruction's rounding)
     g = dbs_geometry([100.0], vertical=True)
     g = dataclasses.replace(g, gate_centres=np.zeros_like(g.gate_centres),
                             times=np.zeros(g.n_beams), dwell=0.0)

@@ -339,3 +339,20 @@ def test_the_spectral_path_is_computed_once_for_a_run_s_chunks(monkeypatch):
         other = {**base, "turbulence": {**base["turbulence"], "intensity": intensity}}
         records.scene_spectral_paths([other], 1)
     assert len(computed) == 1
+
+
+@pytest.mark.parametrize("count", [4, 5, 8, 16, 48])
+def test_the_path_to_path_check_fails_at_its_nominal_rate_where_the_paths_agree(count):
+    # the check's statistic on records whose mean TI^2 is the spectral one: a record's
+    # TI^2 is a sample variance of a correlated series, a scaled chi-square of ~10-100
+    # effective degrees of freedom (skewed); 20000 checks of `count` such records each
+    # (nu = 20) fail at 5 % +- the skew's ~1.5 % and the binomial's 4 sigma
+    # (sqrt(0.05 0.95 / 20000) = 1.5e-3); |z| <= 2 failed 9-15 % of them at 4-8 records
+    from uq.pipeline import records
+    rng = np.random.default_rng(count)
+    squares = rng.chisquare(20, size=(20000, count)) / 20
+    z = (1.0 - squares.mean(axis=1)) / (squares.std(axis=1, ddof=1) / np.sqrt(count))
+    rate = np.mean(np.abs(z) > records.valid_z(count))
+    assert abs(rate - records.VALID_LEVEL) <= 0.015 + 4 * np.sqrt(0.05 * 0.95 / 20000)
+    if count <= 8:
+        assert np.mean(np.abs(z) > 2.0) > 0.08          # the former limit: not nominal

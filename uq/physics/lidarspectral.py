@@ -131,13 +131,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import integrate, special
 
-from uq.constants import (KAIMAL_FREQUENCY_DECADES, SPECTRAL_PRUNE, SPECTRAL_REFINEMENTS,
+from uq.constants import (KAIMAL_FREQUENCY_DECADES, SPECTRAL_REFINEMENTS,
                           SPECTRAL_TOLERANCE)
 from uq.physics.probe import pulse_radius
 from uq.physics.spectralquadrature import (PanelRule, geometric_edges, record_scans,
                                            record_weights, mean_window, symmetric_edges)
 from uq.physics.spectraltensor import (KaimalSpectra, MannTensor, WavenumberGrid,
-                                       kaimal_exponential_integral, mann_variance_factors)
+                                       kaimal_exponential_integral)
 
 #: Most beams for which the Mann path sums over beam pairs with Filon weights (B (B + 1)
 #: / 2 pairs per point); beyond, the vectors G_c on the log-polar grid (module docstring).
@@ -619,11 +619,12 @@ def _refined_polar(grid):
 
 
 def _coarse_polar(grid):
-    """The log-polar grid of the error estimate: 2/3 of the nodes in each direction."""
+    """The log-polar grid of the error estimate: 2/3 of the k1 nodes, 3/4 of the radial
+    nodes and of the angles (the standard grid's (12, 8, 48) -> (8, 6, 36))."""
     return WavenumberGrid(grid.length_scale, grid.k_decades, grid.radius_decades,
                           max(2, 2 * grid.k1_per_decade // 3),
-                          max(2, 2 * grid.radius_per_decade // 3),
-                          max(8, 2 * grid.angle_nodes // 3))
+                          max(2, 3 * grid.radius_per_decade // 4),
+                          max(8, 3 * grid.angle_nodes // 4))
 
 
 def _vector_variances(geometry, tensor, transfer, grid):
@@ -636,42 +637,30 @@ def _vector_variances(geometry, tensor, transfer, grid):
 
 def _vector_sum(geometry, tensor, transfer, grid):
     """Eq. (2)-(3) on the log-polar grid: ``var_c = int G_c Phi G_c^H`` with the phases
-    at the nodes (a few beams by pairs of their projections, many by the vectors)."""
-    directions = np.asarray(geometry.directions, dtype=float)               # (B, 3)
-    centres = np.asarray(geometry.gate_centres, dtype=float)                # (B, G, 3)
-    times = np.asarray(geometry.times, dtype=float)
-    reconstruction = np.asarray(geometry.reconstruction, dtype=float)       # (G, 3, B)
+    at the nodes (:func:`uq.physics.spectralkernels.vector_sums`), a few k1 at a time."""
+    from uq.physics import spectralkernels, turbulencebox
     k1_all, w1_all = grid.k1()
-    speed = geometry.speed
-    highpass = record_filter(k1_all * speed / (2 * np.pi), geometry.scan_period,
+    highpass = record_filter(k1_all * geometry.speed / (2 * np.pi), geometry.scan_period,
                              geometry.record_duration)
-    direct = np.zeros((geometry.n_gates, 3))
-    # steering[g, b, 3c + j] = R_gcb n_bj
-    steering = np.einsum("gcb,bj->gbcj", reconstruction, directions).reshape(
-        geometry.n_gates, geometry.n_beams, 9)
-    trace = tensor.alpha_epsilon * tensor.length_scale ** (2 / 3) * sum(
-        mann_variance_factors(tensor.anisotropy))
+    out = np.zeros((geometry.n_gates, 3))
+    table = turbulencebox._TABLE
+    centres = np.ascontiguousarray(np.moveaxis(np.asarray(geometry.gate_centres, float), 1, 0))
     for start in range(0, len(k1_all), _K1_CHUNK):
         k1 = k1_all[start:start + _K1_CHUNK]
         k2, k3, w23 = grid.cross_section(k1)
-        k1b = np.broadcast_to(k1[:, None], k2.shape)
         weight = (w23 * (w1_all * highpass)[start:start + _K1_CHUNK, None]).ravel()
-        distortion = [np.ravel(v) for v in _flatten(tensor.distortion(k1b, k2, k3))]
-        diagonal = weight[:, None] * _projected(np.eye(3), np.eye(3), distortion)  # (P, 3)
-        # points whose weighted trace of Phi is below SPECTRAL_PRUNE of ~ the field's
-        # trace are left out: each adds at most (sum_b |R_gcb|)^2 w tr(Phi) to var_c
-        keep = diagonal.sum(axis=1) > SPECTRAL_PRUNE * trace
-        weight, distortion = weight[keep], [v[keep] for v in distortion]
-        k1b, k2, k3 = k1b.ravel()[keep], k2.ravel()[keep], k3.ravel()[keep]
-        kvec = np.stack([k1b, k2, k3], axis=-1)                          # (P, 3)
-        dwell = np.sinc(kvec[:, 0] * speed * geometry.dwell / (2 * np.pi))
-        probe = transfer(kvec @ directions.T) * dwell[:, None]            # (G, P, B)
-        delay = np.outer(kvec[:, 0] * speed, times)                      # (P, B)
-        for g in range(geometry.n_gates):
-            phase = np.exp(1j * (kvec @ centres[:, g].T - delay))       # (P, B)
-            vectors = ((probe[g] * phase) @ steering[g]).reshape(-1, 3, 3)   # G_c, Eq. (2)
-            direct[g] += weight @ _form(vectors, *_flat(distortion))
-    return direct
+        spectralkernels.vector_sums(
+            np.ascontiguousarray(np.broadcast_to(k1[:, None], k2.shape).ravel()),
+            np.ascontiguousarray(k2.ravel()), np.ascontiguousarray(k3.ravel()), weight,
+            tensor.alpha_epsilon, tensor.length_scale, tensor.anisotropy, float(table[0][0]),
+            float(table[0][1] - table[0][0]), np.ascontiguousarray(table[1]),
+            np.ascontiguousarray(geometry.directions, dtype=float), centres,
+            np.ascontiguousarray(geometry.times, dtype=float), float(geometry.speed),
+            float(geometry.speed * geometry.dwell),
+            np.ascontiguousarray(geometry.reconstruction, dtype=float),
+            np.ascontiguousarray(transfer.table, dtype=complex), float(transfer.step),
+            float(transfer.tail), out)
+    return out
 
 
 def mann_point_variances(geometry, tensor, per_decade=2, order=6):
@@ -732,25 +721,6 @@ def _flatten(distortion):
     """(factor, k0 components, zetas) of MannTensor.distortion as a flat list of arrays."""
     factor, k0, zetas = distortion
     return [factor, *k0, *zetas]
-
-
-def _flat(distortion):
-    """The (factor, k0, zetas) arguments of :func:`_form` from a flattened distortion,
-    each (P, 1) to broadcast over the components."""
-    factor, k01, k02, k03, zeta1, zeta2, ratio = (v[:, None] for v in distortion)
-    return factor, (k01, k02, k03), (zeta1, zeta2, ratio)
-
-
-def _form(vectors, factor, k0, zetas):
-    """``g Phi g^H`` [m5 s-2] for complex rows g (..., 3): with ``q = g A``,
-    ``E(k0)/(4 pi k0^4) (k0^2 |q|^2 - |q . k0|^2)`` (MannTensor.quadratic_form, unpacked)."""
-    zeta1, zeta2, ratio = zetas
-    g0, g1, g2 = (vectors[..., j] for j in range(3))
-    q2 = zeta1 * g0 + zeta2 * g1 + ratio * g2
-    k0sq = k0[0] ** 2 + k0[1] ** 2 + k0[2] ** 2
-    norm = np.abs(g0) ** 2 + np.abs(g1) ** 2 + np.abs(q2) ** 2
-    along = np.abs(g0 * k0[0] + g1 * k0[1] + q2 * k0[2]) ** 2
-    return factor * (k0sq * norm - along)
 
 
 def _projected(left, right, distortion, pairs=False):

@@ -161,3 +161,75 @@ def pair_sums(k1, k2, k3, alpha_epsilon, length_scale, anisotropy, table_start, 
             for g in range(n_gates):
                 for p in range(n_pairs):
                     out[g, p, i] += inner[g, p] * w2[g, p, j]
+
+
+_VECTOR_SIGNATURE = ("void(float64[::1], float64[::1], float64[::1], float64[::1], float64, "
+                     "float64, float64, float64, float64, float64[::1], float64[:, ::1], "
+                     "float64[:, :, ::1], float64[::1], float64, float64, float64[:, :, ::1], "
+                     "complex128[:, ::1], float64, float64, float64[:, ::1])")
+
+
+@njit(_VECTOR_SIGNATURE, cache=True)
+def vector_sums(k1, k2, k3, weight, alpha_epsilon, length_scale, anisotropy, table_start,
+                table_step, table_values, directions, centres, times, speed, dwell_length,
+                reconstruction, transfer, kappa_step, tail, out):
+    """``out[g, c] += sum_p w_p G_c Phi G_c^H`` at the points (k1_p, k2_p, k3_p) (weights
+    `weight` [m3 with the record's high-pass]): Eq. (2)-(3) of
+    :mod:`uq.physics.lidarspectral` by the vectors ``G_c = sum_b R_gcb n_b P_gb(k . n_b)
+    sinc(k1 U D / 2) exp(i (k . r_bg - k1 U t_b))``, their phases at the points.
+
+    Parameters
+    ----------
+    k1, k2, k3, weight : float64 arrays (P,)
+        The points [rad m-1] (k1^2 + k2^2 > 0) and their weights.
+    directions : (B, 3); centres : (G, B, 3) [m]; times : (B,) [s]
+    speed, dwell_length : float
+        U [m s-1] and U D [m].
+    reconstruction : (G, 3, B)
+    transfer, kappa_step, tail
+        As :func:`pair_sums`.
+    out : float64 array (G, 3)
+    """
+    n_beams, n_gates = directions.shape[0], centres.shape[0]
+    energy_scale = alpha_epsilon * length_scale ** (5.0 / 3.0)
+    vector = np.empty((3, 3), dtype=np.complex128)
+    for p in range(k1.size):
+        a, b, c = k1[p], k2[p], k3[p]
+        ksq = a * a + b * b + c * c
+        beta = _lifetime(math.sqrt(ksq) * length_scale, anisotropy, table_start, table_step,
+                         table_values)
+        k30 = c + beta * a                            # Eq. 3.14 [1]
+        k0sq = a * a + b * b + k30 * k30
+        khsq = a * a + b * b
+        kh = math.sqrt(khsq)
+        c1 = beta * a * a * (k0sq - 2.0 * k30 * k30 + beta * a * k30) / (ksq * khsq)
+        c2 = b * k0sq / (khsq * kh) * (math.atan(k30 / kh) - math.atan(c / kh))
+        z1 = c1 - b / a * c2
+        z2 = b / a * c1 + c2
+        ratio = k0sq / ksq
+        kl = math.sqrt(k0sq) * length_scale
+        energy = energy_scale * kl ** 4 / (1.0 + kl * kl) ** VON_KARMAN_EXPONENT
+        x = 0.5 * a * dwell_length
+        dwell = 1.0 if x == 0.0 else math.sin(x) / x
+        factor = energy / (FOUR_PI * k0sq * k0sq) * weight[p]
+        for g in range(n_gates):
+            vector[:, :] = 0.0
+            for n in range(n_beams):
+                d0, d1, d2 = directions[n, 0], directions[n, 1], directions[n, 2]
+                probe = _transfer(transfer, g, a * d0 + b * d1 + c * d2, kappa_step, tail)
+                if probe == 0.0:
+                    continue
+                phase = (a * centres[g, n, 0] + b * centres[g, n, 1] + c * centres[g, n, 2]
+                         - a * speed * times[n])
+                t = probe * dwell * complex(math.cos(phase), math.sin(phase))
+                for comp in range(3):
+                    r = reconstruction[g, comp, n] * t
+                    vector[comp, 0] += r * d0
+                    vector[comp, 1] += r * d1
+                    vector[comp, 2] += r * d2
+            for comp in range(3):        # G Phi G^H with q = G A (MannTensor.quadratic_form)
+                g0, g1 = vector[comp, 0], vector[comp, 1]
+                q2 = z1 * g0 + z2 * g1 + ratio * vector[comp, 2]
+                norm = abs(g0) ** 2 + abs(g1) ** 2 + abs(q2) ** 2
+                along = abs(g0 * a + g1 * b + q2 * k30) ** 2
+                out[g, comp] += factor * (k0sq * norm - along)
