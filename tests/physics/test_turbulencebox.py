@@ -360,12 +360,16 @@ def test_box_for_holds_the_record():
     grid = tb.box_for(geometry, 33.6)
     lengths, points = np.array(grid.lengths), geometry.probe_points().reshape(-1, 3)
     assert lengths[0] >= geometry.speed * 600.0 + np.ptp(points[:, 0])
-    # y and z: the points plus 3 L on each side
+    # y and z: the points plus 3 L on each side, less the half cell the box moves to put
+    # the reference point (0, 0, 0) on a node
     for axis in (1, 2):
         assert lengths[axis] >= np.ptp(points[:, axis]) + 6 * 33.6
-        low = grid.origin[axis]
-        assert low <= points[:, axis].min() - 3 * 33.6 + 1e-9
-        assert low + (grid.shape[axis] - 1) * grid.spacing[axis] >= points[:, axis].max() + 3 * 33.6 - 1e-9
+        low, half = grid.origin[axis], grid.spacing[axis] / 2
+        assert low <= points[:, axis].min() - 3 * 33.6 + half + 1e-9
+        assert low + (grid.shape[axis] - 1) * grid.spacing[axis] >= \
+            points[:, axis].max() + 3 * 33.6 - half - 1e-9
+        assert (0.0 - low) / grid.spacing[axis] == pytest.approx(
+            round((0.0 - low) / grid.spacing[axis]), abs=1e-9)
     assert grid.spacing == (33.6 / 8,) * 3
     kaimal = tb.box_for(geometry, 42.0, model="kaimal")
     assert not kaimal.periodic_yz

@@ -197,15 +197,18 @@ def test_a_record_sampled_part_by_part_is_its_whole_box_sampled(monkeypatch):
     assert len(list(parts)) == 3
     rng = records.record_generator(7, 0)
     drawn = records._draw_unit_record(settings, geometry, n_scans, rng, {}, 0.0, True)
-    box, kept = records.unit_box(settings, geometry, records.record_generator(7, 0))
+    again = records.record_generator(7, 0)
+    box, kept = records.unit_box(settings, geometry, again)
+    # the reference: the box's line, and the scales below its cells drawn after the box
+    factor = records.reference_complement(settings, geometry, grid)[0]
+    complement = again.standard_normal((n_scans, 3)) @ factor.T
     whole = (ts.record_radial_velocities(box, geometry, n_scans),
-             ts.reference_series(box, geometry.speed, ts.scan_times(geometry, n_scans)))
+             ts.reference_line_series(box, geometry.speed, ts.scan_times(geometry, n_scans))
+             + complement)
     for part_sum, sampled in zip((drawn.radial, drawn.reference, drawn.at_rest),
                                  whole + whole[:1]):
         assert np.max(np.abs(part_sum - sampled)) <= 1e-13 * np.max(np.abs(sampled))
     assert drawn.kept == kept
-    again = records.record_generator(7, 0)
-    records.unit_box(settings, geometry, again)
     assert drawn.state == again.bit_generator.state        # where one draw leaves it
 
 
@@ -315,7 +318,8 @@ def test_a_scene_s_spectral_path_scaled_from_another_intensity_equals_its_own(mo
     from uq.pipeline.scenario import load_scenario
     from uq.pipeline.shipped import scenario_path
     base = load_scenario(scenario_path("sathe2011_ti"),        # one gate: a cheap path
-                         {"turbulence.model": model, "lidar.ranges": [100.0]}).settings
+                         {"turbulence.model": model, "lidar.ranges": [100.0],
+                          "sampling.method": "none"}).settings
     other = {**base, "turbulence": {**base["turbulence"], "intensity": 0.17}}
     monkeypatch.setattr(records, "_SPECTRAL_PATHS", type(records._SPECTRAL_PATHS)())
     n_gates = len(base["lidar"]["ranges"])

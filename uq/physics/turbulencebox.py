@@ -134,19 +134,22 @@ class BoxGrid:
         reference point [m].
     periodic_yz : bool
         Whether the field is periodic along y and z (Mann) or not (Kaimal).
+    max_cells : int
+        The most cells it may have (:func:`check_cells`).
     """
 
     shape: tuple
     spacing: tuple
     origin: tuple = (0.0, 0.0, 0.0)
     periodic_yz: bool = True
+    max_cells: int = constants.MAX_BOX_CELLS
 
     def __post_init__(self):
         if len(self.shape) != 3 or min(self.shape) < 2 or len(self.spacing) != 3 \
                 or min(self.spacing) <= 0 or len(self.origin) != 3:
             raise ValueError("BoxGrid: shape needs 3 sizes >= 2, spacing 3 values > 0, "
                              "origin 3 values")
-        check_cells(self.shape)
+        check_cells(self.shape, self.max_cells)
 
     @property
     def cells(self):
@@ -386,12 +389,14 @@ def cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy):
 
 
 def box_variance(grid, alpha_epsilon, length_scale, anisotropy,
-                 slab_cells=constants.BOX_SLAB_CELLS):
+                 slab_cells=constants.BOX_SLAB_CELLS, spectral_filter=None):
     """Expected variances of (u, v, w) and the u-w covariance of a Mann box [m2 s-2].
 
     The sum of ``Phi(k) dk`` over the box's discrete wavenumbers (k = 0 left out): what a
     box keeps of the tensor's integral, the point variance (a too small or coarse box
-    loses the rest). Parameters as :func:`mann_box`.
+    loses the rest); with `spectral_filter` ``H(k1)`` (of an array of k1 [rad m-1], e.g.
+    a record's high-pass) each wavenumber weighted by it. Other parameters as
+    :func:`mann_box`.
 
     Returns
     -------
@@ -400,21 +405,23 @@ def box_variance(grid, alpha_epsilon, length_scale, anisotropy,
     """
     k1, k2, k3 = box_wavenumbers(grid)
     weights = _half_weights(grid.shape[2], np)
+    filtered = (np.ones(grid.shape[0]) if spectral_filter is None
+                else np.asarray(spectral_filter(np.abs(k1[:, 0, 0])), dtype=float))
     dk = (2.0 * np.pi) ** 3 / np.prod(grid.lengths)
     cells, factors = cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy)
     pairs = ((0, 0), (1, 1), (2, 2), (0, 2))
     total = np.zeros(4)
     for slab in _x_slabs(grid, slab_cells):
         c = mann1998_spectral_factor(k1[slab], k2, k3, alpha_epsilon, length_scale, anisotropy)
-        phi = np.einsum("ik...,jk...->ij...", c, c)
+        phi = np.einsum("ik...,jk...->ij...", c, c) * filtered[slab, None, None]
         total += [np.sum(phi[i, j] * weights) for i, j in pairs]
     index = tuple(cells.T)
     point = mann1998_spectral_factor(k1[index[0], 0, 0], k2[0, index[1], 0], k3[0, 0, index[2]],
                                      alpha_epsilon, length_scale, anisotropy)
     point_phi = np.einsum("ikn,jkn->ijn", point, point)
     averaged_phi = np.einsum("ikn,jkn->ijn", factors, factors)
-    total += [np.sum((averaged_phi[i, j] - point_phi[i, j]) * weights[index[2]])
-              for i, j in pairs]
+    total += [np.sum((averaged_phi[i, j] - point_phi[i, j]) * weights[index[2]]
+                     * filtered[index[0]]) for i, j in pairs]
     return total * dk
 
 
@@ -735,7 +742,7 @@ def box_extent(geometry, length_scale, model="mann", spacing=None, record_durati
     if not np.isfinite(duration) or duration <= 0:
         raise ValueError("box_for: a record needs a finite duration > 0 [s]")
     step = length_scale / constants.BOX_DEFAULT_CELLS_PER_LENGTH if spacing is None else spacing
-    points = np.asarray(geometry.probe_points()).reshape(-1, 3)
+    points = np.vstack([np.asarray(geometry.probe_points()).reshape(-1, 3), np.zeros(3)])
     low, high = points.min(axis=0) - motion_margin, points.max(axis=0) + motion_margin
     pad = margin * length_scale if model == "mann" else step
     advected = geometry.speed * (duration + geometry.dwell) + (high[0] - low[0]) + 2 * step
@@ -753,10 +760,12 @@ def box_for(geometry, length_scale, model="mann", spacing=None, record_duration=
             max_cells=constants.MAX_BOX_CELLS):
     """Size a box that holds every probe point of a record, refusing one above ``max_cells``.
 
-    A box narrower than the scan or shorter than the large eddies removes variance the
-    lidar would see: a periodic (Mann) box extends ``margin`` length scales beyond the
-    probe points on each side in y and z (its discrete wavenumbers then keep the
-    variance :func:`box_variance` reports); a Kaimal box is not periodic in y and z and
+    The box holds the reference point (0, 0, 0) too, on a line of nodes along x (its
+    series is read there without interpolation across the wind). A box narrower than the
+    scan or shorter than the large eddies removes variance the lidar would see: a
+    periodic (Mann) box extends ``margin`` length scales beyond the probe points on each
+    side in y and z (its discrete wavenumbers then keep the variance
+    :func:`box_variance` reports); a Kaimal box is not periodic in y and z and
     covers the points with one cell to spare. Along x the box is at least the record's
     advected length ``U T`` plus the points' x extent, so no part of the field is met
     twice in a record.
@@ -794,8 +803,11 @@ def box_for(geometry, length_scale, model="mann", spacing=None, record_duration=
     if model == "kaimal":
         check_kaimal_points(shape[1] * shape[2])
     centre = (low + high) / 2.0
+    # the reference point (0, 0, 0) on a line of nodes along x: its series is read
+    # without interpolating across the wind (the box moves by at most half a cell, inside
+    # its margins: 3 L for Mann, a cell for Kaimal)
+    across = [-step * round((centre[a] - (shape[a] - 1) * step / 2.0) / -step) for a in (1, 2)]
     origin = (float(low[0] - geometry.speed * (duration + geometry.dwell) - step),
-              float(centre[1] - (shape[1] - 1) * step / 2.0),
-              float(centre[2] - (shape[2] - 1) * step / 2.0))
+              float(across[0]), float(across[1]))
     return BoxGrid(shape=shape, spacing=(step, step, step), origin=origin,
-                   periodic_yz=model == "mann")
+                   periodic_yz=model == "mann", max_cells=max_cells)

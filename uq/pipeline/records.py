@@ -46,6 +46,7 @@ from uq.physics.spectraltensor import KaimalSpectra, mann_tensor_for_intensity
 from uq.pipeline import probesection
 from uq.constants import KAIMAL_LENGTH_FACTOR as LENGTH_FACTORS_KAIMAL
 from uq.constants import (RECORD_BOX_SLAB_CELLS, RECORD_FFT_WORKERS, RECORD_SPECTRA_BYTES,
+                          RECORD_MAX_BOX_CELLS,
                           SPECTRAL_REFINEMENTS, SPECTRAL_TOLERANCE,
                           SPECTRAL_PATHS_KEPT, UNIT_RECORD_CACHE_BYTES)
 from uq.pipeline.turbulencesection import scan_geometry, scans_per_record, slant_ranges
@@ -84,8 +85,9 @@ RECORD_ATTRIBUTES = {
         "check tells from none at this record count (half its TI^2 interval over the "
         "records' mean TI^2): a check that is to decide a difference needs it smaller"},
     "turbulence_intensity_box_kept": {
-        "units": "1", "long_name": "variance of u the turbulence box keeps of the model's "
-        "point variance (Mann; NaN for Kaimal: not computed)"},
+        "units": "1", "long_name": "u-variance the records' field keeps at the reference "
+        "point of the model's over a record (the record's high-pass): the turbulence box's "
+        "discrete wavenumbers and the scales below its cells, drawn once a scan"},
     "wind_speed_record_bias": {
         "units": "m s-1", "long_name": "Monte Carlo mean over records of the record's mean "
         "horizontal wind speed minus the field's true mean"},
@@ -396,11 +398,9 @@ def record_generator(seed, record):
 def turbulence_box(settings, geometry, rng, motion_margin=0.0):
     """A box of the scenario's turbulence holding every probe point of a record, each
     moved by up to `motion_margin` [m] by the platform's motion
-    (:func:`uq.physics.turbulencebox.box_for`), and the variance of u it keeps of the
-    model's point variance [1] (Mann: its discrete wavenumbers, ``box_variance``;
-    Kaimal: NaN, not computed: its box misses the frequencies below 1 / (its length /
-    U), which a record's high-pass partly keeps). The box is :func:`unit_box` times
-    :func:`field_scale`."""
+    (:func:`uq.physics.turbulencebox.box_for`), and the variance of u the records' field
+    keeps of the model's at the record's scales [1] (:func:`reference_complement`).
+    The box is :func:`unit_box` times :func:`field_scale`."""
     box, kept = unit_box(settings, geometry, rng, motion_margin, window=False)
     box.velocity[...] *= field_scale(settings)
     return box, kept
@@ -411,8 +411,9 @@ def field_scale(settings):
     alpha eps^(2/3) [m2/3 s-1] (the field is linear in it, Mann 1998 Sec. 3), or the
     Kaimal field's sigma_u = intensity x speed [m s-1]."""
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
-    if turbulence["model"] == "mann":
-        return math.sqrt(turbulence_model(turbulence, speed).alpha_epsilon)
+    if turbulence["model"] == "mann":          # I U sqrt(unit alpha eps^(2/3)): no underflow
+        return turbulence["intensity"] * speed * math.sqrt(
+            turbulence_model({**turbulence, "intensity": 1.0}, 1.0).alpha_epsilon)
     return turbulence["intensity"] * speed
 
 
@@ -427,7 +428,7 @@ def unit_box(settings, geometry, rng, motion_margin=0.0, window=True):
     turbulence = settings["turbulence"]
     if turbulence["model"] == "mann" and not window:
         grid = record_grid(settings, geometry, motion_margin)
-        kept = _unit_kept(settings, grid)
+        kept = reference_complement(settings, geometry, grid)[1]
         return turbulencebox.mann_box(grid, 1.0, turbulence["length_scale"],
                                       turbulence["anisotropy"], rng,
                                       slab_cells=RECORD_BOX_SLAB_CELLS), kept
@@ -437,15 +438,15 @@ def unit_box(settings, geometry, rng, motion_margin=0.0, window=True):
 
 def unit_box_parts(settings, geometry, rng, motion_margin=0.0):
     """The windowed unit box of :func:`unit_box` as fields whose sum it is, and the
-    variance of u it keeps [1]: a Mann box's parts of its half spectra
-    (:func:`uq.physics.turbulencebox.mann_box_window_parts`, each valid until the next
-    is taken; `rng` is left where the box's draw leaves it once the last is taken), a
-    Kaimal box whole (one part)."""
+    variance of u the records' field keeps [1] (:func:`reference_complement`): a Mann
+    box's parts of its half spectra (:func:`uq.physics.turbulencebox.
+    mann_box_window_parts`, each valid until the next is taken; `rng` is left where the
+    box's draw leaves it once the last is taken), a Kaimal box whole (one part)."""
     from uq.physics import turbulencebox
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
+    grid = record_grid(settings, geometry, motion_margin)
+    kept = reference_complement(settings, geometry, grid)[1]   # (first: not beside the box)
     if turbulence["model"] == "mann":
-        grid = record_grid(settings, geometry, motion_margin)
-        kept = _unit_kept(settings, grid)            # (kept first: not beside the box)
         points = np.vstack([np.asarray(geometry.probe_points()).reshape(-1, 3), np.zeros(3)])
         nx, ny, nz = grid.shape
         parts = math.ceil(3 * nx * ny * (nz // 2 + 1) * 16 / RECORD_SPECTRA_BYTES)
@@ -454,8 +455,86 @@ def unit_box_parts(settings, geometry, rng, motion_margin=0.0):
             turbulencebox.box_window(grid, points, motion_margin), parts,
             slab_cells=RECORD_BOX_SLAB_CELLS, workers=RECORD_FFT_WORKERS), kept
     scale = turbulence["length_scale"] / LENGTH_FACTORS_KAIMAL
-    grid = record_grid(settings, geometry, motion_margin)
-    return [turbulencebox.kaimal_box(grid, 1.0, speed, scale, rng)], np.nan
+    return [turbulencebox.kaimal_box(grid, 1.0, speed, scale, rng)], kept
+
+
+def reference_complement(settings, geometry, grid):
+    """What the records' field at the reference point adds to the box's: the field's
+    (u, v, w) record covariance [m2 s-2 per unit field_scale^2] minus the box's, on its
+    line of nodes (:func:`uq.physics.turbulencebox.box_variance` with the record's
+    high-pass; Kaimal: the box's spectra at its discrete k1), i.e. the scales below the
+    box's cells (5 % of u's variance, 10 % of v's, 17 % of w's at L / 8 for IEC Mann)
+    and the few it misses at the largest scales across the wind (1 %).
+
+    Those scales decorrelate within a few cells (~1/k at k above the Nyquist
+    wavenumber pi / dx across the wind), far less than a scan's advection apart, so the
+    records draw them as independent values once a scan (:func:`_draw_unit_record`;
+    their record variance about its mean is (1 - 1/N) of theirs). Returns the lower
+    Cholesky factor of that covariance (3, 3), negative eigenvalues (the box holding
+    more than the field: rounding) set to zero, and the u-variance the records' field
+    then keeps of the field's at the record's scales [1] (``turbulence_intensity_
+    box_kept``: the box's and the complement's over the field's, with the high-pass)."""
+    turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
+    if turbulence["model"] == "mann":
+        return _mann_complement(grid, turbulence["length_scale"], turbulence["anisotropy"],
+                                speed, geometry.scan_period, geometry.record_duration)
+    return _kaimal_complement(grid, turbulence["length_scale"], speed, geometry.scan_period,
+                              geometry.record_duration)
+
+
+def _complement_factor(field, box, scans):
+    """(Cholesky factor of the white complement's covariance, kept fraction of u)."""
+    missing = field - box
+    values, vectors = np.linalg.eigh(missing)
+    missing = (vectors * np.maximum(values, 0.0)) @ vectors.T
+    factor = np.linalg.cholesky(missing / max(1.0 - 1.0 / scans, 1e-12)
+                                + 1e-300 * np.eye(3))
+    return factor, float((box[0, 0] + missing[0, 0]) / field[0, 0])
+
+
+@functools.lru_cache(maxsize=8)
+def _mann_complement(grid, length_scale, anisotropy, speed, scan_period, duration):
+    """:func:`reference_complement` of a Mann box of unit alpha eps^(2/3) (a function of
+    the grid, the model and the record alone, kept per run)."""
+    from uq.physics import turbulencebox
+    from uq.physics.lidarspectral import _point_matrix, record_filter
+    from uq.physics.scangeometry import ScanGeometry
+    from uq.physics.spectraltensor import MannTensor
+    from uq.physics.spectralquadrature import record_scans
+    point = ScanGeometry(np.array([[1.0, 0, 0]]), np.zeros((1, 1, 3)), np.zeros(1), 0.0,
+                         scan_period, np.zeros(1), np.ones((1, 1)), np.ones((1, 3, 1)),
+                         speed, duration)
+    field = _point_matrix(point, MannTensor(length_scale, anisotropy), dwell=False)
+    u, v, w, uw = turbulencebox.box_variance(
+        grid, 1.0, length_scale, anisotropy, slab_cells=RECORD_BOX_SLAB_CELLS,
+        spectral_filter=lambda k1: record_filter(k1 * speed / (2 * np.pi), scan_period,
+                                                 duration))
+    box = np.array([[u, 0.0, uw], [0.0, v, 0.0], [uw, 0.0, w]])
+    return _complement_factor(field, box, record_scans(scan_period, duration))
+
+
+@functools.lru_cache(maxsize=8)
+def _kaimal_complement(grid, length_u, speed, scan_period, duration):
+    """:func:`reference_complement` of a Kaimal box of unit sigma_u: its point spectra
+    (Veers: the IEC spectra, two-sided in k1 ``S(f) U / (4 pi)``) at its discrete k1
+    against the spectra's record integral (the spectral path's)."""
+    from uq.physics.lidarspectral import _kaimal_true, record_filter
+    from uq.physics.scangeometry import ScanGeometry
+    from uq.physics.spectralquadrature import PanelRule, geometric_edges, record_scans
+    spectra = KaimalSpectra.iec(1.0 / speed, speed, length_u)
+    point = ScanGeometry(np.array([[1.0, 0, 0]]), np.zeros((1, 1, 3)), np.zeros(1), 0.0,
+                         scan_period, np.zeros(1), np.ones((1, 1)), np.ones((1, 3, 1)),
+                         speed, duration)
+    scale = speed / spectra.lengths[0]
+    field = np.diag(_kaimal_true(point, spectra, PanelRule(geometric_edges(
+        1e-5 * scale, 1e5 * scale, 4), 8)))
+    k1 = np.abs(2 * np.pi * np.fft.fftfreq(grid.shape[0], grid.spacing[0]))[1:]
+    f = speed * k1 / (2 * np.pi)
+    dk = 2 * np.pi / grid.lengths[0]
+    highpass = record_filter(f, scan_period, duration)
+    box = np.diag([np.sum(spectra.spectrum(c, f) * speed / (4 * np.pi) * highpass) * dk
+                   for c in range(3)])
+    return _complement_factor(field, box, record_scans(scan_period, duration))
 
 
 def record_grid(settings, geometry, motion_margin=0.0):
@@ -472,29 +551,12 @@ def record_grid(settings, geometry, motion_margin=0.0):
     scale = turbulence["length_scale"] / (1.0 if mann else LENGTH_FACTORS_KAIMAL)
     try:
         return turbulencebox.box_for(geometry, scale, turbulence["model"],
-                                     motion_margin=motion_margin)
+                                     motion_margin=motion_margin,
+                                     max_cells=RECORD_MAX_BOX_CELLS)
     except ValueError as error:
         raise ScenarioError(settings.get("name", "scenario"), "record.duration",
                             f"a record's motion moved the probes {motion_margin:.3g} m, "
                             f"further than validation allowed for, and {error}") from None
-
-
-def _unit_kept(settings, grid):
-    """The u-variance fraction a Mann box on `grid` keeps of the model's point
-    variance [1] (:func:`_unit_box_variance`, scaled to the scene's model)."""
-    turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
-    model = turbulence_model(turbulence, speed)
-    return float(_unit_box_variance(grid, turbulence["length_scale"], turbulence["anisotropy"])
-                 * model.alpha_epsilon / (turbulence["intensity"] * speed) ** 2)
-
-
-@functools.lru_cache(maxsize=8)
-def _unit_box_variance(grid, length_scale, anisotropy):
-    """The u-variance of a Mann box of unit alpha eps^(2/3) [m2 s-2 per m4/3 s-2]
-    (``box_variance``: a function of the grid and the model alone, kept per run)."""
-    from uq.physics import turbulencebox
-    return float(turbulencebox.box_variance(grid, 1.0, length_scale, anisotropy,
-                                            slab_cells=RECORD_BOX_SLAB_CELLS)[0])
 
 
 @dataclasses.dataclass(frozen=True)
@@ -575,13 +637,19 @@ def _draw_unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest)
         samples = (
             np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans,
                                                                    **moving)),
-            np.asarray(turbulencesampling.reference_series(box, geometry.speed, times)),
+            np.asarray(turbulencesampling.reference_line_series(box, geometry.speed,
+                                                                times)),
             np.asarray(turbulencesampling.record_radial_velocities(box, geometry, n_scans))
             if at_rest else None)
         found = samples if found is None else tuple(
             None if a is None else a + b for a, b in zip(found, samples))
         del box
     radial, reference, rest = found
+    # the scales below the box's cells at the reference point, once a scan, drawn after
+    # the box (reference_complement)
+    factor = reference_complement(settings, geometry, record_grid(settings, geometry,
+                                                                  margin))[0]
+    reference = reference + rng.standard_normal((n_scans, 3)) @ factor.T
     return UnitRecord(radial, reference, rest, kept, rng.bit_generator.state)
 
 
@@ -900,8 +968,8 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral, axis=None, mo
                 spectra.add(i, {"wind_speed": vh, "u_true": reference[:, 0], **found.spectra},
                             count)
     squares = apparent ** 2
-    error = squares.std(axis=1, ddof=1) / np.sqrt(count)
-    z = (spectral ** 2 - squares.mean(axis=1)) / error
+    standard_error = squares.std(axis=1, ddof=1) / np.sqrt(count)
+    z = (spectral ** 2 - squares.mean(axis=1)) / standard_error
     limit = valid_z(count)
     low, high = np.quantile(apparent, [0.025, 0.975], axis=1)
     out = {
@@ -917,8 +985,8 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral, axis=None, mo
         "turbulence_intensity_spectral_z": (("scene", "range"), z),
         "turbulence_intensity_spectral_valid": (("scene", "range"), np.abs(z) <= limit),
         "turbulence_intensity_spectral_z_limit": (("scene",), np.full(len(scenes), limit)),
-        "turbulence_intensity_check_resolution": (("scene", "range"), 0.5 * limit * error
-                                                  / squares.mean(axis=1)),
+        "turbulence_intensity_check_resolution": (("scene", "range"), 0.5 * limit
+                                                  * standard_error / squares.mean(axis=1)),
         "turbulence_intensity_box_kept": (("scene",), kept),
         "wind_speed_record_bias": (("scene", "range"), error.mean(axis=1)),
         "wind_speed_record_u": (("scene", "range"), error.std(axis=1, ddof=1)),

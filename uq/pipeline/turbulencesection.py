@@ -33,7 +33,8 @@ import math
 import numpy as np
 
 from uq.constants import (KAIMAL_LENGTH_FACTOR, MANN_ANISOTROPY, MANN_LENGTH_FACTOR,
-                          MAX_ANISOTROPY, MAX_BOX_CELLS, MAX_KAIMAL_POINTS, MAX_LENGTH_SCALE,
+                          MAX_ANISOTROPY, RECORD_MAX_BOX_CELLS, MAX_KAIMAL_POINTS, MAX_LENGTH_SCALE,
+                          CW_RECORD_FAR_CUT, CW_RECORD_PROBE_NODES,
                           MAX_RECORD_DURATION, MAX_RECORD_SCANS, MAX_RECORDS,
                           MAX_TURBULENCE_INTENSITY, MIN_TURBULENCE_INTENSITY,
                           MOTION_REACH_SIGMAS, DEFAULT_RECORDS, TURBULENCE_PROBE_NODES)
@@ -110,7 +111,7 @@ def check_record_cost(check, settings):
     box (:func:`uq.physics.turbulencebox.box_extent`: the record's advected length by the
     scan's width and height with its margins, at the spacing of the length scale, and
     the largest displacement the platform's motion can give a probe point,
-    :func:`motion_reach`) is above :data:`~uq.constants.MAX_BOX_CELLS` cells, or, for
+    :func:`motion_reach`) is above :data:`~uq.constants.RECORD_MAX_BOX_CELLS` cells, or, for
     Kaimal, above :data:`~uq.constants.MAX_KAIMAL_POINTS` points across the wind. One
     line naming the key to change and how far: the longest ``record.duration`` at this
     wind speed, else the smallest ``turbulence.length_scale`` for this lidar. Counted,
@@ -135,7 +136,7 @@ def check_record_cost(check, settings):
     def fits(length, duration):
         shape = box(length, duration)
         across = shape[1] * shape[2]
-        return (math.prod(int(n) for n in shape) <= MAX_BOX_CELLS
+        return (math.prod(int(n) for n in shape) <= RECORD_MAX_BOX_CELLS
                 and (model == "mann" or across <= MAX_KAIMAL_POINTS))
     length, duration = turbulence["length_scale"], settings["record"]["duration"]
     if fits(length, duration):
@@ -145,7 +146,7 @@ def check_record_cost(check, settings):
             f"{float(math.prod(int(n) for n in shape)):.3g} cells" + (
                 f" ({shape[1] * shape[2]:.0f} points across the wind)" if model == "kaimal"
                 else ""))
-    limit = (f"at most {MAX_BOX_CELLS} cells" + (
+    limit = (f"at most {RECORD_MAX_BOX_CELLS} cells" + (
         f" and {MAX_KAIMAL_POINTS} points across the wind" if model == "kaimal" else ""))
     period = geometry.scan_period
     larger = (f"turbulence.length_scale >= "
@@ -315,18 +316,37 @@ def _beam_directions(lidar, ship, direction):
 
 def probe_quadrature(probe_settings, focus, nodes=TURBULENCE_PROBE_NODES):
     """Offsets along the beam [m], shape (n_nodes,), and weights, shape (n_gates,
-    n_nodes), each row summing to 1, of the probe of a validated ``lidar.probe`` at the
-    focus of each gate [m] (see :func:`scan_geometry`)."""
+    n_nodes), of the probe of a validated ``lidar.probe`` at the focus of each gate [m]
+    (see :func:`scan_geometry`): each row sums to 1, but a CW lidar's, whose weighting is
+    the Lorentzian cut at the lens alone, read up to :data:`~uq.constants.
+    CW_RECORD_FAR_CUT` focus distances beyond the focus on a "tan" rule of
+    :data:`~uq.constants.CW_RECORD_PROBE_NODES` nodes (s = z_R tan(theta), theta
+    uniform between ``-atan(F / z_R)`` and ``atan(c F / z_R)``, weights normalised over
+    ``s >= -F``): the tail beyond is dropped (its weight, ~2 z_R / (3 pi F), reads no
+    field), not spread over the rest."""
     probe = probesection.make_probe(probe_settings)
     n_gates = np.size(focus)
     if probe is None:
         return np.zeros(1), np.ones((n_gates, 1))
-    x, w = legendre(nodes)
-    # the probe's own rule (uq.physics.probe: pulsed nodes on its cut interval with
-    # weights w_i W(s_i); CW the "tan" rule), gate by gate
-    rules = [probe._node(x, w, f, probe.parameters()) for f in np.asarray(focus, float)]
-    offsets = [np.broadcast_to(s, x.shape) for s, _ in rules]
-    weights = [np.broadcast_to(omega, x.shape) / np.sum(omega) for _, omega in rules]
+    if probe.kind == "cw":
+        nodes = CW_RECORD_PROBE_NODES
+        x, w = legendre(nodes)
+        rules = []
+        for f in np.asarray(focus, float):
+            z = float(probe.rayleigh(np.array([f]))[0])
+            low, high = -math.atan(f / z), math.atan(CW_RECORD_FAR_CUT * f / z)
+            theta = (low + high) / 2 + (high - low) / 2 * x
+            mass = 0.5 + math.atan(f / z) / math.pi          # of the weighting on s >= -F
+            rules.append((z * np.tan(theta), (high - low) / 2 * w / (math.pi * mass)))
+        offsets = [s for s, _ in rules]
+        weights = [omega for _, omega in rules]
+    else:
+        x, w = legendre(nodes)
+        # the probe's own rule (uq.physics.probe: nodes on its cut interval with weights
+        # w_i W(s_i)), gate by gate
+        rules = [probe._node(x, w, f, probe.parameters()) for f in np.asarray(focus, float)]
+        offsets = [np.broadcast_to(s, x.shape) for s, _ in rules]
+        weights = [np.broadcast_to(omega, x.shape) / np.sum(omega) for _, omega in rules]
     if all(np.array_equal(o, offsets[0]) for o in offsets):
         return np.array(offsets[0]), np.array(weights)
     table = np.zeros((n_gates, n_gates * nodes))
