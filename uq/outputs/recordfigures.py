@@ -40,6 +40,8 @@ def record_plan(dataset):
     if "turbulence_intensity_spectral" not in dataset:
         return []
     plan = [("record_spectra", record_spectra), ("ti_budget", ti_budget)]
+    if "turbulence_v_ratio" in dataset:
+        plan.append(("component_ratios", component_ratios))
     if any(dim == "turbulence_intensity" for dim in dataset.dims):
         plan.append(("apparent_against_true_ti", apparent_against_true))
     return plan
@@ -298,4 +300,53 @@ def apparent_against_true(dataset):
     ax.set_title(dataset.attrs.get("title", ""), fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
+    return figure
+
+
+#: The components of the records' figures and tables: (name, variance-ratio variable,
+#: its error, spectral apparent TI, Monte Carlo mean, true TI).
+COMPONENTS = (
+    ("u (along the wind)", "turbulence_intensity_u_ratio", "turbulence_intensity_u_ratio_error",
+     "turbulence_intensity_spectral_turbulence", "turbulence_intensity_mc_mean",
+     "turbulence_intensity_true"),
+    ("v (lateral)", "turbulence_v_ratio", "turbulence_v_ratio_error",
+     "turbulence_intensity_v_spectral", "turbulence_intensity_v_mc_mean",
+     "turbulence_intensity_v_true"),
+    ("w (vertical)", "turbulence_w_ratio", "turbulence_w_ratio_error",
+     "turbulence_intensity_w_spectral", "turbulence_intensity_w_mc_mean",
+     "turbulence_intensity_w_true"))
+
+
+def component_ratios(dataset):
+    """The lidar's u, v, w against its range gates, at the file's scene: (left) the
+    variance ratios of its filtered turbulence to the field's (spectral path, with the
+    quadrature's stated error), (right) the apparent TIs of each component from the
+    turbulence alone (spectral: lines) and the Monte Carlo records' mean (points, the
+    scans' errors included), with the field's true TIs dashed."""
+    settings = file_settings(dataset)
+    data = file_scene(dataset, settings, keep=("range",))
+    gates = np.atleast_1d(data["range"].values)
+    figure, (left, right) = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
+    for k, (label, ratio, error, spectral, mc, true) in enumerate(COMPONENTS):
+        values = np.atleast_1d(data[ratio].values)
+        left.errorbar(gates, values, yerr=np.atleast_1d(data[error].values), fmt="o-",
+                      color=f"C{k}", capsize=3, label=label)
+        right.plot(gates, 100 * np.atleast_1d(data[spectral].values), "-", color=f"C{k}",
+                   label=f"{label}: spectral (turbulence)")
+        if mc in data:
+            right.plot(gates, 100 * np.atleast_1d(data[mc].values), "o", color=f"C{k}",
+                       label=f"{label}: Monte Carlo records")
+        right.axhline(100 * float(data[true]), color=f"C{k}", ls="--", lw=1)
+    left.axhline(1.0, color="k", lw=0.8)
+    left.set_xlabel("range gate [m]")
+    left.set_ylabel("variance ratio lidar / field [1]")
+    left.set_title("variance ratios (spectral path, numerical error bars)", fontsize=9)
+    left.set_yscale("log")
+    right.set_xlabel("range gate [m]")
+    right.set_ylabel("apparent TI [%] (dashed: the field's true TI)")
+    right.set_title("apparent TI of each component over a record", fontsize=9)
+    for ax in (left, right):
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+    figure.suptitle(f"{dataset.attrs.get('title', '')}: the lidar's u, v and w", fontsize=9)
     return figure

@@ -104,6 +104,12 @@ def _record_lines(dataset):
                      f" to {_cell(100 * dataset['turbulence_intensity_mc_high'].sel(select).values, 'mc_u')});"
                      f" spectral validated {int(np.sum(valid))}/{np.size(valid)}")
         lines.append(text)
+        if "turbulence_v_ratio" in dataset:
+            ratios = ", ".join(
+                f"{c} {_cell(dataset[name].sel(select).values, 'mc_u')}" for c, name in (
+                    ("u", "turbulence_intensity_u_ratio"), ("v", "turbulence_v_ratio"),
+                    ("w", "turbulence_w_ratio")))
+            lines.append(f"    variance ratios lidar / field: {ratios}")
     return lines
 
 

@@ -675,14 +675,37 @@ def mann_box_reference(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np
     return TurbulenceBox(grid=grid, velocity=velocity)
 
 
+def kaimal_nodes(grid, points, margin=0.0):
+    """The (y, z) nodes of a Kaimal box that trilinear sampling of `points` (..., 3) [m],
+    each moved by up to `margin` [m], reads: a mask (ny, nz) of the corners of every
+    point's cell, widened by the margin's cells. Veers' method needs the field only
+    there (the coherence is defined point to point), and its cost grows as the cube of
+    their count."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    (ny, nz), (dy, dz) = grid.shape[1:], grid.spacing[1:]
+    mask = np.zeros((ny, nz), dtype=bool)
+    y = (points[:, 1] - grid.origin[1]) / dy
+    z = (points[:, 2] - grid.origin[2]) / dz
+    wy, wz = int(np.ceil(margin / dy)), int(np.ceil(margin / dz))
+    j0 = np.clip(np.floor(y).astype(int), 0, ny - 1)
+    m0 = np.clip(np.floor(z).astype(int), 0, nz - 1)
+    for dj in range(-wy, wy + 2):
+        for dm in range(-wz, wz + 2):
+            mask[np.clip(j0 + dj, 0, ny - 1), np.clip(m0 + dm, 0, nz - 1)] = True
+    return mask
+
+
 def kaimal_box(grid, sigma_u, speed, scale_parameter, rng, xp=np,
-               slab_cells=constants.BOX_SLAB_CELLS):
+               slab_cells=constants.BOX_SLAB_CELLS, nodes=None):
     """A Kaimal field with IEC coherence on a box periodic along x (Veers' method).
 
     Parameters
     ----------
     grid : BoxGrid
         The box, ``periodic_yz=False``; its (y, z) grid is the set of coherent points.
+    nodes : ndarray of bool, shape (ny, nz), optional
+        The (y, z) nodes to make the field at (:func:`kaimal_nodes`: those a record
+        reads); the others hold 0. Default all.
     sigma_u : float
         Standard deviation of u [m s-1] (v and w: IEC ratios).
     speed : float
@@ -702,31 +725,34 @@ def kaimal_box(grid, sigma_u, speed, scale_parameter, rng, xp=np,
     (nx, ny, nz), (dx, dy, dz) = grid.shape, grid.spacing
     if grid.periodic_yz:
         raise ValueError("kaimal_box: the grid must have periodic_yz=False")
+    nodes = np.ones((ny, nz), dtype=bool) if nodes is None else np.asarray(nodes, bool)
     y, z = np.meshgrid(np.arange(ny) * dy, np.arange(nz) * dz, indexing="ij")
-    points = np.stack([y.ravel(), z.ravel()], axis=-1)
+    points = np.stack([y[nodes], z[nodes]], axis=-1)
+    count = points.shape[0]
     separation = np.linalg.norm(points[:, None] - points[None], axis=-1)
     k1 = 2.0 * np.pi * np.fft.rfftfreq(nx, dx)
     frequency = speed * k1 / (2.0 * np.pi)
     spectra = KaimalSpectra(tuple(np.multiply(constants.IEC_KAIMAL_SIGMA_RATIOS, sigma_u)),
                             tuple(np.multiply(constants.IEC_KAIMAL_LENGTH_FACTORS, scale_parameter)),
                             constants.IEC_COHERENCE_LENGTH_FACTOR * scale_parameter, speed)
-    check_kaimal_points(ny * nz)
+    check_kaimal_points(count)
     fft = _fft(xp)
-    noise = white_noise(rng, (3, nx, ny, nz), xp)
-    half = fft.rfft(noise.reshape(3, nx, ny * nz), axis=1)            # (3, k1, points)
+    noise = white_noise(rng, (3, nx, count), xp)
+    half = fft.rfft(noise, axis=1)                                    # (3, k1, points)
     del noise
     # two-sided densities in k1 [m3 s-2]: S(f) df / dk1 / 2, Table B.1 [3] via Taylor
     density = np.stack([spectra.spectrum(c, frequency) for c in range(3)]) * speed / (4 * np.pi)
     density[:, 0] = 0.0                                                # the box's mean is zero
     amplitude = xp.asarray(np.sqrt(density * 2.0 * np.pi / dx))        # sqrt(nx dk1 F)
-    per_slab = max(1, slab_cells // (ny * nz) ** 2)
+    per_slab = max(1, slab_cells // count ** 2)
     for a in range(0, k1.size, per_slab):
         part = slice(a, min(a + per_slab, k1.size))
         # one coherence, so one Cholesky factor, for the three components
         coherence = spectra.coherence(separation, frequency[part, None, None])
         factor = xp.asarray(np.linalg.cholesky(coherence))
         half[:, part] = xp.einsum("fpq,cfq->cfp", factor, half[:, part]) * amplitude[:, part, None]
-    velocity = fft.irfft(half, n=nx, axis=1).reshape(3, nx, ny, nz)
+    velocity = xp.zeros((3, nx, ny, nz))
+    velocity[:, :, xp.asarray(nodes)] = fft.irfft(half, n=nx, axis=1)
     return TurbulenceBox(grid=grid, velocity=velocity)
 
 
@@ -800,8 +826,6 @@ def box_for(geometry, length_scale, model="mann", spacing=None, record_duration=
     shape, step, (low, high), duration = box_extent(geometry, length_scale, model, spacing,
                                                     record_duration, motion_margin, margin)
     check_cells(shape, max_cells)
-    if model == "kaimal":
-        check_kaimal_points(shape[1] * shape[2])
     centre = (low + high) / 2.0
     # the reference point (0, 0, 0) on a line of nodes along x: its series is read
     # without interpolating across the wind (the box moves by at most half a cell, inside

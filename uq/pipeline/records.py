@@ -18,6 +18,10 @@ For each scene, ``turbulence_intensity_spectral`` at each gate is::
   adds (the record's high-pass takes 1/N of it, N the scans of a record, negligible).
 * ``Vh_true``: the true horizontal speed at the gate (``wind_speed_true``).
 
+Both are the expected sample variance of a record, as a lidar's software and the Monte
+Carlo records reduce it (``N - 1`` in the denominator: ``N / (N - 1)`` times the spectral
+path's variance about the record's mean).
+
 ``turbulence_intensity_true`` is the expected ``sigma_u / U`` of the field at the
 reference point over the record (the same high-pass and scan sampling), so that
 (``turbulence_intensity_spectral`` / ``turbulence_intensity_true``)^2 is the lidar's
@@ -49,7 +53,8 @@ from uq.constants import (RECORD_BOX_SLAB_CELLS, RECORD_FFT_WORKERS, RECORD_SPEC
                           RECORD_MAX_BOX_CELLS,
                           SPECTRAL_REFINEMENTS, SPECTRAL_TOLERANCE,
                           SPECTRAL_PATHS_KEPT, UNIT_RECORD_CACHE_BYTES)
-from uq.pipeline.turbulencesection import scan_geometry, scans_per_record, slant_ranges
+from uq.pipeline.turbulencesection import (record_points, scan_geometry, scans_per_record,
+                                           slant_ranges)
 
 log = logging.getLogger(__name__)
 
@@ -237,8 +242,11 @@ def record_variables(scenario, fields, dataset, seed=0, compiled=True, spectra_o
     speeds = np.array([s["wind"]["speed"] for s in scenes])
     truth = dataset["wind_speed_true"].values.reshape(len(scenes), n_gates)
     u_scan = _scan_uncertainty(dataset).reshape(len(scenes), n_gates)
-    lidar, true = paths["lidar"], paths["true"]
-    lidar_error, true_error = paths["lidar_error"], paths["true_error"]
+    # the records' sample variance (N - 1): N / (N - 1) times the spectral path's (1 / N)
+    sample = np.array([_sample_factor(scans_per_record(scene)) for scene in scenes])
+    lidar, true = paths["lidar"] * sample[:, None, None], paths["true"] * sample[:, None]
+    lidar_error = paths["lidar_error"] * sample[:, None, None]
+    true_error = paths["true_error"] * sample[:, None]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratios = lidar / true[:, None, :]
         ratio_errors = (np.abs(lidar_error) + np.abs(ratios) * true_error[:, None, :]) \
@@ -273,6 +281,14 @@ def record_variables(scenario, fields, dataset, seed=0, compiled=True, spectra_o
             spectrum_axis(spectra_of) if spectra_of else None,
             bool(spectra_of and spectra_of.get("motion"))))
     return out
+
+
+def _sample_factor(scans):
+    """``N / (N - 1)`` [1]: the expected sample variance (a lidar's standard deviation
+    over a record's N scans, N - 1 in the denominator, as the records reduce it) over the
+    variance about the record's mean that the spectral path gives (1 / N); NaN for one
+    scan."""
+    return scans / (scans - 1) if scans > 1 else np.nan
 
 
 def prepare_records(scenario, fields, seed, spectra_of=None):
@@ -447,7 +463,7 @@ def unit_box_parts(settings, geometry, rng, motion_margin=0.0):
     grid = record_grid(settings, geometry, motion_margin)
     kept = reference_complement(settings, geometry, grid)[1]   # (first: not beside the box)
     if turbulence["model"] == "mann":
-        points = np.vstack([np.asarray(geometry.probe_points()).reshape(-1, 3), np.zeros(3)])
+        points = record_points(geometry)
         nx, ny, nz = grid.shape
         parts = math.ceil(3 * nx * ny * (nz // 2 + 1) * 16 / RECORD_SPECTRA_BYTES)
         return turbulencebox.mann_box_window_parts(
@@ -455,7 +471,8 @@ def unit_box_parts(settings, geometry, rng, motion_margin=0.0):
             turbulencebox.box_window(grid, points, motion_margin), parts,
             slab_cells=RECORD_BOX_SLAB_CELLS, workers=RECORD_FFT_WORKERS), kept
     scale = turbulence["length_scale"] / LENGTH_FACTORS_KAIMAL
-    return [turbulencebox.kaimal_box(grid, 1.0, speed, scale, rng)], kept
+    nodes = turbulencebox.kaimal_nodes(grid, record_points(geometry), motion_margin)
+    return [turbulencebox.kaimal_box(grid, 1.0, speed, scale, rng, nodes=nodes)], kept
 
 
 def reference_complement(settings, geometry, grid):

@@ -133,19 +133,26 @@ def check_record_cost(check, settings):
         return turbulencebox.box_extent(geometry, scale, model, record_duration=duration,
                                         motion_margin=margin)[0]
 
+    def across(length, duration):        # the (y, z) nodes a Kaimal record makes
+        grid = turbulencebox.box_for(geometry, length / KAIMAL_LENGTH_FACTOR, model,
+                                     record_duration=duration, motion_margin=margin,
+                                     max_cells=RECORD_MAX_BOX_CELLS)
+        return int(turbulencebox.kaimal_nodes(grid, record_points(geometry), margin).sum())
+
     def fits(length, duration):
         shape = box(length, duration)
-        across = shape[1] * shape[2]
-        return (math.prod(int(n) for n in shape) <= RECORD_MAX_BOX_CELLS
-                and (model == "mann" or across <= MAX_KAIMAL_POINTS))
+        if math.prod(int(n) for n in shape) > RECORD_MAX_BOX_CELLS:
+            return False
+        return model == "mann" or across(length, duration) <= MAX_KAIMAL_POINTS
     length, duration = turbulence["length_scale"], settings["record"]["duration"]
     if fits(length, duration):
         return
     shape = box(length, duration)
+    cells = math.prod(int(n) for n in shape)
     size = (f"a turbulence box of {' x '.join(f'{n:.0f}' for n in shape)} = "
-            f"{float(math.prod(int(n) for n in shape)):.3g} cells" + (
-                f" ({shape[1] * shape[2]:.0f} points across the wind)" if model == "kaimal"
-                else ""))
+            f"{float(cells):.3g} cells" + (
+                f" ({across(length, duration)} points across the wind)"
+                if model == "kaimal" and cells <= RECORD_MAX_BOX_CELLS else ""))
     limit = (f"at most {RECORD_MAX_BOX_CELLS} cells" + (
         f" and {MAX_KAIMAL_POINTS} points across the wind" if model == "kaimal" else ""))
     period = geometry.scan_period
@@ -162,6 +169,12 @@ def check_record_cost(check, settings):
     check.fail("turbulence.length_scale", f"{length:g} m needs {size} (a cell is L / 8); "
                f"allowed: {limit}, i.e. {larger or 'a shorter record.duration'} for this "
                "lidar (or sampling.method: none for the spectral path alone)")
+
+
+def record_points(geometry):
+    """The points a record's box must hold, (n, 3) [m]: every probe point of the scan
+    and the reference point (0, 0, 0)."""
+    return np.vstack([np.asarray(geometry.probe_points()).reshape(-1, 3), np.zeros(3)])
 
 
 def _bisect(inside, good, bad, log=False, steps=60):
