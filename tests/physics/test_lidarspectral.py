@@ -425,3 +425,40 @@ def test_kaimal_gates_with_their_nodes_side_by_side_equal_each_gate_alone():
     for g, height in enumerate((40.0, 100.0)):
         alone = variances([height])
         np.testing.assert_allclose(both.lidar[g], alone.lidar[0], rtol=1e-12)
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_a_beam_staring_along_the_wind_sees_the_along_beam_probe_filter_alone(tensor, sign):
+    # one pulsed beam along x (a nacelle lidar's boresight looks against the wind: -x),
+    # u its radial velocity: k . n = +-k1, so the lidar's u-variance is the 1-D spectrum
+    # F11(k1) filtered by |What(k1)|^2 and the record's high-pass: a 1-D integral on the
+    # log-polar cross-section's 1-D spectra (not the Cartesian pair sums), with scipy's
+    # adaptive quadrature in k1 over a cubic spline of log F11; within the stated error
+    from scipy import interpolate as interp
+    from uq.physics.lidarspectral import _one_dimensional_spectra
+    g = ScanGeometry(np.array([[sign, 0, 0]]), np.array([[[sign * 120.0, 0, 0]]]),
+                     np.zeros(1), 0.0, 1.0, np.zeros(1), np.ones((1, 1)),
+                     np.array([[[sign], [0.0], [0.0]]]), SPEED, 600.0)
+    ours = mann_lidar_variances(g, tensor, probe_transfer_for(SATHE_PROBE, [120.0]))
+    k = np.geomspace(1e-6 / 33.6, 1e6 / 33.6, 241)
+    f11 = np.concatenate([_one_dimensional_spectra(tensor, WavenumberGrid(33.6, angle_nodes=64,
+                                                                          radius_per_decade=12),
+                                                   k[i:i + 12])[:, 0, 0]
+                          for i in range(0, k.size, 12)])
+    spline = interp.CubicSpline(np.log(k), np.log(f11))
+
+    def integral(filtered):
+        def f(x):
+            value = np.exp(spline(np.log(x))) * record_filter(x * SPEED / (2 * np.pi), 1.0,
+                                                             600.0)
+            return value * (pulsed_transfer(x, 18.75, 24.75) ** 2 if filtered else 1.0)
+        edges = np.union1d(np.geomspace(k[0], k[-1], 49),
+                           np.arange(1, 64) * np.pi / (SPEED * 600.0))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", integrate.IntegrationWarning)
+            return 2 * sum(integrate.quad(f, a, b, limit=200, epsrel=1e-9)[0]
+                           for a, b in zip(edges[:-1], edges[1:]))
+    expected = integral(True) / integral(False)
+    # the stated error plus the spline's and the record peak's quadrature (~2e-4)
+    assert abs(ours.ratios()[0, 0] - expected) <= ours.ratio_errors()[0, 0] + 2e-4 * expected
+    assert 0.6 < expected < 0.95

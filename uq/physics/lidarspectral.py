@@ -16,7 +16,9 @@ gate centre r_bg of gate g, mid-dwell time t_b, dwell d, range weighting W_g) me
 
 with ``What_g(kappa) = int W_g(s) exp(i kappa s) ds`` (for the pulsed weighting
 ``sinc(kappa Dp/2) exp(-kappa^2 r_p^2 / 4)``, the rectangle's and the Gaussian's
-transforms; for the uncut Lorentzian ``exp(-z_R |kappa|)``) and ``sinc x = sin x / x``.
+transforms; for a CW lidar's Lorentzian cut at the lens alone the closed form of
+:func:`lens_cut_lorentzian_transfer`, complex as the cut is one-sided) and ``sinc x =
+sin x / x``.
 The reconstruction R (n_gates, 3, n_beams) gives component c of scan m (start m T_s)::
 
     u_c[m] = int exp(-i k1 U m T_s) G_c(k) . dZ(k),   G_cj = sum_b R_gcb n_bj T_bg   (2)
@@ -27,8 +29,8 @@ reduced to its variance about its own mean, ``s^2 = (1/N) sum (u_c[m] - mean)^2`
     <s^2> = int G_c Phi G_c^H (1 - |D_N(f)|^2) d^3k,   f = k1 U / (2 pi)          (3)
     D_N(f) = (1/N) sum_m exp(2 pi i f m T_s),  |D_N|^2 = sin^2(pi f N T_s) / (N sin(pi f T_s))^2
 
-exactly (``<mean^2> = int ... |D_N|^2``); the variance of one sample is the full integral
-whatever the sampling, so there is no aliasing term. N = 1 gives 0; ``T_rec = inf`` no
+exactly (``<mean^2> = int ... |D_N|^2``): |D_N|^2 peaks at every multiple of the scan
+rate, the scans' aliasing, which removes 1/N of the variance above it. N = 1 gives 0; ``T_rec = inf`` no
 high-pass. The true point variance over the record is (3) with ``G = e_c`` at r = 0 and the
 same scan times (the reference point sampled once a scan). The horizontal speed, linearised
 for the wind along x, has ``var(Vh) = var(u_x) + O(sigma^4 / U^2)``.

@@ -174,8 +174,9 @@ MEANINGS = {
                                 "above (IEC 61400-1 Ed. 3, Annex B). The records' box has "
                                 "cells of L / 8 (Kaimal: Lambda_1 / 8) over the record's "
                                 "advected length and the scan's width and height (Mann: "
-                                "plus 3 L each side): at most 16777216 cells, and for "
-                                "Kaimal 1024 points across the wind, checked at validation "
+                                "plus 3 L each side): at most 33554432 cells, and for "
+                                "Kaimal 1024 points across the wind where its records read "
+                                "the field, checked at validation "
                                 "(the message gives the smallest L that fits)"),
     "turbulence.anisotropy": ("1", "Mann's Gamma (IEC 61400-1 Ed. 3, Annex B: 3.9)"),
     "record.count": ("1", "Monte Carlo records per scene (each a turbulence box; not with "
@@ -185,7 +186,7 @@ MEANINGS = {
                         "default 600 with turbulence). With Monte Carlo records the box "
                         "(see turbulence.length_scale) spans wind.speed x record.duration "
                         "along the wind, with the motion's reach (3 standard deviations) "
-                        "around the probes: at most 16777216 cells, checked at validation "
+                        "around the probes: at most 33554432 cells, checked at validation "
                         "(the message gives the longest record at that wind speed)"),
     "lidar.lever_arm": ("m", "(bow, starboard, up) from the INS to the lidar"),
     "lidar.mount.tilt": ("deg", "boresight tilted from vertical towards the bow (0: the "
