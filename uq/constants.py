@@ -441,6 +441,11 @@ MANN_LENGTH_SCALE_IEC = MANN_LENGTH_FACTOR * IEC_SCALE_PARAMETER
 #: Taylor's frozen-turbulence hypothesis (it needs sigma_u << U; Willis and Deardorff
 #: 1976, J. Atmos. Sci. 33, 1530, find it holds to sigma_u / U ~ 0.5) that both paths use.
 MAX_TURBULENCE_INTENSITY = 0.5
+#: Smallest turbulence intensity a scenario accepts [1]: sigma_u = 1e-6 U is 1e-5 m s-1 at
+#: 10 m s-1, three orders below any lidar's radial-velocity resolution (~1 cm s-1); far
+#: below it the records' variances (~(I U)^2) underflow float64 (a TI of 1e-300 has a
+#: variance of 1e-598 m2 s-2, which is 0) and their ratios are 0 / 0.
+MIN_TURBULENCE_INTENSITY = 1e-6
 #: Longest length scale a scenario accepts [m]: 10 km, beyond any atmospheric surface
 #: layer's integral length (the Kaimal L_u of IEC 61400-1 is 340 m).
 MAX_LENGTH_SCALE = 10_000.0
@@ -454,6 +459,14 @@ MAX_RECORD_DURATION = 3600.0
 #: allocated (2^20 scans of a 5-beam DBS is 5 x 2^20 lines of sight: 40 MB per gate and
 #: probe node in float64); a 600-s record of 1-ms beams of a 5-beam DBS has 120 000.
 MAX_RECORD_SCANS = 2**20
+#: Standard deviations of a random-phase motion's displacement taken for its reach in a
+#: record at validation [1] (uq.pipeline.turbulencesection.motion_reach: the box a record
+#: needs is counted before any record is drawn): a sum of many harmonics is near
+#: Gaussian, and over a ten-minute record of a 7-s sea (~90 cycles) its largest value is
+#: ~sqrt(2 ln 90) = 3.0 sigma (floating_lidar_ti's records reach 1.8-2.0 sigma). A record
+#: that reaches further and needs a box above the limit is refused in one line when its
+#: box is counted, before anything is allocated.
+MOTION_REACH_SIGMAS = 3.0
 #: Default Monte Carlo records per scene (``record.count``) [1]: each record costs a
 #: turbulence box (~7 s CPU for a 600-s record of a 5-beam DBS at 10 m s-1, L = 33.6 m, on
 #: one core here); with 20 records the standard error of the mean apparent TI is its
@@ -475,6 +488,17 @@ TURBULENCE_PROBE_NODES = 48
 #: k h up to which the :data:`TURBULENCE_PROBE_NODES`-node rule holds to 1e-3 [1],
 #: per probe kind (measured, see above).
 TURBULENCE_PROBE_REACH = {"pulsed": 70.0, "cw": 50.0}
+#: A CW lidar's weighting in the records (uq.pipeline.turbulencesection.probe_quadrature):
+#: the Lorentzian cut at the lens (s >= -F, no beam behind it) as the spectral path
+#: takes it, read up to CW_RECORD_FAR_CUT focus distances beyond the focus (the field is
+#: not read farther: that tail's weight, 2 z_R / (3 pi F) of the mass, is dropped, not
+#: spread over the rest), on a "tan" rule of CW_RECORD_PROBE_NODES nodes. Measured with
+#: the spectral path (its ratios with this rule's own transfer against the uncut one,
+#: tests/pipeline/test_turbulencesection.py): a CW VAD's u, v, w variance ratios at 40-100
+#: m move by < 0.3 % (their TIs by < 0.15 %), where a cut at the focus distance (s <= F)
+#: moved them by up to 1.1 % and the per-scan truncation of 2 % by 4-9 %.
+CW_RECORD_FAR_CUT = 2.0
+CW_RECORD_PROBE_NODES = 96
 # --- Turbulence (issue 24) ------------------------------------------------------------
 
 #: Von Karman energy spectrum's exponent 17/6 [1], also the second parameter of Mann's
@@ -494,6 +518,12 @@ EDDY_LIFETIME_TABLE_RANGE = (1e-4, 1e4)
 #: one slab) bytes per cell, ~1 GB at 2^24 cells, the memory a 2-core machine shared
 #: with others can give one record. Boxes above it are refused (box_for, mann_box).
 MAX_BOX_CELLS = 2**24
+#: Most cells of a record's box [1] (uq.pipeline.records.record_grid, checked at
+#: validation): its half spectra are held in parts of at most RECORD_SPECTRA_BYTES and
+#: only the probes' (y, z) lines come back from the transforms, so its memory does not
+#: grow with its cells; its time does (~2 x a box of MAX_BOX_CELLS). A CW VAD's box,
+#: which reaches from the lens to three focus distances, needs ~2.8e7 at 100 m.
+RECORD_MAX_BOX_CELLS = 2**25
 
 #: Cells of one slab of the spectral factor computed at a time [1]: nine float64 arrays
 #: of that size (2^20: 72 MB) bound the factor's memory whatever the box.
@@ -563,14 +593,18 @@ SPECTRAL_K1_PER_DECADE = 12
 SPECTRAL_RADIUS_DECADES = (-5.0, 4.0)
 SPECTRAL_RADIUS_PER_DECADE = 8
 SPECTRAL_ANGLE_NODES = 48
-#: Points of the wavenumber grid whose weighted trace of Phi is below this fraction of the
-#: field's total trace are left out of the lidar's sum [1]: they hold 3e-6 of the trace
-#: of the IEC Mann field, so a component's variance moves by < (sum_b |R_b|)^2 3e-6 (2e-5
-#: of sigma_u^2 for a DBS u), and 40 % of the points go (measured).
-SPECTRAL_PRUNE = 1e-10
-#: Frequencies of the Kaimal path: f L_u / U from 1e-5 to 1e5 [1], nodes per decade.
+#: Frequencies of the Kaimal path: f L_u / U from 1e-5 to 1e5 [1].
 KAIMAL_FREQUENCY_DECADES = (-5.0, 5.0)
-KAIMAL_FREQUENCY_PER_DECADE = 40
+#: Largest estimated relative error of a spectral ratio (u, v, w) that the spectral path
+#: accepts before it refines its rules [1] (uq.physics.lidarspectral). The estimate is
+#: the difference from a coarser rule (two nodes fewer a panel; for a VAD's log-polar
+#: grid 2/3 of its k1 nodes and 3/4 of the others), which overstates the error 3-5 times
+#: (measured: a pulsed DBS at 40-300 m and a CW VAD at 40-100 m move by < 1.5e-3 when
+#: their rules are refined, where the estimates say 2e-3 to 6e-3).
+SPECTRAL_TOLERANCE = 1e-2
+#: Most refinements of the spectral path's rules before it reports a result as not
+#: converged [1] (each costs ~2.4 times the one before).
+SPECTRAL_REFINEMENTS = 2
 
 #: Golden TI (issue 24, item 5): a record is 10 min [s] (IEC 61400-12-1); the
 #: representative TI is the mean plus 1.28 standard deviations (IEC 61400-1:2005 Sec.

@@ -307,6 +307,34 @@ def test_kaimal_coherence_follows_iec():
             assert abs(gamma - iec) < 4 * (1 - iec**2) / np.sqrt(2 * n), (r, low, gamma, iec)
 
 
+def test_a_kaimal_box_made_at_the_nodes_a_record_reads_has_their_statistics():
+    # Veers' method at a subset of the (y, z) nodes (those a record reads): the same
+    # coherence between two of them and the same spectra as the whole grid has there
+    # (the coherence is point to point), zeros elsewhere; the cost falls as the cube of
+    # the nodes (here 2 of 20)
+    speed, dx, dy = KAIMAL["speed"], 2.5, 20.0
+    grid = tb.BoxGrid((2048, 5, 4), (dx, dy, dy), periodic_yz=False)
+    points = np.array([[0.0, 0.5 * dy, 0.5 * dy], [10.0, 1.5 * dy, 0.5 * dy]])
+    nodes = tb.kaimal_nodes(grid, points)
+    assert nodes.sum() == 6 and nodes[0, 0] and nodes[2, 1] and not nodes[4, 3]
+    boxes = np.array([tb.kaimal_box(grid, rng=np.random.default_rng(s), nodes=nodes,
+                                    **KAIMAL).velocity for s in range(8)])
+    assert np.all(boxes[:, :, :, ~nodes] == 0)
+    spectra = np.fft.rfft(boxes[:, 0], axis=1)
+    f = speed * np.fft.rfftfreq(grid.shape[0], dx)
+    xa, xb = spectra[:, :, 0, 0], spectra[:, :, 1, 0]
+    band = (f >= 0.002) & (f < 0.02)
+    co = np.mean(np.real(xa * np.conj(xb))[:, band])
+    gamma = co / np.sqrt(np.mean(np.abs(xa[:, band]) ** 2) * np.mean(np.abs(xb[:, band]) ** 2))
+    iec = np.mean(np.exp(-12 * np.sqrt((f[band] * dy / speed) ** 2
+                                      + (0.12 * dy / (8.1 * KAIMAL["scale_parameter"])) ** 2)))
+    n = band.sum() * len(boxes)           # the co-coherence's standard error, 4 of them
+    assert abs(gamma - iec) < 4 * (1 - iec ** 2) / np.sqrt(2 * n)
+    variance = boxes[:, 0][:, :, nodes].var(axis=1).mean()
+    whole = np.array(_kaimal_boxes(grid, range(8)))[:, 0].var(axis=1).mean()
+    assert variance == pytest.approx(whole, rel=0.15)     # 8 boxes' scatter: ~5 %
+
+
 # --- seeds, memory, sizing -------------------------------------------------------------
 
 def test_same_seed_same_box_whatever_the_slab():
@@ -360,12 +388,16 @@ def test_box_for_holds_the_record():
     grid = tb.box_for(geometry, 33.6)
     lengths, points = np.array(grid.lengths), geometry.probe_points().reshape(-1, 3)
     assert lengths[0] >= geometry.speed * 600.0 + np.ptp(points[:, 0])
-    # y and z: the points plus 3 L on each side
+    # y and z: the points plus 3 L on each side, less the half cell the box moves to put
+    # the reference point (0, 0, 0) on a node
     for axis in (1, 2):
         assert lengths[axis] >= np.ptp(points[:, axis]) + 6 * 33.6
-        low = grid.origin[axis]
-        assert low <= points[:, axis].min() - 3 * 33.6 + 1e-9
-        assert low + (grid.shape[axis] - 1) * grid.spacing[axis] >= points[:, axis].max() + 3 * 33.6 - 1e-9
+        low, half = grid.origin[axis], grid.spacing[axis] / 2
+        assert low <= points[:, axis].min() - 3 * 33.6 + half + 1e-9
+        assert low + (grid.shape[axis] - 1) * grid.spacing[axis] >= \
+            points[:, axis].max() + 3 * 33.6 - half - 1e-9
+        assert (0.0 - low) / grid.spacing[axis] == pytest.approx(
+            round((0.0 - low) / grid.spacing[axis]), abs=1e-9)
     assert grid.spacing == (33.6 / 8,) * 3
     kaimal = tb.box_for(geometry, 42.0, model="kaimal")
     assert not kaimal.periodic_yz

@@ -114,3 +114,36 @@ def test_clause_8_small_pitch_valid_large_pitch_not():
     shift = u**2 / 20.0 - 10.0 * np.deg2rad(np.array(broken))**2 / 4
     mean = ds["wind_speed_mc_mean"].values.ravel()[len(valid):] - 10.0
     np.testing.assert_allclose(mean, shift, atol=3e-3)   # 3 x u / sqrt(n) and 4th order
+
+
+def test_a_static_attitude_is_the_static_limit_of_the_motion_with_the_height_at_trim():
+    # lidar.height is the height at the static attitude (docs/scenario.md): a static pitch
+    # p with height h is the level platform whose harmonic pitch is frozen at p (a period
+    # of 1e6 s, phase 90 deg: pitch = p sin(w t + pi/2), 3e-5 of p off over a scan) with
+    # the height h - [(R(p) - 1) r]_up, r the lever arm (150 m up: 0.21 m at 3 deg): what
+    # the lidar measures agrees to rounding (gate heights 1e-9 m, speeds 1e-9 m/s, the
+    # shear exponent 1e-9; the motion's rates, ~1e-7 rad/s, move nothing measurable)
+    import math
+    from uq.pipeline.runner import run
+    base = {"wind": {"speed": 10.0, "shear": 0.14, "reference_height": 150.0},
+            "ship": {"pitch": 3.0},
+            "lidar": {"height": 150.0, "ranges": [50.0, 150.0], "half_cone": 15.0,
+                      "azimuths": [0, 90, 180, 270], "mount": {"tilt": 90},
+                      "lever_arm": [0.0, 0.0, 150.0], "scan": {"beam_duration": 1.0}},
+            "correction": "pointwise", "ins": {"rate": 10}, "sampling": {"method": "none"},
+            "outputs": ["wind_speed", "gate_height", "shear_exponent", "wind_direction"]}
+    static = run(base)
+    drop = 150.0 * (math.cos(math.radians(3.0)) - 1.0)                    # [(R - 1) r]_up
+    frozen = run({**base, "ship": {"pitch": 0.0},
+                  "lidar": {**base["lidar"], "height": 150.0 - drop},
+                  "motion": {"pitch": {"amplitude": 3.0, "period": 1e6, "phase": 90}}})
+    for name in ("gate_height_nominal", "wind_speed_nominal", "shear_exponent_nominal"):
+        np.testing.assert_allclose(frozen[name].values, static[name].values, rtol=0,
+                                   atol=1e-9)
+    turned = (frozen["wind_direction_nominal"] - static["wind_direction_nominal"] + 180) % 360
+    np.testing.assert_allclose(turned - 180, 0.0, atol=1e-9)
+    # without the height's correction the frozen motion lowers the lidar by 0.21 m
+    lowered = run({**base, "ship": {"pitch": 0.0},
+                   "motion": {"pitch": {"amplitude": 3.0, "period": 1e6, "phase": 90}}})
+    assert float((lowered["gate_height_nominal"] - static["gate_height_nominal"]).mean()) == \
+        pytest.approx(drop, abs=1e-6)

@@ -366,6 +366,12 @@ CAPTIONS = {
     "axis): the spectral path's expectation (line) and the Monte Carlo records' mean with "
     "the 95 % of records (markers), each against its own field TI; on the dashed line the "
     "lidar would read the field's TI.",
+    "component_ratios": "The lidar's along-wind (u), lateral (v) and vertical (w) "
+    "turbulence: left, the variance ratio of what the lidar reports to the field's at the "
+    "reference point (spectral path; the bars are the quadrature's stated numerical "
+    "error); right, each component's apparent TI from the turbulence alone (lines) and the "
+    "Monte Carlo records' mean with the scans' errors (points), against the field's TI "
+    "over a record (dashed). The title names the scene.",
     "uncertainty_against_preview": "u of the hub-height wind speed, the yaw misalignment "
     "and the shear exponent against the preview distance, a colour per correction model: "
     "Monte Carlo as markers, the GUM as dashed lines, on a log scale.",

@@ -35,7 +35,7 @@ from uq.pipeline.scenario import load_scenario
 from uq.pipeline.turbulencesection import scan_geometry
 from uq.outputs import layout
 from uq.outputs.samples import scene_assignments
-from uq.outputs.scenes import swept_keys, value_text
+from uq.outputs.scenes import gate_words, swept_keys, value_text
 
 
 def record_plan(dataset):
@@ -43,6 +43,8 @@ def record_plan(dataset):
     if "turbulence_intensity_spectral" not in dataset:
         return []
     plan = [("record_spectra", record_spectra), ("ti_budget", ti_budget)]
+    if "turbulence_v_ratio" in dataset:
+        plan.append(("component_ratios", component_ratios))
     if any(dim == "turbulence_intensity" for dim in dataset.dims):
         plan.append(("apparent_against_true_ti", apparent_against_true))
     return plan
@@ -326,4 +328,57 @@ def apparent_against_true(dataset):
     layout.title(ax, dataset.attrs.get("title", ""))
     ax.grid(alpha=0.3)
     layout.legend_below(figure, *ax.get_legend_handles_labels(), fontsize=7)
+    return figure
+
+
+#: The components of the records' figures and tables: (name, variance-ratio variable,
+#: its error, spectral apparent TI, Monte Carlo mean, true TI).
+COMPONENTS = (
+    ("u (along the wind)", "turbulence_intensity_u_ratio", "turbulence_intensity_u_ratio_error",
+     "turbulence_intensity_spectral_turbulence", "turbulence_intensity_mc_mean",
+     "turbulence_intensity_true"),
+    ("v (lateral)", "turbulence_v_ratio", "turbulence_v_ratio_error",
+     "turbulence_intensity_v_spectral", "turbulence_intensity_v_mc_mean",
+     "turbulence_intensity_v_true"),
+    ("w (vertical)", "turbulence_w_ratio", "turbulence_w_ratio_error",
+     "turbulence_intensity_w_spectral", "turbulence_intensity_w_mc_mean",
+     "turbulence_intensity_w_true"))
+
+
+def component_ratios(dataset):
+    """The lidar's u, v, w against its range gates, at the scene :func:`shown_scene`
+    picks: (left) the variance ratios of its filtered turbulence to the field's (spectral
+    path, with the quadrature's stated error), (right) the apparent TIs of each component
+    from the turbulence alone (spectral: lines) and the Monte Carlo records' mean (points,
+    the scans' errors included), with the field's TIs over a record dashed."""
+    settings, chosen, words = shown_scene(dataset)
+    data = dataset.sel(chosen)
+    gates = np.atleast_1d(data["range"].values)
+    gate = gate_words(dataset)
+    figure, (left, right) = plt.subplots(1, 2, figsize=(10, 4.4), constrained_layout=True)
+    for k, (label, ratio, error, spectral, mc, true) in enumerate(COMPONENTS):
+        values = np.atleast_1d(data[ratio].values)
+        left.errorbar(gates, values, yerr=np.atleast_1d(data[error].values), fmt="o-",
+                      color=f"C{k}", capsize=3, label=label)
+        right.plot(gates, 100 * np.atleast_1d(data[spectral].values), "-", color=f"C{k}",
+                   label=f"{label}: spectral (turbulence)")
+        if mc in data:
+            right.plot(gates, 100 * np.atleast_1d(data[mc].values), "o", color=f"C{k}",
+                       label=f"{label}: Monte Carlo records")
+        right.axhline(100 * float(np.atleast_1d(data[true].values)[0]), color=f"C{k}",
+                      ls="--", lw=1, label=f"{label}: the field over a record")
+    left.axhline(1.0, color="k", lw=0.8)
+    left.set_xlabel(f"{gate} [m]")
+    left.set_ylabel("variance ratio lidar / field [1]")
+    layout.title(left, "variance ratios (spectral path, numerical error bars)")
+    left.set_yscale("log")
+    right.set_xlabel(f"{gate} [m]")
+    right.set_ylabel("apparent TI [%]")
+    layout.title(right, "apparent TI of each component over a record")
+    for ax in (left, right):
+        ax.grid(alpha=0.3, which="both")
+    left.legend(fontsize=7)
+    layout.suptitle(figure, f"{dataset.attrs.get('title', '')}: the lidar's u, v and w"
+                    + (f" at {words}" if words else ""))
+    layout.legend_below(figure, *right.get_legend_handles_labels(), fontsize=7)
     return figure

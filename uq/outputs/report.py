@@ -109,7 +109,7 @@ def render_report(dataset, source="", targets=None, select=None, true_ti=None):
              _description(dataset), _run_table(dataset, source),
              _answers(dataset, targets, DEFAULT_TRUE_TI if true_ti is None else true_ti),
              _outputs(dataset), _findings(dataset),
-             _summary_tables(dataset), _scene_tables(dataset),
+             _summary_tables(dataset), _records_table(dataset), _scene_tables(dataset),
              _figures(select_scenes(dataset, select), select),
              _scenario(dataset),
              "</body></html>"]
@@ -118,6 +118,52 @@ def render_report(dataset, source="", targets=None, select=None, true_ti=None):
 
 def _e(text):
     return html.escape(str(text))
+
+
+def _records_table(dataset):
+    """Record mode: per range gate (the first scene of a sweep), the lidar's u, v, w
+    variance ratios with their numerical errors, each component's apparent TI (spectral
+    from the turbulence alone; the Monte Carlo records' mean, scans' errors included) and
+    the field's true TI, and the records' check of the spectral path."""
+    from uq.outputs.recordfigures import COMPONENTS
+    if "turbulence_v_ratio" not in dataset:
+        return ""
+    first = {d: 0 for d in dataset["turbulence_v_ratio"].dims if d != "range"}
+    data = dataset.isel(first)
+    gates = np.atleast_1d(data["range"].values)
+    where = "" if not first else " (first scene: " + ", ".join(
+        f"{d} {_e(str(dataset[d].values[0]))}" for d in first) + ")"
+    header = ("component", "quantity") + tuple(f"range gate {g:g} m" for g in gates)
+    rows = []
+    for label, ratio, error, spectral, mc, true in COMPONENTS:
+        rows.append((label, "variance ratio lidar / field") + tuple(
+            f"{_number(r)} &plusmn; {_number(e)}" for r, e in zip(
+                np.atleast_1d(data[ratio].values), np.atleast_1d(data[error].values))))
+        rows.append(("", "apparent TI [%], spectral (turbulence)") + tuple(
+            _number(100 * v) for v in np.atleast_1d(data[spectral].values)))
+        if mc in data:
+            rows.append(("", "apparent TI [%], Monte Carlo records") + tuple(
+                _number(100 * v) for v in np.atleast_1d(data[mc].values)))
+        rows.append(("", "true TI [%] (reference point)") + (_number(
+            100 * float(data[true])),) * len(gates))
+    out = [f"<h2>Turbulence over a record{where}</h2>", _table(header, rows)]
+    if "turbulence_intensity_spectral_z" in data:
+        z, limit = np.atleast_1d(data["turbulence_intensity_spectral_z"].values), float(
+            np.atleast_1d(data["turbulence_intensity_spectral_z_limit"].values)[0])
+        resolution = np.atleast_1d(data["turbulence_intensity_check_resolution"].values)
+        out.append(f"<p>The Monte Carlo records check the spectral path's apparent TI: z = "
+                   f"{', '.join(_number(v) for v in z)} against |z| &le; {_number(limit)} "
+                   f"(Student's t of the run's records, 5 % false alarms); at this record "
+                   f"count the check tells a "
+                   f"relative difference of the TI of {', '.join(_number(100 * r) for r in resolution)} % "
+                   f"from none. The records' field keeps "
+                   f"{_number(float(data['turbulence_intensity_box_kept']))} of the field's "
+                   f"u-variance at the reference point over a record.</p>")
+    if "turbulence_spectral_converged" in data and not bool(
+            np.all(data["turbulence_spectral_converged"].values)):
+        out.append("<p><b>The spectral path did not reach its tolerance</b>: its stated "
+                   "errors say by how much.</p>")
+    return "\n".join(out)
 
 
 def _table(header, rows):

@@ -197,7 +197,32 @@ def _record_table(dataset, per_scene):
             rows.append(cells)
     header = keys + (["field point"] if per_scene else []) + list(present) + (
         ["spectral vs records"] if valid is not None else [])
-    return lines + _table(rows, header)
+    return lines + _table(rows, header) + _component_lines(dataset)
+
+
+def _component_lines(dataset):
+    """Record mode: the lidar's u, v and w variance ratios (its filtered turbulence over
+    the field's, spectral path) per gate, min..max over a sweep."""
+    if "turbulence_v_ratio" not in dataset:
+        return []
+    ratio = dataset["turbulence_v_ratio"]
+    lines = ["", "variance ratio lidar / field (spectral path) [1]:"]
+    for gate in (range(dataset.sizes["range"]) if "range" in ratio.dims else [None]):
+        at = dataset if gate is None else dataset.isel(range=gate)
+        where = "" if gate is None else f"{gate_words(dataset)} {float(at['range']):g} m: "
+        lines.append("  " + where + ", ".join(
+            f"{component} {_extent(at, name)}" for component, name in (
+                ("u", "turbulence_intensity_u_ratio"), ("v", "turbulence_v_ratio"),
+                ("w", "turbulence_w_ratio"))))
+    return lines
+
+
+def _extent(dataset, name):
+    values = np.asarray(dataset[name].values, dtype=float)
+    if np.all(np.isnan(values)):
+        return "nan"
+    low, high = np.nanmin(values), np.nanmax(values)
+    return _number(low) if _same(low, high) else f"{_number(low)}..{_number(high)}"
 
 
 def _point_ti(dataset, index):

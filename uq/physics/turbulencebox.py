@@ -85,6 +85,7 @@ References
    the exponential coherence model), 6.3.1 (Lambda_1).
 .. [4] Veers, P. S. (1988). Three-dimensional wind simulation. SAND88-0152, Sandia.
 """
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -133,19 +134,22 @@ class BoxGrid:
         reference point [m].
     periodic_yz : bool
         Whether the field is periodic along y and z (Mann) or not (Kaimal).
+    max_cells : int
+        The most cells it may have (:func:`check_cells`).
     """
 
     shape: tuple
     spacing: tuple
     origin: tuple = (0.0, 0.0, 0.0)
     periodic_yz: bool = True
+    max_cells: int = constants.MAX_BOX_CELLS
 
     def __post_init__(self):
         if len(self.shape) != 3 or min(self.shape) < 2 or len(self.spacing) != 3 \
                 or min(self.spacing) <= 0 or len(self.origin) != 3:
             raise ValueError("BoxGrid: shape needs 3 sizes >= 2, spacing 3 values > 0, "
                              "origin 3 values")
-        check_cells(self.shape)
+        check_cells(self.shape, self.max_cells)
 
     @property
     def cells(self):
@@ -160,7 +164,7 @@ class BoxGrid:
 
 def check_cells(shape, max_cells=constants.MAX_BOX_CELLS):
     """Raise ValueError (one line) if a box of ``shape`` cells is above ``max_cells``."""
-    cells = int(np.prod([int(n) for n in shape]))
+    cells = math.prod(int(n) for n in shape)           # Python integers: no overflow
     if cells > max_cells:
         raise ValueError(
             f"turbulence box of {' x '.join(str(int(n)) for n in shape)} = {cells} cells is "
@@ -385,12 +389,14 @@ def cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy):
 
 
 def box_variance(grid, alpha_epsilon, length_scale, anisotropy,
-                 slab_cells=constants.BOX_SLAB_CELLS):
+                 slab_cells=constants.BOX_SLAB_CELLS, spectral_filter=None):
     """Expected variances of (u, v, w) and the u-w covariance of a Mann box [m2 s-2].
 
     The sum of ``Phi(k) dk`` over the box's discrete wavenumbers (k = 0 left out): what a
     box keeps of the tensor's integral, the point variance (a too small or coarse box
-    loses the rest). Parameters as :func:`mann_box`.
+    loses the rest); with `spectral_filter` ``H(k1)`` (of an array of k1 [rad m-1], e.g.
+    a record's high-pass) each wavenumber weighted by it. Other parameters as
+    :func:`mann_box`.
 
     Returns
     -------
@@ -399,21 +405,23 @@ def box_variance(grid, alpha_epsilon, length_scale, anisotropy,
     """
     k1, k2, k3 = box_wavenumbers(grid)
     weights = _half_weights(grid.shape[2], np)
+    filtered = (np.ones(grid.shape[0]) if spectral_filter is None
+                else np.asarray(spectral_filter(np.abs(k1[:, 0, 0])), dtype=float))
     dk = (2.0 * np.pi) ** 3 / np.prod(grid.lengths)
     cells, factors = cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy)
     pairs = ((0, 0), (1, 1), (2, 2), (0, 2))
     total = np.zeros(4)
     for slab in _x_slabs(grid, slab_cells):
         c = mann1998_spectral_factor(k1[slab], k2, k3, alpha_epsilon, length_scale, anisotropy)
-        phi = np.einsum("ik...,jk...->ij...", c, c)
+        phi = np.einsum("ik...,jk...->ij...", c, c) * filtered[slab, None, None]
         total += [np.sum(phi[i, j] * weights) for i, j in pairs]
     index = tuple(cells.T)
     point = mann1998_spectral_factor(k1[index[0], 0, 0], k2[0, index[1], 0], k3[0, 0, index[2]],
                                      alpha_epsilon, length_scale, anisotropy)
     point_phi = np.einsum("ikn,jkn->ijn", point, point)
     averaged_phi = np.einsum("ikn,jkn->ijn", factors, factors)
-    total += [np.sum((averaged_phi[i, j] - point_phi[i, j]) * weights[index[2]])
-              for i, j in pairs]
+    total += [np.sum((averaged_phi[i, j] - point_phi[i, j]) * weights[index[2]]
+                     * filtered[index[0]]) for i, j in pairs]
     return total * dk
 
 
@@ -667,14 +675,37 @@ def mann_box_reference(grid, alpha_epsilon, length_scale, anisotropy, rng, xp=np
     return TurbulenceBox(grid=grid, velocity=velocity)
 
 
+def kaimal_nodes(grid, points, margin=0.0):
+    """The (y, z) nodes of a Kaimal box that trilinear sampling of `points` (..., 3) [m],
+    each moved by up to `margin` [m], reads: a mask (ny, nz) of the corners of every
+    point's cell, widened by the margin's cells. Veers' method needs the field only
+    there (the coherence is defined point to point), and its cost grows as the cube of
+    their count."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    (ny, nz), (dy, dz) = grid.shape[1:], grid.spacing[1:]
+    mask = np.zeros((ny, nz), dtype=bool)
+    y = (points[:, 1] - grid.origin[1]) / dy
+    z = (points[:, 2] - grid.origin[2]) / dz
+    wy, wz = int(np.ceil(margin / dy)), int(np.ceil(margin / dz))
+    j0 = np.clip(np.floor(y).astype(int), 0, ny - 1)
+    m0 = np.clip(np.floor(z).astype(int), 0, nz - 1)
+    for dj in range(-wy, wy + 2):
+        for dm in range(-wz, wz + 2):
+            mask[np.clip(j0 + dj, 0, ny - 1), np.clip(m0 + dm, 0, nz - 1)] = True
+    return mask
+
+
 def kaimal_box(grid, sigma_u, speed, scale_parameter, rng, xp=np,
-               slab_cells=constants.BOX_SLAB_CELLS):
+               slab_cells=constants.BOX_SLAB_CELLS, nodes=None):
     """A Kaimal field with IEC coherence on a box periodic along x (Veers' method).
 
     Parameters
     ----------
     grid : BoxGrid
         The box, ``periodic_yz=False``; its (y, z) grid is the set of coherent points.
+    nodes : ndarray of bool, shape (ny, nz), optional
+        The (y, z) nodes to make the field at (:func:`kaimal_nodes`: those a record
+        reads); the others hold 0. Default all.
     sigma_u : float
         Standard deviation of u [m s-1] (v and w: IEC ratios).
     speed : float
@@ -694,32 +725,60 @@ def kaimal_box(grid, sigma_u, speed, scale_parameter, rng, xp=np,
     (nx, ny, nz), (dx, dy, dz) = grid.shape, grid.spacing
     if grid.periodic_yz:
         raise ValueError("kaimal_box: the grid must have periodic_yz=False")
+    nodes = np.ones((ny, nz), dtype=bool) if nodes is None else np.asarray(nodes, bool)
     y, z = np.meshgrid(np.arange(ny) * dy, np.arange(nz) * dz, indexing="ij")
-    points = np.stack([y.ravel(), z.ravel()], axis=-1)
+    points = np.stack([y[nodes], z[nodes]], axis=-1)
+    count = points.shape[0]
     separation = np.linalg.norm(points[:, None] - points[None], axis=-1)
     k1 = 2.0 * np.pi * np.fft.rfftfreq(nx, dx)
     frequency = speed * k1 / (2.0 * np.pi)
     spectra = KaimalSpectra(tuple(np.multiply(constants.IEC_KAIMAL_SIGMA_RATIOS, sigma_u)),
                             tuple(np.multiply(constants.IEC_KAIMAL_LENGTH_FACTORS, scale_parameter)),
                             constants.IEC_COHERENCE_LENGTH_FACTOR * scale_parameter, speed)
-    check_kaimal_points(ny * nz)
+    check_kaimal_points(count)
     fft = _fft(xp)
-    noise = white_noise(rng, (3, nx, ny, nz), xp)
-    half = fft.rfft(noise.reshape(3, nx, ny * nz), axis=1)            # (3, k1, points)
+    noise = white_noise(rng, (3, nx, count), xp)
+    half = fft.rfft(noise, axis=1)                                    # (3, k1, points)
     del noise
     # two-sided densities in k1 [m3 s-2]: S(f) df / dk1 / 2, Table B.1 [3] via Taylor
     density = np.stack([spectra.spectrum(c, frequency) for c in range(3)]) * speed / (4 * np.pi)
     density[:, 0] = 0.0                                                # the box's mean is zero
     amplitude = xp.asarray(np.sqrt(density * 2.0 * np.pi / dx))        # sqrt(nx dk1 F)
-    per_slab = max(1, slab_cells // (ny * nz) ** 2)
+    per_slab = max(1, slab_cells // count ** 2)
     for a in range(0, k1.size, per_slab):
         part = slice(a, min(a + per_slab, k1.size))
         # one coherence, so one Cholesky factor, for the three components
         coherence = spectra.coherence(separation, frequency[part, None, None])
         factor = xp.asarray(np.linalg.cholesky(coherence))
         half[:, part] = xp.einsum("fpq,cfq->cfp", factor, half[:, part]) * amplitude[:, part, None]
-    velocity = fft.irfft(half, n=nx, axis=1).reshape(3, nx, ny, nz)
+    velocity = xp.zeros((3, nx, ny, nz))
+    velocity[:, :, xp.asarray(nodes)] = fft.irfft(half, n=nx, axis=1)
     return TurbulenceBox(grid=grid, velocity=velocity)
+
+
+def box_extent(geometry, length_scale, model="mann", spacing=None, record_duration=None,
+               motion_margin=0.0, margin=constants.BOX_MARGIN_LENGTH_SCALES):
+    """The cells of :func:`box_for`'s box, counted without allocating anything: (shape,
+    spacing [m], (low, high) corners of the probe points with the motion's margin [m],
+    record duration [s]). Parameters as :func:`box_for`; the shape is that of a box of
+    any size (:func:`check_cells` refuses it)."""
+    if model not in ("mann", "kaimal"):
+        raise ValueError(f"box_for: model must be 'mann' or 'kaimal', not {model!r}")
+    duration = geometry.record_duration if record_duration is None else record_duration
+    if not np.isfinite(duration) or duration <= 0:
+        raise ValueError("box_for: a record needs a finite duration > 0 [s]")
+    step = length_scale / constants.BOX_DEFAULT_CELLS_PER_LENGTH if spacing is None else spacing
+    points = np.vstack([np.asarray(geometry.probe_points()).reshape(-1, 3), np.zeros(3)])
+    low, high = points.min(axis=0) - motion_margin, points.max(axis=0) + motion_margin
+    pad = margin * length_scale if model == "mann" else step
+    advected = geometry.speed * (duration + geometry.dwell) + (high[0] - low[0]) + 2 * step
+    extent = np.array([advected, high[1] - low[1] + 2 * pad, high[2] - low[2] + 2 * pad])
+    cells = np.ceil(extent / step) + 1
+    if np.any(cells > 2.0 ** 52):              # beyond any box: no fast length looked for
+        shape = tuple(float(c) for c in cells)
+    else:
+        shape = tuple(int(scipy.fft.next_fast_len(int(c), real=True)) for c in cells)
+    return shape, step, (low, high), duration
 
 
 def box_for(geometry, length_scale, model="mann", spacing=None, record_duration=None,
@@ -727,10 +786,12 @@ def box_for(geometry, length_scale, model="mann", spacing=None, record_duration=
             max_cells=constants.MAX_BOX_CELLS):
     """Size a box that holds every probe point of a record, refusing one above ``max_cells``.
 
-    A box narrower than the scan or shorter than the large eddies removes variance the
-    lidar would see: a periodic (Mann) box extends ``margin`` length scales beyond the
-    probe points on each side in y and z (its discrete wavenumbers then keep the
-    variance :func:`box_variance` reports); a Kaimal box is not periodic in y and z and
+    The box holds the reference point (0, 0, 0) too, on a line of nodes along x (its
+    series is read there without interpolation across the wind). A box narrower than the
+    scan or shorter than the large eddies removes variance the lidar would see: a
+    periodic (Mann) box extends ``margin`` length scales beyond the probe points on each
+    side in y and z (its discrete wavenumbers then keep the variance
+    :func:`box_variance` reports); a Kaimal box is not periodic in y and z and
     covers the points with one cell to spare. Along x the box is at least the record's
     advected length ``U T`` plus the points' x extent, so no part of the field is met
     twice in a record.
@@ -762,25 +823,15 @@ def box_for(geometry, length_scale, model="mann", spacing=None, record_duration=
     ValueError
         One line naming the box's size and the limit, before anything is allocated.
     """
-    if model not in ("mann", "kaimal"):
-        raise ValueError(f"box_for: model must be 'mann' or 'kaimal', not {model!r}")
-    duration = geometry.record_duration if record_duration is None else record_duration
-    if not np.isfinite(duration) or duration <= 0:
-        raise ValueError("box_for: a record needs a finite duration > 0 [s]")
-    step = length_scale / constants.BOX_DEFAULT_CELLS_PER_LENGTH if spacing is None else spacing
-    points = np.asarray(geometry.probe_points()).reshape(-1, 3)
-    low, high = points.min(axis=0) - motion_margin, points.max(axis=0) + motion_margin
-    pad = margin * length_scale if model == "mann" else step
-    advected = geometry.speed * (duration + geometry.dwell) + (high[0] - low[0]) + 2 * step
-    extent = np.array([advected, high[1] - low[1] + 2 * pad, high[2] - low[2] + 2 * pad])
-    shape = tuple(int(scipy.fft.next_fast_len(int(np.ceil(e / step)) + 1, real=True))
-                  for e in extent)
+    shape, step, (low, high), duration = box_extent(geometry, length_scale, model, spacing,
+                                                    record_duration, motion_margin, margin)
     check_cells(shape, max_cells)
-    if model == "kaimal":
-        check_kaimal_points(shape[1] * shape[2])
     centre = (low + high) / 2.0
+    # the reference point (0, 0, 0) on a line of nodes along x: its series is read
+    # without interpolating across the wind (the box moves by at most half a cell, inside
+    # its margins: 3 L for Mann, a cell for Kaimal)
+    across = [-step * round((centre[a] - (shape[a] - 1) * step / 2.0) / -step) for a in (1, 2)]
     origin = (float(low[0] - geometry.speed * (duration + geometry.dwell) - step),
-              float(centre[1] - (shape[1] - 1) * step / 2.0),
-              float(centre[2] - (shape[2] - 1) * step / 2.0))
+              float(across[0]), float(across[1]))
     return BoxGrid(shape=shape, spacing=(step, step, step), origin=origin,
-                   periodic_yz=model == "mann")
+                   periodic_yz=model == "mann", max_cells=max_cells)

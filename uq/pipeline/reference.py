@@ -66,7 +66,8 @@ EXEMPLAR_ALTERNATIVE = {"sampling": {"digits": 2, "stop_when_gum_valid": True},
 MEANINGS = {
     "name": ("", "name of the scenario; names the output file results/<name>.nc"),
     "description": ("", "free text, kept in the results"),
-    "wind.speed": ("m s-1", "horizontal wind speed at wind.reference_height"),
+    "wind.speed": ("m s-1", "horizontal wind speed at wind.reference_height (> 0 with a "
+                   "turbulence section: the mean wind carries the frozen field)"),
     "wind.direction": ("deg", "meteorological direction the wind comes from, clockwise "
                        "from north"),
     "wind.vertical": ("m s-1", "vertical wind, positive upwards"),
@@ -80,7 +81,12 @@ MEANINGS = {
     "ship.heave": ("m s-1", "heave velocity, positive up"),
     "ins.correlation": ("", "scan: one INS reading per scan, shared by all beams; beam: an "
                         "independent reading per beam (point-wise correction)"),
-    "lidar.height": ("m", "height of the lidar above sea level"),
+    "lidar.height": ("m", "height of the lidar above sea level at the platform's static "
+                     "attitude (ship.pitch, ship.roll): the height surveyed at its trim. The "
+                     "static attitude does not move the lidar through lidar.lever_arm, the "
+                     "motion does, from there (a static pitch p and a height h are the "
+                     "level platform with its motion frozen at pitch p and a height h - "
+                     "[(R(p) - 1) lever_arm]_up: tested)"),
     "lidar.ranges": ("m", "range-gate heights above a level lidar"),
     "lidar.half_cone": ("deg", "half-cone angle of the slanted beams, from vertical"),
     "lidar.azimuths": ("deg", "beam azimuths, clockwise from the reference beam: a list, "
@@ -101,9 +107,12 @@ MEANINGS = {
                                 "lens; the Rayleigh length at the focus F (the gate's slant "
                                 "distance) is lambda F^2 / (pi a^2)"),
     "lidar.probe.truncation": ("1", "a CW weighting's tails are cut where it falls below "
-                               "this fraction of its peak (abs(s) <= sqrt(1/t - 1) z_R); "
-                               "part of the model (the Lorentzian's variance is infinite), stated "
-                               "in the results' probe attribute"),
+                               "this fraction of its peak (abs(s) <= sqrt(1/t - 1) z_R) for "
+                               "the wind profile of a scan; part of that model (the "
+                               "Lorentzian's variance is infinite), stated in the results' "
+                               "probe attribute. Not of the turbulence paths: their CW "
+                               "weighting is cut at the lens alone (there is no beam "
+                               "behind it)"),
     "correction": ("", "motion correction; what each removes is stated below (Correction "
                    "models) and in the results' correction_description attribute"),
     "sampling.method": ("", "mc, lhs, sobol, or none (GUM and the paper's model only)"),
@@ -157,16 +166,28 @@ MEANINGS = {
                          "(Mann 1994 uniform-shear tensor) or kaimal (IEC 61400-1 Kaimal "
                          "spectra with its exponential coherence); gives record mode"),
     "turbulence.intensity": ("1", "sigma_u / U of the point field at wind.reference_height "
-                             "(required: the site's)"),
+                             "(required: the site's; from 1e-6, three orders below any "
+                             "lidar's resolution, where the records' variances stay far "
+                             "above float64's smallest numbers)"),
     "turbulence.length_scale": ("m", "Mann's L (default 0.8 Lambda_1) or Kaimal's L_u "
                                 "(default 8.1 Lambda_1); Lambda_1 = 0.7 z below 60 m, 42 m "
-                                "above (IEC 61400-1 Ed. 3, Annex B)"),
+                                "above (IEC 61400-1 Ed. 3, Annex B). The records' box has "
+                                "cells of L / 8 (Kaimal: Lambda_1 / 8) over the record's "
+                                "advected length and the scan's width and height (Mann: "
+                                "plus 3 L each side): at most 33554432 cells, and for "
+                                "Kaimal 1024 points across the wind where its records read "
+                                "the field, checked at validation "
+                                "(the message gives the smallest L that fits)"),
     "turbulence.anisotropy": ("1", "Mann's Gamma (IEC 61400-1 Ed. 3, Annex B: 3.9)"),
     "record.count": ("1", "Monte Carlo records per scene (each a turbulence box; not with "
                      "sampling.method none, the spectral path alone)"),
     "record.duration": ("s", "length of a record, the scans that lidar.scan times in it, "
                         "reduced to a mean and standard deviation (needs turbulence; "
-                        "default 600 with turbulence)"),
+                        "default 600 with turbulence). With Monte Carlo records the box "
+                        "(see turbulence.length_scale) spans wind.speed x record.duration "
+                        "along the wind, with the motion's reach (3 standard deviations) "
+                        "around the probes: at most 33554432 cells, checked at validation "
+                        "(the message gives the longest record at that wind speed)"),
     "lidar.lever_arm": ("m", "(bow, starboard, up) from the INS to the lidar"),
     "lidar.mount.tilt": ("deg", "boresight tilted from vertical towards the bow (0: the "
                          "upward lidar, as without mount; 90: a nacelle lidar looking "

@@ -32,7 +32,8 @@ from uq.pipeline.motionsection import (check_dwell, check_record, random_phase_c
                                        validate_ins_timing, validate_lever_arm, validate_motion,
                                        validate_scan)
 from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
-from uq.pipeline.turbulencesection import validate_record, validate_turbulence
+from uq.pipeline.turbulencesection import (check_record_cost, validate_record,
+                                           validate_turbulence)
 from uq.physics.modelinputs import error_keys
 from uq.physics.scene import ALL_OUTPUTS
 from uq.pipeline.mountsection import (check_mount_settings, check_mounted_beams, tilt_of,
@@ -320,6 +321,8 @@ def _validate(raw, source, check=None):
         _records(check, raw, settings)               # optional: records in turbulence
     _check_time_resolved(check, settings)
     check_mount_settings(check, settings)
+    if "turbulence" in settings:
+        check_record_cost(check, settings)
     return settings
 
 
