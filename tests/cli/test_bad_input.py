@@ -1392,3 +1392,43 @@ def _(d):
     return check_and_run(scenario(d, with_good(motion={
         "spectrum": {"hs": 1.0, "tp": 0.02}, "response": {"heave": {"factor": 1.0}}})),
         "motion.spectrum.tp", "default band")
+
+
+# --- messages stay one bounded line, whatever the input echoes -----------------------
+@case("a key with a line break")
+def _(d):
+    # the key is echoed with its line break escaped (it split the message over two lines)
+    return check_and_run(scenario(d, 'name: tiny\nwind:\n  "spe\\ned": 5\n'), "wind.spe\\ned",
+                         "unknown key")
+
+
+@case("a --set key with a line break")
+def _(d):
+    path = scenario(d, GOOD)
+    return [(["check", str(path), "--set", "wind.sp\need=3"], ("--set", "wind.sp\\need",
+                                                               "unknown key"))]
+
+
+HARMONICS_257 = "[" + ", ".join(["{amplitude: 0.1, period: 5}"] * 257) + "]"
+
+
+@case("257 harmonics given by --set")
+def _(d):
+    # the value was echoed whole, over 103 lines; now shortened in its middle
+    path = scenario(d, GOOD)
+    return [(["check", str(path), "--set", f"motion.pitch={HARMONICS_257}"],
+             ("--set motion.pitch=[{amplitude: 0.1", "motion.pitch", "257 harmonics",
+              "allowed: 1 to 256"))]
+
+
+def test_a_message_echoes_a_bounded_part_of_the_input(tmp_path, capsys, monkeypatch):
+    """The 257 harmonics' message is one line of at most MAX_MESSAGE characters (it was
+    103 lines of ~7800 characters), and still names the file it was applied to."""
+    from uq.errors import MAX_MESSAGE
+    path = scenario(tmp_path, GOOD)
+    status, err = run_in_process(["check", str(path), "--set",
+                                  f"motion.pitch={HARMONICS_257}"], tmp_path, capsys,
+                                 monkeypatch)
+    assert status == 2
+    line, = err.strip().splitlines()
+    assert len(line) <= MAX_MESSAGE + len("uq: error: ") and str(path) in line, line

@@ -4,7 +4,7 @@ import argparse
 import logging
 import sys
 
-from uq.errors import ScenarioError
+from uq.errors import ScenarioError, one_line
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_INTERRUPTED = 130          # the shell's code for SIGINT
@@ -74,7 +74,7 @@ class _Formatter(logging.Formatter):
     def format(self, record):
         parts = record.name.split(".")
         prefix = f"uq {parts[1]}" if len(parts) > 1 and parts[1] in WINGS else "uq"
-        return f"{prefix}: {record.levelname.lower()}: {record.getMessage()}"
+        return f"{prefix}: {record.levelname.lower()}: {one_line(record.getMessage())}"
 
 
 WINGS = ("golden", "fit", "bench")

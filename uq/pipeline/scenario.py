@@ -26,7 +26,7 @@ from uq.constants import (COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, MANN_ANISOTROPY
 from uq.physics.correction import CORRECTION_MODELS
 from uq.physics.beams import beam_unit_vectors
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS, validate_error
-from uq.errors import ScenarioError
+from uq.errors import MAX_ECHO, ScenarioError, one_line
 from uq.pipeline.fitconfig import validate_fit
 from uq.pipeline.motionsection import (check_dwell, check_record, random_phase_count,
                                        validate_ins_timing, validate_lever_arm, validate_motion,
@@ -207,9 +207,11 @@ def _blame_override(error, overrides):
     it), with the file it was applied to; unchanged where no override set it."""
     for dotted, value in overrides.items():
         if error.key == dotted or error.key.startswith((dotted + ".", dotted + "[")):
-            text = yaml.safe_dump(value, default_flow_style=True).strip()
+            text = yaml.safe_dump(value, default_flow_style=True, width=math.inf).strip()
             text = text[:-4].strip() if text.endswith("...") else text
-            return ScenarioError(f"--set {dotted}={text} (applied to {error.source})",
+            return ScenarioError(f"--set {one_line(dotted, MAX_ECHO)}="
+                                 f"{one_line(text, MAX_ECHO)} (applied to "
+                                 f"{one_line(error.source, MAX_ECHO)})",
                                  error.key, error.problem)
     return error
 
