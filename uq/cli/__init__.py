@@ -86,17 +86,43 @@ def _command(argv):
         parser.print_help(sys.stderr)
         return EXIT_BAD_INPUT
     configure_logging(args)
+    if args.command in COMPILING:
+        _cache_notes()
     with _compile_notice(args):
         try:
             status = args.handler(args)
-        except Exception:
+        except Exception as error:
             # a stop that library code turned into another error (a C extension's
             # import fails with "ImportError: initialization failed" when Ctrl-C
             # lands in its initialisation) is the stop
             raise_if_stopped()
+            if isinstance(error, RuntimeError) and NO_CACHE_FOLDER in str(error):
+                return _no_cache_folder()
             raise
         raise_if_stopped()                   # a stop some library code swallowed
         return status
+
+
+#: numba's words when it has no folder to keep a compiled kernel in.
+NO_CACHE_FOLDER = "no locator available"
+
+
+def _cache_notes():
+    """Warn of what :func:`uq.numbacache.configure` settled for (a planted link)."""
+    import logging
+    from uq import numbacache
+    for note in numbacache.NOTES:
+        logging.getLogger("uq.numbacache").warning(note)
+
+
+def _no_cache_folder():
+    """One line, status 1: numba found no writable folder for its compiled kernels."""
+    import os
+    print("uq: error: numba has no writable folder to keep its compiled kernels in (the "
+          "package's, ~/.cache and the temporary folder are not writable, or not this "
+          f"user's); allowed: set NUMBA_CACHE_DIR to a writable folder (now "
+          f"{os.environ.get('NUMBA_CACHE_DIR') or 'unset'})", file=sys.stderr)
+    return EXIT_FAILURE
 
 
 @contextlib.contextmanager
