@@ -114,3 +114,24 @@ def test_clause_8_small_pitch_valid_large_pitch_not():
     shift = u**2 / 20.0 - 10.0 * np.deg2rad(np.array(broken))**2 / 4
     mean = ds["wind_speed_mc_mean"].values.ravel()[len(valid):] - 10.0
     np.testing.assert_allclose(mean, shift, atol=3e-3)   # 3 x u / sqrt(n) and 4th order
+
+
+@pytest.mark.parametrize("method", ["mc", "none"])
+def test_a_run_wholly_outside_the_domain_says_so_and_reports_nan(method, caplog):
+    """A nacelle lidar 3 m above the sea whose lower beam reaches 300 m ahead: its gate is
+    77 m below the surface, every trial's shear exponent is outside the power law. Its u
+    was 0.0 from the GUM (read as 'no uncertainty') and nothing was said; now every u is
+    NaN and one warning names the outputs."""
+    import logging
+    scenario = {**HELD_OUT, "lidar": {**HELD_OUT["lidar"], "height": 3.0, "ranges": [300.0]},
+                "sampling": {"n": 500, "seed": 1} if method == "mc" else {"method": "none"},
+                "outputs": ["wind_speed", "shear_exponent"]}
+    with caplog.at_level(logging.WARNING, logger="uq.pipeline.runner"):
+        ds = uq.run(uq.load_scenario(scenario))
+    for q in ("wind_speed", "shear_exponent"):
+        assert np.isnan(float(ds[f"{q}_gum_u"])), q
+        if method == "mc":
+            assert np.isnan(float(ds[f"{q}_mc_u"])) and int(ds[f"{q}_mc_n_invalid"]) == 500
+    said = [r.getMessage() for r in caplog.records if r.name == "uq.pipeline.runner"]
+    assert len(said) == 1 and said[0].startswith("wind_speed, shear_exponent: "), said
+    assert ("every Monte Carlo trial" if method == "mc" else "GUM value") in said[0]

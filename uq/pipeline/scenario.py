@@ -28,7 +28,8 @@ from uq.physics.beams import beam_unit_vectors
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS, validate_error
 from uq.errors import MAX_ECHO, ScenarioError, one_line
 from uq.pipeline.fitconfig import validate_fit
-from uq.pipeline.motionsection import (check_dwell, check_record, random_phase_count,
+from uq.pipeline.motionsection import (check_dwell, check_motion_reach, check_record,
+                                       random_phase_count,
                                        validate_ins_timing, validate_lever_arm, validate_motion,
                                        validate_scan)
 from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
@@ -204,16 +205,20 @@ def load_scenario(path_or_mapping, overrides=None):
 
 def _blame_override(error, overrides):
     """`error` as an error of the ``--set KEY=VALUE`` that set its key (or a key above
-    it), with the file it was applied to; unchanged where no override set it."""
-    for dotted, value in overrides.items():
-        if error.key == dotted or error.key.startswith((dotted + ".", dotted + "[")):
-            text = yaml.safe_dump(value, default_flow_style=True, width=math.inf).strip()
-            text = text[:-4].strip() if text.endswith("...") else text
-            return ScenarioError(f"--set {one_line(dotted, MAX_ECHO)}="
-                                 f"{one_line(text, MAX_ECHO)} (applied to "
-                                 f"{one_line(error.source, MAX_ECHO)})",
-                                 error.key, error.problem)
-    return error
+    it, or a key its problem names: the wave height of a spectrum whose motion is too
+    large), with the file it was applied to; unchanged where no override set one."""
+    named = [dotted for dotted in overrides if error.key == dotted or
+             error.key.startswith((dotted + ".", dotted + "["))]
+    named = named or [dotted for dotted in overrides
+                      if re.search(rf"(?<![\w.]){re.escape(dotted)}(?![\w])", error.problem)]
+    if not named:
+        return error
+    dotted, value = named[0], overrides[named[0]]
+    text = yaml.safe_dump(value, default_flow_style=True, width=math.inf).strip()
+    text = text[:-4].strip() if text.endswith("...") else text
+    return ScenarioError(f"--set {one_line(dotted, MAX_ECHO)}={one_line(text, MAX_ECHO)} "
+                         f"(applied to {one_line(error.source, MAX_ECHO)})", error.key,
+                         error.problem)
 
 
 #: Largest half-cone angle [deg] that is taken for a slip into radians (pi/2 rad is
@@ -444,6 +449,7 @@ def _check_time_resolved(check, settings):
     if RECORD_OUTPUTS[0] in settings["outputs"] and "turbulence" not in settings:
         check.fail("outputs", f"{RECORD_OUTPUTS[0]} needs a turbulence section; allowed: "
                    "the other outputs, or add turbulence: {model, intensity}")
+    check_motion_reach(check, settings)
     check_dwell(check, settings)
     lidar = settings["lidar"]
     check_record(settings, len(lidar["azimuths"]) + int(lidar["vertical_beam"]))
