@@ -7,7 +7,8 @@ import signal
 import sys
 from pathlib import Path
 
-from uq.cli.common import EXIT_OK, EXIT_TERMINATED, interrupted_status, parse_overrides, say
+from uq.cli.common import (EXIT_OK, EXIT_TERMINATED, add_overrides, interrupted_status,
+                           parse_overrides, say)
 from uq.cli.sidecompile import draws_records, side_compile
 from uq.errors import OutputError, ScenarioError
 
@@ -17,8 +18,7 @@ def add_parser(commands):
     run.add_argument("scenario", help="scenario YAML file, or the name of a shipped "
                      "scenario (e.g. rubio2022_case_i)")
     run.add_argument("-o", "--output", help="output file (default results/<name>.nc)")
-    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                     help="override a scenario value (dotted key, YAML value); repeatable")
+    add_overrides(run)
     run.add_argument("--resume", action="store_true",
                      help="continue an interrupted run: reuse the finished chunks kept in "
                      "OUT.nc.partial/ and compute only the missing scenes")

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from uq.constants import (COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, MANN_ANISOTROPY, MAX_BEAMS, MAX_CHUNK_SIZE,
+from uq.constants import (COVERAGE_PROBABILITY, DEFAULT_RECORDS, FULL_CIRCLE_DEG, MANN_ANISOTROPY, MAX_BEAMS, MAX_CHUNK_SIZE,
                           MAX_GATES, MAX_GROUPS, MAX_MAGNITUDE, MAX_SCENES, MAX_SEED)
 from uq.physics.correction import CORRECTION_MODELS
 from uq.physics.beams import beam_unit_vectors
@@ -141,8 +141,7 @@ class Scenario:
     def with_values(self, assignments):
         """A new scenario with ``{dotted: value}`` set and validated (sweep kept)."""
         raw = copy.deepcopy(self.settings)
-        for dotted, value in assignments.items():
-            assign_dotted(raw, dotted, value, self.source)
+        apply_overrides(raw, assignments, self.source)
         settings = _validate(raw, self.source)
         settings["sweep"] = copy.deepcopy(self.settings["sweep"])
         return Scenario(settings["name"], settings["description"], settings, self.sweep,
@@ -192,33 +191,39 @@ def load_scenario(path_or_mapping, overrides=None):
     if not isinstance(raw, dict):
         raise ScenarioError(source, "", "a scenario must be a mapping of the top-level keys "
                             f"{', '.join(DEFAULTS)}")
-    for dotted, value in (overrides or {}).items():
-        assign_dotted(raw, dotted, value, source)
+    apply_overrides(raw, overrides or {}, source)
     try:
         scenario = _build(raw, source)
     except ScenarioError as error:
-        raise _blame_override(error, overrides or {}) from None
+        raise blame_override(error, overrides or {}) from None
     for key, text in keys_without_effect(scenario.settings, dict(scenario.sweep)):
         log.warning("%s: %s: %s", source, key, text)
     return scenario
 
 
-def _blame_override(error, overrides):
+def blame_override(error, overrides):
     """`error` as an error of the ``--set KEY=VALUE`` that set its key (or a key above
     it, or a key its problem names: the wave height of a spectrum whose motion is too
     large), with the file it was applied to; unchanged where no override set one."""
     named = [dotted for dotted in overrides if error.key == dotted or
-             error.key.startswith((dotted + ".", dotted + "["))]
+             error.key.startswith((dotted + ".", dotted + "[")) or
+             (error.key and dotted.startswith(error.key + "."))]
     named = named or [dotted for dotted in overrides
                       if re.search(rf"(?<![\w.]){re.escape(dotted)}(?![\w])", error.problem)]
     if not named:
         return error
-    dotted, value = named[0], overrides[named[0]]
+    return ScenarioError(f"{override_text(named[0], overrides[named[0]])} (applied to "
+                         f"{one_line(error.source, MAX_ECHO)})", error.key, error.problem)
+
+
+def override_text(dotted, value):
+    """``--set KEY=VALUE`` (or ``--unset KEY`` for None) as a message echoes it: one
+    line, the value shortened."""
+    if value is None:
+        return f"--unset {one_line(dotted, MAX_ECHO)}"
     text = yaml.safe_dump(value, default_flow_style=True, width=math.inf).strip()
     text = text[:-4].strip() if text.endswith("...") else text
-    return ScenarioError(f"--set {one_line(dotted, MAX_ECHO)}={one_line(text, MAX_ECHO)} "
-                         f"(applied to {one_line(error.source, MAX_ECHO)})", error.key,
-                         error.problem)
+    return f"--set {one_line(dotted, MAX_ECHO)}={one_line(text, MAX_ECHO)}"
 
 
 #: Largest half-cone angle [deg] that is taken for a slip into radians (pi/2 rad is
@@ -256,6 +261,36 @@ def keys_without_effect(settings, sweep=None):
                       f"degrees; {lidar['half_cone']:g} rad would be "
                       f"{math.degrees(lidar['half_cone']):.1f} deg"))
     return found
+
+
+def apply_overrides(raw, overrides, source):
+    """Apply ``{dotted: value}`` (``--set``) to the mapping `raw` in order: a value of
+    None (``--set KEY=null`` or ``--unset KEY``) removes the key
+    (:func:`remove_dotted`), any other sets it (:func:`assign_dotted`)."""
+    for dotted, value in overrides.items():
+        if value is None:
+            remove_dotted(raw, dotted, source)
+        else:
+            assign_dotted(raw, dotted, value, source)
+
+
+def remove_dotted(raw, dotted, source):
+    """Remove the key 'a.b...' from `raw` (``--unset a.b``; ``sweep.<dotted key>``
+    removes that key's sweep): what the file says without it, its default where it has
+    one, else the validator's one line ("missing") for a required key. A key the
+    scenario does not set is refused (nothing to remove)."""
+    parts = dotted.split(".")
+    if parts[0] == "sweep" and len(parts) > 1:
+        parts = ["sweep", ".".join(parts[1:])]
+    node = raw
+    for part in parts[:-1]:
+        node = node.get(part) if isinstance(node, dict) else None
+    where = f"--unset {one_line(dotted, MAX_ECHO)} (applied to {one_line(source, MAX_ECHO)})"
+    if not isinstance(node, dict) or parts[-1] not in node:
+        present = ", ".join(map(str, node)) if isinstance(node, dict) and node else "none"
+        raise ScenarioError(where, dotted, "the scenario does not set it: nothing to remove; "
+                            f"allowed: a key it sets (here: {one_line(present, MAX_ECHO)})")
+    del node[parts[-1]]
 
 
 def assign_dotted(raw, dotted, value, source):
@@ -341,6 +376,12 @@ def _records(check, raw, settings):
                                                  settings["wind"]["reference_height"])
     settings["record"] = validate_record(check, raw.get("record") or {}, len(lidar["azimuths"])
                                          + int(lidar["vertical_beam"]), lidar)
+    count = settings["record"]["count"]
+    if settings["sampling"]["method"] == "none" and count != DEFAULT_RECORDS:
+        check.fail("record.count", f"{count} Monte Carlo records per scene, but "
+                   "sampling.method none draws none (the spectral path alone); allowed: "
+                   "leave record.count out (--unset record.count), or sampling.method mc, "
+                   "lhs or sobol")
 
 
 def _section(check, value, key, optional=()):
@@ -523,7 +564,29 @@ def _sampling(check, value):
     if out["stop_when_gum_valid"] and "digits" not in out:
         check.fail("sampling.stop_when_gum_valid", "needs adaptive sampling; allowed: with "
                    "sampling.digits, not sampling.n")
+    if out["method"] == "none":
+        _no_monte_carlo_keys(check, value)
     return out
+
+
+#: The keys of ``sampling`` that set the Monte Carlo trials, and their defaults (a
+#: validated scenario carries the defaults, which pass again): with ``method: none``
+#: there are no trials, and a key set otherwise would be ignored.
+MONTE_CARLO_DEFAULTS = {"n": DEFAULT_SAMPLES, "digits": None, "chunk_size": None,
+                        "control_variate": False, "interval": "symmetric",
+                        "stopping": "jcgm101", "stop_when_gum_valid": False}
+
+
+def _no_monte_carlo_keys(check, value):
+    """Refuse a Monte Carlo key of `value` (``sampling``) set with ``method: none``."""
+    for key, default in MONTE_CARLO_DEFAULTS.items():
+        if key in value and value[key] != default:
+            shown = str(value[key]).lower() if isinstance(value[key], bool) else value[key]
+            check.fail(f"sampling.{key}", f"{shown} sets the Monte Carlo trials, but "
+                       "sampling.method none draws none (the GUM and the paper's model "
+                       f"alone); allowed: leave sampling.{key} out (--unset sampling.{key}, "
+                       "or --set 'sampling={method: none}'), or sampling.method mc, lhs or "
+                       "sobol")
 
 
 def _outputs(check, value):
