@@ -213,7 +213,7 @@ def blame_override(error, overrides):
     if not named:
         return error
     return ScenarioError(f"{override_text(named[0], overrides[named[0]])} (applied to "
-                         f"{one_line(error.source, MAX_ECHO)})", error.key, error.problem)
+                         f"{error.source})", error.key, error.problem)
 
 
 def override_text(dotted, value):
@@ -285,7 +285,7 @@ def remove_dotted(raw, dotted, source):
     node = raw
     for part in parts[:-1]:
         node = node.get(part) if isinstance(node, dict) else None
-    where = f"--unset {one_line(dotted, MAX_ECHO)} (applied to {one_line(source, MAX_ECHO)})"
+    where = f"--unset {one_line(dotted, MAX_ECHO)} (applied to {source})"
     if not isinstance(node, dict) or parts[-1] not in node:
         present = ", ".join(map(str, node)) if isinstance(node, dict) and node else "none"
         raise ScenarioError(where, dotted, "the scenario does not set it: nothing to remove; "
