@@ -75,7 +75,8 @@ def command(args):
     load_kernels(args, scenario)
     before_run = compiling.seconds if compiling else 0.0     # compiled before the run
     new_folders = missing_folders(output.parent)
-    checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume).acquire()
+    checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume,
+                            notify=None if args.quiet else _note).acquire()
     beside = side_compile(args, scenario)
     if beside:
         say(args, "uq: compiling the model's kernels in a second process while the "
@@ -115,6 +116,11 @@ def command(args):
     say(args, summary_table(dataset, compile_s=compile_s))
     say(args, f"wrote {output}")
     return EXIT_OK
+
+
+def _note(text):
+    """A line about the run on stderr (``uq: ...``), beside its progress."""
+    print(f"uq: {text}", file=sys.stderr, flush=True)
 
 
 def load_kernels(args, scenario):

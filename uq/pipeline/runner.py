@@ -136,6 +136,8 @@ def _compute(scenario, plan, seed, progress, client, checkpoint, compiled,
     """Results of every chunk, by index: from the checkpoint, else computed."""
     results = checkpoint.load() if checkpoint else {}
     todo = [chunk for chunk in plan.chunks if chunk.index not in results]
+    if checkpoint:
+        checkpoint.resumed(len(results), len(plan.chunks))
     finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed, compiled,
                                         kernels_ready), None)
                 for chunk in todo) if client is None else \
