@@ -1,4 +1,5 @@
-"""``uq check SCENARIO``: validate a scenario or a golden-lidar configuration."""
+"""``uq check SCENARIO``: validate a scenario or a golden-lidar configuration; for a
+scenario, say the run's size and an estimate of its time (:mod:`uq.pipeline.estimate`)."""
 from uq.cli.common import EXIT_OK, add_overrides, parse_overrides, say
 
 
@@ -25,10 +26,10 @@ def command(args):
             f"{len(config.comparisons)} comparison(s)"
         say(args, f"{args.scenario}: ok (golden-lidar configuration {config.name}: {what})")
         return EXIT_OK
+    from uq.pipeline.estimate import run_size
     scenario = load_scenario(path, parse_overrides(args.set))
-    scenes = 1
-    for _, values in scenario.sweep:
-        scenes *= len(values)
-    say(args, f"{args.scenario}: ok ({scenario.name}: {scenes} scene(s), outputs "
-         f"{', '.join(scenario.outputs)})")
+    size = run_size(scenario)
+    say(args, f"{args.scenario}: ok ({scenario.name}: {size.describe()}; outputs "
+        f"{', '.join(scenario.outputs)})")
+    say(args, size.estimate())
     return EXIT_OK
