@@ -119,6 +119,10 @@ def _series(check, value):
     check.required(value, key, ("file", "columns"),
                    "a record needs its file and the columns of its degrees of freedom")
     path = check.text(value["file"], f"{key}.file")
+    check.limit(f"{key}.file", f"a CSV of at most {MAX_SERIES_ROWS:,} rows and "
+                f"{MAX_SERIES_BYTES >> 20} MiB; at least {MIN_SERIES_SAMPLES} samples, "
+                f"increasing and equally spaced (within {100 * SERIES_SPACING_TOLERANCE:g} %), "
+                f"at most {MAX_SERIES_STEP:g} s apart, lasting at least one scan")
     columns = value["columns"]
     check.mapping(columns, f"{key}.columns")
     check.keys(columns, f"{key}.columns", DEGREES_OF_FREEDOM)
@@ -266,6 +270,8 @@ def _harmonics(check, value, key, angular):
     """One harmonic ``{amplitude, period, phase}`` or a list of them for one degree of
     freedom (e.g. a floater's slow pitch and its wave-frequency pitch), each its own
     component with its own phase."""
+    check.limit("motion.<dof>.amplitude", f"a list of 1 to {MAX_WAVE_COMPONENTS} harmonics "
+                "per degree of freedom")
     if not isinstance(value, list):
         return _harmonic(check, value, key, angular)
     if not value or len(value) > MAX_WAVE_COMPONENTS:
@@ -343,6 +349,13 @@ def check_motion_reach(check, settings):
     static ``ship.pitch`` or ``ship.roll``) or :data:`MAX_TRANSLATION_AMPLITUDE_M`.
     Checked once here, before any work: 8 pitch harmonics of 45 deg each passed the
     bound of one harmonic, and a spectrum of hs 1e6 m overflowed at the run's start."""
+    reach = (f"the sum of a degree of freedom's amplitudes (its harmonics, a spectrum's "
+             f"components, a record's) at most {MAX_ANGULAR_AMPLITUDE_DEG:g} deg per rotation "
+             f"({MAX_ATTITUDE_DEG:g} with ship.pitch or ship.roll), "
+             f"{MAX_TRANSLATION_AMPLITUDE_M:g} m per translation")
+    for key in ("motion.<dof>.amplitude", "motion.response.<dof>.factor",
+                "motion.series.columns.<dof>"):
+        check.limit(key, reach)
     motion = settings.get("motion") or {}
     if not motion:
         return
@@ -437,6 +450,9 @@ def check_dwell(check, settings):
     """Refuse a dwell average whose quadrature would need more nodes than
     :data:`~uq.constants.MAX_DWELL_TOTAL_NODES` (:func:`uq.physics.timing.dwell_rule`),
     before anything is allocated: a dwell of more cycles of the motion than a lidar has."""
+    check.limit("lidar.scan.beam_duration", f"with dwell_average, at most "
+                f"{MAX_DWELL_TOTAL_NODES} quadrature nodes per dwell (a dwell of fewer cycles "
+                "of the motion)")
     scan = settings["lidar"].get("scan") or {}
     if not scan.get("dwell_average") or not is_time_resolved(settings):
         return

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from uq.constants import (COVERAGE_PROBABILITY, DEFAULT_RECORDS, FULL_CIRCLE_DEG, MANN_ANISOTROPY, MAX_BEAMS, MAX_CHUNK_SIZE,
+from uq.constants import (COVERAGE_PROBABILITY, DEFAULT_RECORDS, MAX_RECORD_SCANS, FULL_CIRCLE_DEG, MANN_ANISOTROPY, MAX_BEAMS, MAX_CHUNK_SIZE,
                           MAX_GATES, MAX_GROUPS, MAX_MAGNITUDE, MAX_SCENES, MAX_SEED)
 from uq.physics.correction import CORRECTION_MODELS
 from uq.physics.beams import beam_unit_vectors
@@ -374,6 +374,9 @@ def _records(check, raw, settings):
     lidar = settings["lidar"]
     settings["turbulence"] = validate_turbulence(check, raw["turbulence"],
                                                  settings["wind"]["reference_height"])
+    check.limit("record.duration", f"at least one scan and at most {MAX_RECORD_SCANS} scans "
+                "(of lidar.scan.beam_duration per beam)")
+    check.limit("record.count", "only with sampling.method mc, lhs or sobol")
     settings["record"] = validate_record(check, raw.get("record") or {}, len(lidar["azimuths"])
                                          + int(lidar["vertical_beam"]), lidar)
     count = settings["record"]["count"]
@@ -441,6 +444,9 @@ def _ins_error(check, spec, key):
 def _lidar(check, value):
     lid = _section(check, value, "lidar", OPTIONAL_LIDAR_KEYS)
     lid["azimuths"] = _azimuth_steps(check, lid["azimuths"])
+    check.limit("lidar.ranges", f"at most {MAX_GATES} gates, distinct")
+    check.limit("lidar.azimuths", f"at most {MAX_BEAMS} beams, distinct; with the vertical "
+                "beam they must determine the 3-D wind")
     check.length(lid["ranges"], "lidar.ranges", MAX_GATES)
     check.length(lid["azimuths"], "lidar.azimuths", MAX_BEAMS)
     out = {"height": check.number(lid["height"], "lidar.height", low=0.0),
@@ -564,6 +570,8 @@ def _sampling(check, value):
     if out["stop_when_gum_valid"] and "digits" not in out:
         check.fail("sampling.stop_when_gum_valid", "needs adaptive sampling; allowed: with "
                    "sampling.digits, not sampling.n")
+    for key in MONTE_CARLO_DEFAULTS:
+        check.limit(f"sampling.{key}", "not with sampling.method none")
     if out["method"] == "none":
         _no_monte_carlo_keys(check, value)
     return out
@@ -674,6 +682,12 @@ def _check_sweep_size(sweep, source):
                             "instead, which are evaluated as arrays)")
 
 
+def sweep_limits():
+    """The limits :func:`_check_sweep_size` enforces, in words (the scenario reference)."""
+    return (f"at most {MAX_SCENES:,} scenes (environment variable UQ_MAX_SCENES) and "
+            f"{MAX_GROUPS:,} combinations of structural keys (each its own model)")
+
+
 def max_scenes():
     """The most scenes a sweep may have: UQ_MAX_SCENES if set, else MAX_SCENES."""
     text = os.environ.get("UQ_MAX_SCENES", "")
@@ -740,6 +754,12 @@ class Checker:
 
     def fail(self, key, problem):
         raise ScenarioError(self.source, key, problem)
+
+    def limit(self, key, text):
+        """Declare a limit the validator enforces on `key` beyond its type and range (a
+        list's length, a file's size, a sum over keys), where it is enforced: nothing
+        here; the scenario reference lists it beside the key
+        (:class:`uq.pipeline.reference.RecordingChecker`)."""
 
     def keys(self, mapping, prefix, allowed):
         for key in mapping:
