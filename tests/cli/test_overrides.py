@@ -127,3 +127,14 @@ def test_record_count_with_method_none_is_refused(capsys):
     assert "record.count: 8 Monte Carlo records" in line and "--unset record.count" in line
     assert main(["check", "sathe2011_ti", "--set", "sampling={method: none}",
                  "--unset", "record.count"]) == 0
+
+
+@pytest.mark.parametrize("changes, key", [
+    ({"lidar": {"lever_arm": [0.0, 0.0, 2.0]}}, "lidar.lever_arm"),
+    ({"ins": {"correlation": "beam"}}, "ins.correlation")])
+def test_keys_without_effect_that_were_silent_are_refused(changes, key):
+    """A lever arm without motion (no rotation: the lidar moves as the INS) and readings
+    per beam without an INS error changed nothing and were accepted without a word."""
+    with pytest.raises(Exception) as refused:
+        load_scenario({"name": "x", **changes})
+    assert refused.value.key == key and "has no effect" in str(refused.value)
