@@ -119,14 +119,35 @@ def test_method_none_keeps_what_applies():
     assert load_scenario(scenario.settings).sampling["method"] == "none"
 
 
-def test_record_count_with_method_none_is_refused(capsys):
+def test_record_count_with_method_none_is_refused(tmp_path, capsys):
     """record.count asks for Monte Carlo records, which method none does not draw: it was
-    accepted and ignored."""
-    assert main(["check", "sathe2011_ti", "--set", "sampling={method: none}"]) == 2
+    accepted and ignored. Switching the Monte Carlo off from the command line drops the
+    file's own Monte Carlo keys (written for the method it replaces); one given with it
+    is refused."""
+    path = write(tmp_path, {"name": "r", "turbulence": {"intensity": 0.1},
+                            "record": {"count": 5}, "sampling": {"method": "none"}})
+    assert main(["check", str(path)]) == 2
     line = one_line(capsys)
-    assert "record.count: 8 Monte Carlo records" in line and "--unset record.count" in line
-    assert main(["check", "sathe2011_ti", "--set", "sampling={method: none}",
-                 "--unset", "record.count"]) == 0
+    assert "record.count: 5 Monte Carlo records" in line and "--unset record.count" in line
+    assert main(["check", str(path), "--unset", "record.count"]) == 0
+    assert main(["check", "sathe2011_ti", "--set", "sampling.method=none"]) == 0
+    capsys.readouterr()
+    assert main(["check", "sathe2011_ti", "--set", "sampling.method=none",
+                 "--set", "record.count=3"]) == 2
+    assert one_line(capsys).startswith("uq: error: --set record.count=3 (applied to ")
+
+
+def test_switching_monte_carlo_off_from_the_command_line_drops_the_files_keys():
+    """The documented GUM-only grid, --set sampling.method=none on a scenario with n and
+    a seed: the file's n is dropped (not refused), the seed kept; an n given with it is
+    refused."""
+    scenario = load_scenario({"sampling": {"n": 5000, "seed": 3, "interval": "shortest"}},
+                             {"sampling.method": "none"})
+    assert scenario.sampling["method"] == "none" and scenario.sampling["seed"] == 3
+    assert scenario.sampling["n"] == 100_000 and scenario.sampling["interval"] == "symmetric"
+    with pytest.raises(Exception, match="sampling.n"):
+        load_scenario({"sampling": {"n": 5000}}, {"sampling.method": "none",
+                                                  "sampling.n": 4000})
 
 
 @pytest.mark.parametrize("changes, key", [

@@ -14,7 +14,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def scenario(name, **changes):
     return uq.load_scenario(ROOT / "scenarios" / f"{name}.yaml",
-                            {"sampling": {"method": "none"}, **changes})
+                            {"sampling.method": "none", **changes})
 
 
 def test_velocity_ratio_on_a_hand_computed_grid():

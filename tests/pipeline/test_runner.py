@@ -249,7 +249,7 @@ def independent_gum(case, uncertainties, **scene):
 def beam_mode_scene(name, **values):
     """One scene of a shipped paper scenario with independent readings per beam, GUM only."""
     return uq.run(uq.load_scenario(ROOT / "scenarios" / f"{name}.yaml", {
-        "sweep": {}, "ins.correlation": "beam", "sampling": {"method": "none"}, **values}))
+        "sweep": {}, "ins.correlation": "beam", "sampling.method": "none", **values}))
 
 
 @pytest.mark.parametrize("direction", [0.0, 60.0, 135.0, 300.0])

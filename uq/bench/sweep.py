@@ -40,7 +40,7 @@ def gum_grid(step=1.0, model="compiled"):
     """The Fig. 2 grid, GUM only, with the measurement model `model` (``uq run
     --model``): (seconds, scenes)."""
     scenario = load_scenario(SCENARIO, {
-        "sampling": {"method": "none"},
+        "sampling.method": "none",
         "sweep.lidar.misalignment": {"start": -180, "stop": 180, "step": step},
         "sweep.wind.direction": {"start": 0, "stop": 360, "step": step}})
     seconds, dataset = _timed(lambda: run(scenario, model=model))

@@ -84,14 +84,14 @@ class RunSize:
     def describe(self):
         """The size in words: ``36 scenes x 100000 trials, 1 gate``."""
         low, high = self.trials
+        scenes = f"{self.scenes} scene{'s' * (self.scenes != 1)}"
         if high == 0:
-            trials = "no Monte Carlo (GUM only)"
+            trials = f"{scenes}, no Monte Carlo (GUM only)"
         elif low == high:
-            trials = f"{low} trials"
+            trials = f"{scenes} x {low} trials"
         else:
-            trials = f"{low}-{high} trials (adaptive)"
-        text = (f"{self.scenes} scene{'s' * (self.scenes != 1)} x {trials}, {self.gates} "
-                f"gate{'s' * (self.gates != 1)}, {self.beams} beams")
+            trials = f"{scenes} x {low}-{high} trials (adaptive)"
+        text = f"{trials}, {self.gates} gate{'s' * (self.gates != 1)}, {self.beams} beams"
         if self.records:
             text += f"; {self.scenes * self.records} records of {self.scans} scans"
         return text

@@ -192,6 +192,7 @@ def load_scenario(path_or_mapping, overrides=None):
         raise ScenarioError(source, "", "a scenario must be a mapping of the top-level keys "
                             f"{', '.join(DEFAULTS)}")
     apply_overrides(raw, overrides or {}, source)
+    _monte_carlo_switched_off(raw, overrides or {})
     try:
         scenario = _build(raw, source)
     except ScenarioError as error:
@@ -595,6 +596,26 @@ MONTE_CARLO_DEFAULTS = {"n": DEFAULT_SAMPLES, "digits": None, "chunk_size": None
                         "stopping": "jcgm101", "stop_when_gum_valid": False}
 
 
+def _monte_carlo_switched_off(raw, overrides):
+    """An override that sets ``sampling.method`` to none (``--set sampling.method=none``,
+    or a whole ``sampling`` section) switches the Monte Carlo off: the file's own Monte
+    Carlo keys (``sampling.n`` ..., ``record.count``) are dropped from `raw`, as the file
+    wrote them for the method the override replaced. One the overrides set themselves
+    stays, and is refused (:func:`_no_monte_carlo_keys`)."""
+    method = overrides.get("sampling.method", (overrides.get("sampling") or {}).get(
+        "method") if isinstance(overrides.get("sampling"), dict) else None)
+    if method != "none":
+        return
+    sampling, record = raw.get("sampling"), raw.get("record")
+    for key in MONTE_CARLO_DEFAULTS:
+        if isinstance(sampling, dict) and f"sampling.{key}" not in overrides and \
+                not (isinstance(overrides.get("sampling"), dict) and
+                     key in overrides["sampling"]):
+            sampling.pop(key, None)
+    if isinstance(record, dict) and "record.count" not in overrides:
+        record.pop("count", None)
+
+
 def _no_monte_carlo_keys(check, value):
     """Refuse a Monte Carlo key of `value` (``sampling``) set with ``method: none``."""
     for key, default in MONTE_CARLO_DEFAULTS.items():
@@ -602,9 +623,8 @@ def _no_monte_carlo_keys(check, value):
             shown = str(value[key]).lower() if isinstance(value[key], bool) else value[key]
             check.fail(f"sampling.{key}", f"{shown} sets the Monte Carlo trials, but "
                        "sampling.method none draws none (the GUM and the paper's model "
-                       f"alone); allowed: leave sampling.{key} out (--unset sampling.{key}, "
-                       "or --set 'sampling={method: none}'), or sampling.method mc, lhs or "
-                       "sobol")
+                       f"alone); allowed: leave sampling.{key} out (--unset sampling.{key}), "
+                       "or sampling.method mc, lhs or sobol")
 
 
 def _outputs(check, value):
