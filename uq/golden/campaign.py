@@ -50,7 +50,7 @@ def validate_synthetic(check, raw, scenarios=None):
     """Validated ``golden.synthetic`` settings (defaults filled in); `scenarios` the
     overrides of the lidars' scenarios by role (``uq golden --set unit:KEY=VALUE``),
     whose roles are kept in ``overridden``."""
-    from .config import load_lidar_scenario
+    from .overrides import load_lidar_scenario
     scenarios = scenarios or {}
     out = {**DEFAULTS, **raw}
     check.choice(out["truth"], "golden.synthetic.truth", ("brightwind",))

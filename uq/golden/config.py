@@ -17,6 +17,7 @@ from uq.errors import ScenarioError
 from uq.files import check_name
 from uq.pipeline.scenario import Checker
 from uq.pipeline.yamlfile import read_yaml
+from .overrides import SCENARIO_SEPARATOR, load_lidar_scenario, split_overrides
 
 TOP_KEYS = ("name", "description", "instruments", "comparisons", "smc", "classification",
             "bins", "kpi", "synthetic")
@@ -73,10 +74,6 @@ class GoldenConfig:
     ti_bands: dict = field(default_factory=dict)
 
 
-#: Separates the name of a scenario from its key in an override (``unit:lidar.height``).
-SCENARIO_SEPARATOR = ":"
-
-
 def load_golden_config(path, overrides=None):
     """Read and validate a ``uq golden`` configuration file.
 
@@ -106,19 +103,6 @@ def load_golden_config(path, overrides=None):
         raise blame_override(error, own) from None
 
 
-def split_overrides(overrides):
-    """(the configuration's own overrides, {scenario NAME: its overrides}) of ``--set``
-    keys, ``NAME:dotted`` naming a lidar's scenario."""
-    own, scenarios = {}, {}
-    for key, value in overrides.items():
-        name, separator, dotted = key.partition(SCENARIO_SEPARATOR)
-        if separator:
-            scenarios.setdefault(name, {})[dotted] = value
-        else:
-            own[key] = value
-    return own, scenarios
-
-
 def scenario_names(raw):
     """The names of the uq scenarios a ``golden`` mapping names: the roles of a synthetic
     campaign's lidars, else the instruments (and ``smc``) with a ``scenario``."""
@@ -138,25 +122,11 @@ def _known_scenarios(check, raw, scenarios):
     names = scenario_names(raw)
     for name, keys in scenarios.items():
         if name not in names:
-            check.fail(f"--set {name}{SCENARIO_SEPARATOR}{next(iter(keys))}", "no lidar scenario "
+            check.fail(f"--set {name}{SCENARIO_SEPARATOR}{next(iter(keys))}",
+                       "no lidar scenario "
                        f"named {name!r} in this configuration; allowed: "
                        f"{', '.join(names) or 'none (it names no scenario)'} before "
                        f"'{SCENARIO_SEPARATOR}'")
-
-
-def load_lidar_scenario(path, name, scenarios):
-    """The uq scenario at `path` of the lidar `name`, with its overrides from
-    `scenarios` (:func:`split_overrides`); an error of one names ``NAME:KEY``."""
-    from uq.pipeline.scenario import load_scenario
-    try:
-        return load_scenario(path, scenarios.get(name) or None)
-    except ScenarioError as error:
-        for prefix in ("--set ", "--unset "):
-            if error.source.startswith(prefix):
-                raise ScenarioError(f"{prefix}{name}{SCENARIO_SEPARATOR}"
-                                    f"{error.source[len(prefix):]}", error.key,
-                                    error.problem) from None
-        raise
 
 
 def validate_golden(raw, check, base, scenarios=None):

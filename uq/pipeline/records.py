@@ -632,7 +632,6 @@ def at_rest(settings):
     from uq.pipeline.scenario import load_scenario
     raw = {**copy.deepcopy(settings), "sweep": {}}       # (this scene alone)
     raw.pop("motion", None)
-    raw["lidar"].pop("lever_arm", None)                  # (no rotation: no effect)
     raw["correction"] = "full"
     for key in ("rate", "interpolation", "clock_offset"):
         raw.get("ins", {}).pop(key, None)

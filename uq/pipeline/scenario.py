@@ -497,12 +497,7 @@ def _check_time_resolved(check, settings):
     if RECORD_OUTPUTS[0] in settings["outputs"] and "turbulence" not in settings:
         check.fail("outputs", f"{RECORD_OUTPUTS[0]} needs a turbulence section; allowed: "
                    "the other outputs, or add turbulence: {model, intensity}")
-    check.limit("lidar.lever_arm", "only with a motion section")
     check.limit("ins.correlation", "beam only with an INS error")
-    if "lever_arm" in settings["lidar"] and not settings.get("motion"):
-        check.fail("lidar.lever_arm", "has no effect without a motion section (a platform "
-                   "that does not rotate moves the lidar as it moves the INS); allowed: add "
-                   "motion, or leave lidar.lever_arm out")
     if ins["correlation"] == "beam" and not any(key in ins for key in INS_KEYS):
         check.fail("ins.correlation", "beam (an independent INS reading per beam) has no "
                    f"effect without an INS error ({', '.join(f'ins.{k}' for k in INS_KEYS)}); "
