@@ -29,6 +29,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from uq.outputs import verdicts
+
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
 README = ROOT / "README.md"
@@ -100,13 +102,10 @@ def table_case_i(folder):
         lines.append(_row(label, f"{mean(ds, f'wind_speed_{model}'):.4f}",
                           f"{mean(ds, f'wind_direction_{model}'):.3f}"))
     ratio = mean(scan, "wind_speed_paper_u") / mean(scan, "wind_speed_gum_u")
-    valid = int(scan["wind_speed_gum_valid"].astype(bool).sum())
-    conclusive = int(scan["wind_speed_gum_validation_conclusive"].astype(bool).sum())
-    total = int(scan["wind_speed_gum_valid"].size)
     lines += ["", f"The paper's u(Vh) is {ratio:.3f} of the physical one with one INS reading "
-              f"per scan. Clause 8 validates the GUM interval of Vh in {valid} of the {total} "
-              f"directions; {conclusive} of the {total} verdicts are conclusive at this number "
-              "of trials."]
+              "per scan. Clause 8's verdicts on the GUM interval of Vh over the directions: "
+              f"{verdicts.counts_text(scan, 'wind_speed')} (undecided: this number of trials "
+              "cannot tell)."]
     return "\n".join(lines)
 
 
