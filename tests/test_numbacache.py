@@ -74,10 +74,53 @@ def test_a_planted_link_in_the_temporary_folder_is_not_followed(tmp_path, monkey
     (tmp_path / "elsewhere").mkdir()
     (tmp_path / "tmp" / f"uq-numba-{os.getuid()}").symlink_to(tmp_path / "elsewhere")
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    monkeypatch.setattr(numbacache, "NOTES", [])
+    environ = {"HOME": str(tmp_path / "home")}
+    chosen = Path(numbacache.configure(environ, read_only_package(tmp_path / "pkg")))
+    # not None (numba then failed with its "no locator available" traceback): a new
+    # owner-only folder of this process, beside the planted name, said in one note
+    assert chosen.parent == tmp_path / "tmp" and chosen.name.startswith(
+        f"uq-numba-{os.getuid()}-") and not chosen.is_symlink()
+    assert chosen.stat().st_mode & 0o777 == numbacache.PRIVATE_MODE
+    assert environ["NUMBA_CACHE_DIR"] == str(chosen)
+    assert len(numbacache.NOTES) == 1 and "NUMBA_CACHE_DIR" in numbacache.NOTES[0]
+    assert list((tmp_path / "elsewhere").iterdir()) == []
+
+
+def test_a_planted_link_and_no_temporary_folder_leave_the_choice_to_numba(tmp_path,
+                                                                           monkeypatch):
+    (tmp_path / "home").write_text("not a folder")
+    (tmp_path / "tmp").mkdir()
+    (tmp_path / "tmp" / f"uq-numba-{os.getuid()}").symlink_to(tmp_path / "elsewhere")
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    monkeypatch.setattr(tempfile, "mkdtemp", lambda **kw: (_ for _ in ()).throw(
+        PermissionError(13, "Permission denied")))
     environ = {"HOME": str(tmp_path / "home")}
     assert numbacache.configure(environ, read_only_package(tmp_path / "pkg")) is None
     assert "NUMBA_CACHE_DIR" not in environ
-    assert list((tmp_path / "elsewhere").iterdir()) == []
+
+
+def test_the_command_says_where_the_kernels_went_in_one_line(monkeypatch, capsys):
+    """The note of a planted link is one warning line of a compiling command; numba's
+    'no locator available' (no folder at all) is one error line, status 1, where it was
+    a traceback."""
+    import uq.cli.warmup
+    from uq.cli import main
+    monkeypatch.setattr(numbacache, "NOTES", ["/tmp/uq-numba-0 is not a folder of this "
+                                              "user"])
+    monkeypatch.setattr(uq.cli.warmup, "command", lambda args: 0)
+    assert main(["warmup"]) == 0
+    assert capsys.readouterr().err.splitlines() == [
+        "uq: warning: /tmp/uq-numba-0 is not a folder of this user"]
+
+    def no_locator(args):
+        raise RuntimeError("cannot cache function 'moments': no locator available for "
+                           "file '/opt/uq/engine/statkernels.py'")
+    monkeypatch.setattr(numbacache, "NOTES", [])
+    monkeypatch.setattr(uq.cli.warmup, "command", no_locator)
+    assert main(["warmup"]) == 1
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "NUMBA_CACHE_DIR" in err and "Traceback" not in err
 
 
 @pytest.fixture

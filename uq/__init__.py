@@ -14,8 +14,12 @@ all the base modules :mod:`uq.constants`, :mod:`uq.errors`, :mod:`uq.files`,
 """
 import importlib
 
-from uq import numbacache
-from uq._version import __version__
+from uq import interrupts
+
+interrupts.hold_while_starting()  # the command: a Ctrl-C while importing, one line (first)
+
+from uq import numbacache  # noqa: E402
+from uq._version import __version__  # noqa: E402
 
 numbacache.configure()          # before any kernel is compiled (a read-only install)
 

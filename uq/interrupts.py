@@ -82,6 +82,30 @@ def acknowledge():
     return number
 
 
+def hold(number, frame=None):
+    """Signal handler while the command is starting (:func:`hold_while_starting`): write
+    the stop down, raise nothing (an exception raised inside an import reaches the user
+    as a traceback); the command's ``main`` raises it once it can handle it."""
+    _pending["number"] = number
+
+
+def hold_while_starting(argv=None):
+    """When this process is the ``uq`` command (its console script, or ``python -m
+    uq.cli``), hold a Ctrl-C that lands while the package is imported (:func:`hold`)
+    instead of raising it inside an import, where it ends the process with a traceback;
+    ``uq.cli.main`` then exits 130 with one line. A program that imports uq keeps its own
+    handler. Returns whether the handler was installed. (A Ctrl-C before Python starts
+    importing uq, in its first tens of milliseconds, ends it as Python does.)"""
+    argv = list(getattr(sys, "orig_argv", None) or sys.argv) if argv is None else argv
+    command = any(os.path.basename(a) == "uq" for a in argv[1:2]) or \
+        any(a == "-m" and b in ("uq.cli", "uq") for a, b in zip(argv, argv[1:]))
+    if not command or threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        return False
+    signal.signal(signal.SIGINT, hold)
+    return True
+
+
 def _note(number):
     """Write the stop `number` down and start its watcher."""
     _pending["number"] = number
@@ -141,7 +165,7 @@ def stopping_on_signals():
         yield
         return
     numbers = [signal.SIGTERM]
-    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+    if signal.getsignal(signal.SIGINT) in (signal.default_int_handler, hold):
         numbers.append(signal.SIGINT)
     previous = {number: signal.signal(number, stop) for number in numbers}
     previous_hook = sys.unraisablehook

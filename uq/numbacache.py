@@ -14,12 +14,21 @@ Otherwise ``NUMBA_CACHE_DIR`` is set to the first writable per-user folder of:
 1. ``$XDG_CACHE_HOME/uq/numba`` (when ``XDG_CACHE_HOME`` is an absolute path);
 2. ``~/.cache/uq/numba`` (the platform's user cache folder on Linux);
 3. ``<temporary folder>/uq-numba-<uid>``, created owner-only (0700) and used only if it
-   is a folder (not a link) owned by the user.
+   is a folder (not a link) owned by the user;
+4. where that name is taken by something else (a link another user planted, a folder
+   they own), a new owner-only folder for this process alone
+   (``<temporary folder>/uq-numba-<uid>-XXXXXXXX``, removed at exit: the kernels are
+   compiled again by the next run), said in :data:`NOTES`.
+
+Where no folder is writable at all, numba refuses to compile ("no locator available"),
+which the command line reports in one line.
 
 The cache changes how fast a kernel loads, never what it computes. Only the standard
 library is imported (``import uq`` stays light).
 """
+import atexit
 import os
+import shutil
 import stat
 import sys
 import tempfile
@@ -32,6 +41,8 @@ CACHE_VARIABLE = "NUMBA_CACHE_DIR"
 KERNEL_PACKAGES = ("engine", "physics")
 #: Owner-only permissions of the shared temporary fallback folder.
 PRIVATE_MODE = 0o700
+#: What :func:`configure` had to settle for, in words (the command line warns of each).
+NOTES = []
 
 
 def configure(environ=None, package=None):
@@ -99,8 +110,22 @@ def _private_temporary():
     except OSError:
         return None
     if not stat.S_ISDIR(info.st_mode) or info.st_uid != os.getuid():
-        return None
+        return _process_folder(folder)
     return folder
+
+
+def _process_folder(taken):
+    """A new owner-only folder beside `taken` (a name someone else holds) for this
+    process alone, removed at exit; None if none can be made. Said in :data:`NOTES`."""
+    try:
+        folder = tempfile.mkdtemp(prefix=f"{taken.name}-", dir=taken.parent)
+    except OSError:
+        return None
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
+    NOTES.append(f"{taken} is not a folder of this user (a link, or another user's): "
+                 f"numba's compiled kernels are kept in {folder} for this run only (compiled "
+                 "again next time); set NUMBA_CACHE_DIR to a folder of yours to keep them")
+    return Path(folder)
 
 
 def _tell_numba(folder):

@@ -1210,6 +1210,84 @@ def snapshot(folder):
     return out
 
 
+@case("motion spectrum tp whose default band is beyond the motion limit")
+def _(d):
+    # tp 0.02 s: its default band 0.5/tp to 4/tp = [25, 200] Hz reaches past the 100 Hz
+    # of the shortest motion period (0.01 s); the problem is tp's, not the band's
+    return check_and_run(scenario(d, with_good(motion={
+        "spectrum": {"hs": 1.0, "tp": 0.02}, "response": {"heave": {"factor": 1.0}}})),
+        "motion.spectrum.tp", "default band")
+
+
+# --- messages stay one bounded line, whatever the input echoes -----------------------
+@case("a key with a line break")
+def _(d):
+    # the key is echoed with its line break escaped (it split the message over two lines)
+    return check_and_run(scenario(d, 'name: tiny\nwind:\n  "spe\\ned": 5\n'), "wind.spe\\ned",
+                         "unknown key")
+
+
+@case("a --set key with a line break")
+def _(d):
+    path = scenario(d, GOOD)
+    return [(["check", str(path), "--set", "wind.sp\need=3"], ("--set", "wind.sp\\need",
+                                                               "unknown key"))]
+
+
+HARMONICS_257 = "[" + ", ".join(["{amplitude: 0.1, period: 5}"] * 257) + "]"
+
+
+@case("257 harmonics given by --set")
+def _(d):
+    # the value was echoed whole, over 103 lines; now shortened in its middle
+    path = scenario(d, GOOD)
+    return [(["check", str(path), "--set", f"motion.pitch={HARMONICS_257}"],
+             ("--set motion.pitch=[{amplitude: 0.1", "motion.pitch", "257 harmonics",
+              "allowed: 1 to 256"))]
+
+
+@case("8 pitch harmonics of 45 deg each")
+def _(d):
+    # each within the bound of one harmonic; together 360 deg (all trials outside)
+    return check_and_run(scenario(d, with_good(motion={"pitch": [
+        {"amplitude": 45.0, "period": 5.0 + i} for i in range(8)]})), "motion.pitch",
+        "360 deg", "at most 45 deg")
+
+
+@case("a wave spectrum of hs 1e6 m")
+def _(d):
+    # an OverflowError in the dwell frequency at the run's start, dwell_average false
+    return check_and_run(scenario(d, with_good(motion={
+        "spectrum": {"hs": 1e6, "tp": 7.0}, "response": {"roll": {"factor": 4.0}}})),
+        "motion.response.roll.factor", "motion.spectrum.hs")
+
+
+@case("a response factor of 1e100")
+def _(d):
+    return check_and_run(scenario(d, with_good(motion={
+        "spectrum": {"hs": 2.0, "tp": 7.0}, "response": {"pitch": {"factor": 1e100}}})),
+        "motion.response.pitch.factor", "at most 45 deg")
+
+
+@case("record.count with sampling.method none")
+def _(d):
+    return check_and_run(scenario(d, {"name": "tiny", "turbulence": {"intensity": 0.1},
+                                      "record": {"count": 5}, "sampling": {"method": "none"}}),
+                         "record.count", "sampling.method none")
+
+
+@case("uq warmup --set without --for")
+def _(d):
+    return [(["warmup", "--set", "wind.speed=3"], ("--set", "wind.speed", "--for"))]
+
+
+@case("--unset of a key the scenario does not set")
+def _(d):
+    path = scenario(d, GOOD)
+    return [(["check", str(path), "--unset", "motion.surge"], ("--unset motion.surge",
+                                                               "nothing to remove"))]
+
+
 #: Seconds after which a case is taken to hang [s]: a guard that turns a regression (a
 #: FIFO opened blocking) into a failure instead of a stuck suite; no case is timed by it
 #: (each takes well under a second of work).
@@ -1385,10 +1463,14 @@ def test_every_input_kind_refuses_a_fifo_dev_zero_and_a_sparse_file_cheaply():
     assert report["peak"] < HOSTILE_MEMORY
 
 
-@case("motion spectrum tp whose default band is beyond the motion limit")
-def _(d):
-    # tp 0.02 s: its default band 0.5/tp to 4/tp = [25, 200] Hz reaches past the 100 Hz
-    # of the shortest motion period (0.01 s); the problem is tp's, not the band's
-    return check_and_run(scenario(d, with_good(motion={
-        "spectrum": {"hs": 1.0, "tp": 0.02}, "response": {"heave": {"factor": 1.0}}})),
-        "motion.spectrum.tp", "default band")
+def test_a_message_echoes_a_bounded_part_of_the_input(tmp_path, capsys, monkeypatch):
+    """The 257 harmonics' message is one line of at most MAX_MESSAGE characters (it was
+    103 lines of ~7800 characters), and still names the file it was applied to."""
+    from uq.errors import MAX_MESSAGE
+    path = scenario(tmp_path, GOOD)
+    status, err = run_in_process(["check", str(path), "--set",
+                                  f"motion.pitch={HARMONICS_257}"], tmp_path, capsys,
+                                 monkeypatch)
+    assert status == 2
+    line, = err.strip().splitlines()
+    assert len(line) <= MAX_MESSAGE + len("uq: error: ") and str(path) in line, line

@@ -154,3 +154,49 @@ def test_dask_is_silenced_before_the_stop_is_raised():
     finally:
         for name, level in levels.items():
             logging.getLogger(name).setLevel(level)
+
+
+#: A ``sitecustomize`` that sends this process Ctrl-C when the module named by
+#: UQ_TEST_INTERRUPT_AT is first imported: the interrupt lands at a chosen moment of the
+#: command's start, without timing it.
+INTERRUPT_AT_IMPORT = '''
+import os, signal, sys
+
+class InterruptAt:
+    def find_spec(self, name, path=None, target=None):
+        if name == os.environ["UQ_TEST_INTERRUPT_AT"]:
+            sys.meta_path.remove(self)
+            os.kill(os.getpid(), signal.SIGINT)
+        return None
+
+sys.meta_path.insert(0, InterruptAt())
+'''
+
+
+@pytest.mark.parametrize("module", [
+    "uq.numbacache", "uq._version", "uq.cli", "uq.cli.common", "argparse", "uq.cli.streams",
+    "uq.cli.run", "uq.cli.golden", "uq.cli.warmup", "uq.pipeline.shipped", "yaml"])
+def test_ctrl_c_while_the_command_starts_is_one_line_and_130(tmp_path, module):
+    """Ctrl-C while ``uq`` is importing its own modules (~0.05-0.1 s after the start):
+    it was a KeyboardInterrupt traceback and death by SIGINT; now the stop is held until
+    the command can handle it (:func:`uq.interrupts.hold_while_starting`). Only the
+    interpreter's own start and the import of uq.interrupts come before."""
+    (tmp_path / "hook").mkdir()
+    (tmp_path / "hook" / "sitecustomize.py").write_text(INTERRUPT_AT_IMPORT)
+    environment = {**os.environ, "UQ_TEST_INTERRUPT_AT": module,
+                   "PYTHONPATH": os.pathsep.join([str(tmp_path / "hook")] + [
+                       p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])}
+    done = subprocess.run([sys.executable, "-m", "uq.cli", "check", "rubio2022_case_i"],
+                          cwd=tmp_path, capture_output=True, text=True, env=environment,
+                          preexec_fn=as_from_a_terminal, timeout=600)
+    assert done.returncode == 130, (module, done.returncode, done.stderr)
+    assert done.stderr.strip().splitlines() == ["uq: interrupted"], done.stderr
+    assert done.stdout == ""
+
+
+def test_the_held_stop_only_for_the_command():
+    """A program that imports uq keeps Python's Ctrl-C (a KeyboardInterrupt where it
+    lands); the command's console script and ``python -m uq.cli`` hold it."""
+    from uq.interrupts import hold_while_starting
+    assert hold_while_starting(["python", "notebook.py"]) is False
+    assert signal.getsignal(signal.SIGINT) is not __import__("uq").interrupts.hold

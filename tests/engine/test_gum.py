@@ -39,3 +39,20 @@ def test_moments_that_overflow_are_reported(caplog):
     with caplog.at_level(logging.WARNING, logger="uq.engine.propagate"):
         ds = uq.propagate(lambda a: a * 1e200, {"a": st.norm(1, 1)}, n=2000, seed=1)
     assert not np.isfinite(ds["y_mc_u"]).any() and "overflowed" in caplog.text
+
+
+def test_outside_the_domain_at_the_means_the_gum_is_nan_not_zero():
+    """A model that is NaN at the input means (a power law of a negative height ratio,
+    the shear exponent of a gate below the sea surface) has no first-order GUM there: u
+    is NaN. The imaginary part of the complex step of a NaN read as 0, which gave u = 0,
+    a reading of 'no uncertainty'."""
+    def model(x, y):
+        valid = uq.complexstep.real_part(x) > 0
+        return np.where(valid, np.log(np.where(valid, x, 2.0)) * y, np.nan)
+    inputs = {"x": st.norm(-1.0, 0.1), "y": st.norm(1.0, 0.1)}
+    result = uq.propagate(model, inputs, n=1000, seed=1)
+    assert np.isnan(float(result["y_gum_u"])) and np.isnan(float(result["y_gum_value"]))
+    assert np.all(np.isnan(result["y_budget"].values))
+    assert np.isnan(float(result["y_mc_u"])) and int(result["y_mc_n_invalid"]) == 1000
+    inside = uq.propagate(model, {**inputs, "x": st.norm(1.0, 0.1)}, n=1000, seed=1)
+    assert float(inside["y_gum_u"]) == pytest.approx(0.1, rel=1e-9)  # d(y ln x)/dx = y/x

@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import xarray as xr
+import yaml
 
 from uq.cli import main
 from uq.golden.findings import reference_comparison
@@ -229,3 +230,46 @@ def test_turbulence_kpis_and_prediction(campaign):
     report = (folder / "report.md").read_text()
     assert "Turbulence intensity per bin" in report and "TI predicted [%]" in report
     assert "not a measurement, so no TI error is stated" in report
+
+
+def test_golden_set_changes_the_configuration_and_a_lidars_scenario(tmp_path, capsys):
+    """``uq golden --set`` (it had none: changing one number took copying three YAML
+    files): ``golden.KEY`` sets the configuration's keys, ``unit:KEY`` the unit's
+    scenario. Removing FLSa's height bias (-2.5 m, by --unset) removes its shear
+    sensitivity: its slope against shear is 0 within 4 standard errors of the
+    regression, where the shipped unit's is 100 ln(1 - 2.5/h) (the test above); FLSb,
+    untouched, keeps its -1 m. The changed scenario is written beside the data, as run."""
+    folder = tmp_path / "out"
+    assert main(["golden", str(CONFIG), "-o", str(folder), "-q",
+                 "--set", "golden.synthetic.verification=[2016-06-01, 2016-08-01]",
+                 "--set", "golden.bins.minimum_records=3",
+                 "--unset", "unit:lidar.errors.height.mean"]) == 0
+    ds = xr.open_dataset(folder / "golden_campaign.nc").load()
+    assert int(ds.attrs["minimum_records"]) == 3                  # 6 as shipped
+    for height in ds["height"].values:
+        unit = ds.sel(comparison="flsa-mast", height=height, variable="shear")
+        assert abs(float(unit["slope"])) < 4 * float(unit["slope_standard_error"]), height
+        golden = ds.sel(comparison="flsb-mast", height=height, variable="shear")
+        expected = 100 * np.log(1 - 1.0 / height)
+        assert abs(float(golden["slope"]) - expected) < 4 * float(golden["slope_standard_error"])
+    written = yaml.safe_load((folder / "data" / "unit.yaml").read_text())
+    assert written["lidar"]["errors"]["height"] == {"dist": "normal", "u": 0.2, "mean": 0.0}
+    assert written["name"] == "golden_flsa"
+    mast = pd.read_csv(folder / "data" / "mast.csv", index_col=0, parse_dates=True)
+    assert mast.index.max() < pd.Timestamp("2016-08-01")          # the period as set
+    assert not (folder / "data" / "golden.yaml").exists()         # FLSb's file as shipped
+
+
+def test_golden_set_refuses_what_it_cannot_apply(tmp_path, capsys):
+    config = str(CONFIG)
+    for args, words in [
+        (["--set", "flsx:lidar.height=3"], ("flsx", "allowed: unit, golden")),
+        (["--set", "unit:lidar.height=-3"], ("--set unit:lidar.height=-3", "lidar.height")),
+        (["--set", "bins.width=1"], ("--set bins.width=1", "unknown key")),
+        (["--unset", "golden.synthetic.lidars"], ("--unset golden.synthetic.lidars",))]:
+        assert main(["golden", config, "-o", str(tmp_path / "out"), *args]) == 2, args
+        line, = capsys.readouterr().err.strip().splitlines()
+        assert all(word in line for word in words), (words, line)
+        assert main(["check", config, *args]) == 2, args          # uq check takes them too
+        capsys.readouterr()
+    assert not (tmp_path / "out").exists()

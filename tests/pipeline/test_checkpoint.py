@@ -423,3 +423,27 @@ def test_a_record_mode_run_resumed_after_any_chunk_is_bit_identical(tmp_path, af
     resumed = run(scenario, checkpoint=Checkpoint(directory, resume=True))
     same(resumed, clean)
     assert "turbulence_intensity_spectral" in resumed and "turbulence_v_ratio" in resumed
+
+
+def test_resume_says_how_many_chunks_it_reused_and_how_many_remain(tmp_path,
+                                                                   one_scene_per_chunk,
+                                                                   capsys, monkeypatch):
+    """`uq run --resume` said nothing of what it reused. Three of the chunks were
+    finished before the stop; the resumed run says 3 reused and the rest to compute, on
+    stderr (nothing with --quiet); without a checkpoint, that all are to compute."""
+    path = tmp_path / "s.yaml"
+    path.write_text(one_scene_per_chunk.text)
+    directory = tmp_path / "out.nc.partial"
+    interrupted(one_scene_per_chunk, directory, after=3)
+    total = 8                                    # chunks (one_scene_per_chunk)
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", str(path), "-o", "out.nc", "--resume"]) == 0
+    err = capsys.readouterr().err
+    assert f"uq: resuming from out.nc.partial: 3 of {total} chunks reused, {total - 3} to " \
+        "compute" in err.splitlines(), err
+    assert main(["run", str(path), "-o", "other.nc", "--resume"]) == 0
+    assert (f"uq: --resume: no finished chunk in other.nc.partial; all {total} chunks to "
+            "compute") in capsys.readouterr().err.splitlines()
+    (tmp_path / "other.nc").unlink()
+    assert main(["run", str(path), "-o", "other.nc", "--resume", "-q"]) == 0
+    assert capsys.readouterr().err == ""

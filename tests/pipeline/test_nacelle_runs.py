@@ -147,3 +147,24 @@ def test_a_static_attitude_is_the_static_limit_of_the_motion_with_the_height_at_
                    "motion": {"pitch": {"amplitude": 3.0, "period": 1e6, "phase": 90}}})
     assert float((lowered["gate_height_nominal"] - static["gate_height_nominal"]).mean()) == \
         pytest.approx(drop, abs=1e-6)
+
+
+@pytest.mark.parametrize("method", ["mc", "none"])
+def test_a_run_wholly_outside_the_domain_says_so_and_reports_nan(method, caplog):
+    """A nacelle lidar 3 m above the sea whose lower beam reaches 300 m ahead: its gate is
+    77 m below the surface, every trial's shear exponent is outside the power law. Its u
+    was 0.0 from the GUM (read as 'no uncertainty') and nothing was said; now every u is
+    NaN and one warning names the outputs."""
+    import logging
+    scenario = {**HELD_OUT, "lidar": {**HELD_OUT["lidar"], "height": 3.0, "ranges": [300.0]},
+                "sampling": {"n": 500, "seed": 1} if method == "mc" else {"method": "none"},
+                "outputs": ["wind_speed", "shear_exponent"]}
+    with caplog.at_level(logging.WARNING, logger="uq.pipeline.runner"):
+        ds = uq.run(uq.load_scenario(scenario))
+    for q in ("wind_speed", "shear_exponent"):
+        assert np.isnan(float(ds[f"{q}_gum_u"])), q
+        if method == "mc":
+            assert np.isnan(float(ds[f"{q}_mc_u"])) and int(ds[f"{q}_mc_n_invalid"]) == 500
+    said = [r.getMessage() for r in caplog.records if r.name == "uq.pipeline.runner"]
+    assert len(said) == 1 and said[0].startswith("wind_speed, shear_exponent: "), said
+    assert ("every Monte Carlo trial" if method == "mc" else "GUM value") in said[0]

@@ -89,3 +89,79 @@ def test_every_key_without_required_is_optional():
     """What the reference calls optional is: the default scenario of the validator
     fills every key whose default is not **required** (an empty scenario is valid)."""
     assert load_scenario({}).settings["lidar"]["azimuths"] == DEFAULTS["lidar"]["azimuths"]
+
+
+# --- every limit the validator enforces is written beside its key ---------------------
+def documented_allowed():
+    """Row key -> the 'allowed' column of docs/scenario.md, as a user reads it."""
+    rows = {}
+    for line in (ROOT / "docs" / "scenario.md").read_text().splitlines():
+        cells = [cell.strip() for cell in line.strip("|").split("|")]
+        if len(cells) == 6 and cells[0].startswith("`"):
+            rows[cells[0].strip("`")] = cells[4]
+    return rows
+
+
+HARMONIC = {"amplitude": 1.0, "period": 8.0}
+
+
+def _limit_cases(tmp_path):
+    """(scenario mapping beyond one limit, the key its message names, the row of
+    docs/scenario.md, what that row must say)."""
+    from uq.constants import MAX_FIT_DRAWS, MAX_RECORD_SCANS, MAX_SERIES_ROWS
+    times = [0.5 * i for i in range(64)]
+    (tmp_path / "long.csv").write_text("time,roll\n" + "".join(f"{t},1\n" for t in times))
+    turbulent = {"turbulence": {"intensity": 0.1}}
+    return [
+        ({"lidar": {"ranges": [float(i + 1) for i in range(1001)]}}, "lidar.ranges",
+         "lidar.ranges", "at most 1000 gates"),
+        ({"lidar": {"azimuths": {"start": 0, "stop": 360, "step": 0.3}}}, "lidar.azimuths",
+         "lidar.azimuths", "at most 1000 beams"),
+        ({"motion": {"pitch": [HARMONIC] * 257}}, "motion.pitch", "motion.<dof>.amplitude",
+         "1 to 256 harmonics"),
+        ({"motion": {"pitch": [{**HARMONIC, "amplitude": 45.0}] * 8}}, "motion.pitch",
+         "motion.<dof>.amplitude", "at most 45 deg per rotation"),
+        ({"ship": {"pitch": 86.0}, "motion": {"pitch": [HARMONIC] * 4}}, "motion.pitch",
+         "motion.<dof>.amplitude", "89 with ship.pitch"),
+        ({"motion": {"heave": [{**HARMONIC, "amplitude": 600.0}] * 2}}, "motion.heave",
+         "motion.<dof>.amplitude", "1000 m per translation"),
+        ({"motion": {"spectrum": {"hs": 1e6, "tp": 7.0}, "response": {"roll": {"factor": 2}}}},
+         "motion.response.roll.factor", "motion.response.<dof>.factor", "45 deg"),
+        ({"motion": {"series": {"file": str(tmp_path / "long.csv"),
+                                "columns": {"roll": "roll"}}}},
+         "motion.series.file", "motion.series.file", f"{MAX_SERIES_ROWS:,} rows"),
+        ({**turbulent, "record": {"duration": 3600}, "lidar": {"scan": {"beam_duration":
+                                                                        0.0005}}},
+         "record.duration", "record.duration", f"at most {MAX_RECORD_SCANS} scans"),
+        ({**turbulent, "record": {"count": 5}, "sampling": {"method": "none"}}, "record.count",
+         "record.count", "only with sampling.method mc"),
+        ({"sampling": {"method": "none", "n": 1000}}, "sampling.n", "sampling.n",
+         "not with sampling.method none"),
+        ({"fit": {"walkers": 1024, "ensembles": 64, "max_steps": 1000}}, "fit.max_steps",
+         "fit.max_steps", f"at most {MAX_FIT_DRAWS:,}"),
+        ({"motion": {"roll": {**HARMONIC, "period": 0.05}}, "ins": {"rate": 10},
+          "lidar": {"scan": {"beam_duration": 100.0, "dwell_average": True}}},
+         "lidar.scan.beam_duration", "lidar.scan.beam_duration", "at most 512 quadrature"),
+        ({"lidar": {"probe": {"kind": "cw", "wavelength": 1.565, "beam_radius": 1.0,
+                              "truncation": 0.02}}},
+         "lidar.probe.beam_radius", "lidar.probe.beam_radius", "0.25 pi a^2 / lambda"),
+        ({"sweep": {"wind.direction": [float(i % 360) for i in range(4000)],
+                    "wind.speed": [float(i) for i in range(4000)]}}, "sweep", "sweep",
+         "at most 10,000,000 scenes"),
+    ]
+
+
+def test_every_enforced_limit_is_written_beside_its_key(tmp_path, monkeypatch):
+    """Each input beyond a limit is refused naming a key, and the row of that key in
+    docs/scenario.md states the limit (the 2,000,000 rows of a motion record were
+    enforced and documented nowhere). The motion record's row limit is lowered here to
+    refuse a small file; the row states the real one."""
+    from uq.errors import InputError
+    from uq.pipeline import motionsection
+    monkeypatch.setattr(motionsection, "MAX_SERIES_ROWS", 32)
+    allowed = documented_allowed()
+    for changes, key, row, said in _limit_cases(tmp_path):
+        with pytest.raises(InputError) as refused:
+            load_scenario({"name": "limits", **changes})
+        assert refused.value.key == key, (key, str(refused.value))
+        assert said in allowed[row], (row, said, allowed[row])

@@ -50,14 +50,24 @@ def test_every_command_that_takes_a_name_says_did_you_mean(argv, tmp_path, monke
     assert list(tmp_path.iterdir()) == []
 
 
-def test_uq_list_shows_every_shipped_scenario_on_one_line(capsys):
+@pytest.mark.parametrize("columns", [60, 100, 200])
+def test_uq_list_shows_every_whole_description_wrapped(columns, capsys, monkeypatch):
+    """Each scenario's name, then its whole description (it was cut at ~45 characters)
+    wrapped to the terminal's width (COLUMNS), continued under the description's column."""
+    monkeypatch.setenv("COLUMNS", str(columns))
     assert main(["list"]) == 0
     lines = capsys.readouterr().out.splitlines()
     names = shipped.shipped_names()
-    assert [line.split()[0] for line in lines] == names
-    for name, line in zip(names, lines):
+    starts = [i for i, line in enumerate(lines) if not line.startswith(" ")]
+    assert [lines[i].split()[0] for i in starts] == names
+    assert all(len(line) <= columns for line in lines)
+    width = max(map(len, names)) + 2
+    for name, start, stop in zip(names, starts, starts[1:] + [len(lines)]):
         description = shipped.describe(shipped.shipped_path(name))
-        assert description and line.split(None, 1)[1][:20] == description[:20]
+        shown = " ".join([lines[start][width:]] + [line[width:] for line in
+                                                   lines[start + 1:stop]])
+        assert description and shown.split() == description.split(), name
+        assert all(line[:width].isspace() for line in lines[start + 1:stop])
 
 
 def test_report_and_plot_find_a_run_by_its_name(tmp_path, monkeypatch, capsys):

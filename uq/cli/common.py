@@ -4,7 +4,7 @@ import argparse
 import logging
 import sys
 
-from uq.errors import ScenarioError
+from uq.errors import ScenarioError, one_line
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_INTERRUPTED = 130          # the shell's code for SIGINT
@@ -27,14 +27,37 @@ class Parser(argparse.ArgumentParser):
         self.exit(EXIT_BAD_INPUT, f"uq: error: {message}\n")
 
 
+def add_overrides(parser, what="a scenario value", example="KEY"):
+    """``--set KEY=VALUE`` and ``--unset KEY`` (both repeatable, applied in the order
+    given) into ``args.set``, read by :func:`parse_overrides`."""
+    parser.add_argument("--set", action="append", default=[], metavar=f"{example}=VALUE",
+                        help=f"override {what} (dotted key, YAML value); repeatable; "
+                        f"{example}=null removes the key, as --unset does")
+    parser.add_argument("--unset", action="append", dest="set", type=_unset,
+                        metavar=example, help="remove an optional key (what the file "
+                        "says without it: its default, or nothing); repeatable; a required "
+                        "key is refused")
+
+
+def _unset(key):
+    """``--unset KEY`` as the override ``KEY=null`` (:func:`parse_overrides`)."""
+    if "=" in key or not key.strip():
+        raise argparse.ArgumentTypeError(f"{key!r}: expected a dotted key alone (no =VALUE)")
+    return f"{key.strip()}=null"
+
+
 def parse_overrides(items, source="--set"):
-    """``['a.b=1', ...]`` -> ``{'a.b': 1}`` (values parsed as YAML)."""
+    """``['a.b=1', 'c=null', ...]`` -> ``{'a.b': 1, 'c': None}`` (values parsed as YAML;
+    None removes the key: ``--set c=null`` or ``--unset c``)."""
     import yaml
     overrides = {}
     for item in items:
         key, sep, text = item.partition("=")
         if not sep or not key.strip():
             raise ScenarioError(source, item, "expected KEY=VALUE with a dotted key")
+        if not text.strip():
+            raise ScenarioError(source, key, "no value after '='; allowed: a YAML value, or "
+                                f"--unset {key.strip()} to remove the key")
         try:
             overrides[key.strip()] = _number_or_value(yaml.safe_load(text))
         except yaml.YAMLError:
@@ -74,7 +97,7 @@ class _Formatter(logging.Formatter):
     def format(self, record):
         parts = record.name.split(".")
         prefix = f"uq {parts[1]}" if len(parts) > 1 and parts[1] in WINGS else "uq"
-        return f"{prefix}: {record.levelname.lower()}: {record.getMessage()}"
+        return f"{prefix}: {record.levelname.lower()}: {one_line(record.getMessage())}"
 
 
 WINGS = ("golden", "fit", "bench")

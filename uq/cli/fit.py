@@ -1,5 +1,5 @@
 """``uq fit RESULTS.nc | TABLE.csv [-c CONFIG] [-o OUT.nc] [--set fit.k=v]``."""
-from uq.cli.common import parse_overrides
+from uq.cli.common import add_overrides, parse_overrides
 
 
 def add_parser(commands):
@@ -12,8 +12,7 @@ def add_parser(commands):
                      "results' scenario's fit section, else the defaults)")
     fit.add_argument("-o", "--output", help="fit results (.nc; default beside the input, "
                      "<name>_fit.nc); figures beside it")
-    fit.add_argument("--set", action="append", default=[], metavar="fit.KEY=VALUE",
-                     help="override a fit setting (dotted key, YAML value); repeatable")
+    add_overrides(fit, "a fit setting", "fit.KEY")
     fit.set_defaults(handler=command)
     return fit
 

@@ -1,16 +1,20 @@
-"""``uq list``: the shipped scenarios, one line each (name and description)."""
+"""``uq list``: the shipped scenarios, each with its whole description, wrapped to the
+terminal's width."""
 import shutil
 
 from uq.cli.common import EXIT_OK, say
 
-#: Narrowest line a description is shortened to [characters] (a terminal that reports a
-#: smaller width, or none, still gets a readable line).
+#: Narrowest line the descriptions are wrapped to [characters] (a terminal that reports
+#: a smaller width still gets readable lines; the width is ``COLUMNS``, else the
+#: terminal's, else 80).
 MIN_WIDTH = 60
+#: Fewest characters of description beside a name, however long the names [characters].
+MIN_TEXT = 30
 
 
 def add_parser(commands):
-    listing = commands.add_parser("list", help="the shipped scenarios, one line each (name "
-                                  "and description); run one with 'uq run NAME'")
+    listing = commands.add_parser("list", help="the shipped scenarios with their "
+                                  "descriptions; run one with 'uq run NAME'")
     listing.set_defaults(handler=command)
     return listing
 
@@ -19,15 +23,18 @@ def command(args):
     from uq.pipeline.shipped import describe, shipped_names, shipped_path
     names = shipped_names()
     width = max(len(name) for name in names) + 2
-    say(args, "\n".join(scenario_line(name, describe(shipped_path(name)), width,
-                                      args.verbose) for name in names))
+    columns = max(MIN_WIDTH, shutil.get_terminal_size().columns)
+    say(args, "\n".join(scenario_lines(name, describe(shipped_path(name)), width, columns)
+                        for name in names))
     return EXIT_OK
 
 
-def scenario_line(name, description, width, verbose=0):
-    """``name  description`` on one line: the description shortened to the terminal's
-    width (its whole text with -v)."""
+def scenario_lines(name, description, width, columns):
+    """``name  description``: the whole description, wrapped into lines of at most
+    `columns` characters, those after the first indented by `width` (the names'
+    column); one line for an empty description."""
     import textwrap
-    room = max(MIN_WIDTH, shutil.get_terminal_size().columns) - width
-    text = description if verbose else textwrap.shorten(description, room, placeholder=" ...")
-    return f"{name:<{width}}{text}".rstrip()
+    room = max(MIN_TEXT, columns - width)
+    lines = textwrap.wrap(description, room, break_on_hyphens=False) or [""]
+    first = f"{name:<{width}}{lines[0]}".rstrip()
+    return "\n".join([first] + [" " * width + line for line in lines[1:]])

@@ -7,7 +7,8 @@ import signal
 import sys
 from pathlib import Path
 
-from uq.cli.common import EXIT_OK, EXIT_TERMINATED, interrupted_status, parse_overrides, say
+from uq.cli.common import (EXIT_OK, EXIT_TERMINATED, add_overrides, interrupted_status,
+                           parse_overrides, say)
 from uq.cli.sidecompile import draws_records, side_compile
 from uq.errors import OutputError, ScenarioError
 
@@ -17,8 +18,7 @@ def add_parser(commands):
     run.add_argument("scenario", help="scenario YAML file, or the name of a shipped "
                      "scenario (e.g. rubio2022_case_i)")
     run.add_argument("-o", "--output", help="output file (default results/<name>.nc)")
-    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                     help="override a scenario value (dotted key, YAML value); repeatable")
+    add_overrides(run)
     run.add_argument("--resume", action="store_true",
                      help="continue an interrupted run: reuse the finished chunks kept in "
                      "OUT.nc.partial/ and compute only the missing scenes")
@@ -75,7 +75,8 @@ def command(args):
     load_kernels(args, scenario)
     before_run = compiling.seconds if compiling else 0.0     # compiled before the run
     new_folders = missing_folders(output.parent)
-    checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume).acquire()
+    checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume,
+                            notify=None if args.quiet else _note).acquire()
     beside = side_compile(args, scenario)
     if beside:
         say(args, "uq: compiling the model's kernels in a second process while the "
@@ -115,6 +116,11 @@ def command(args):
     say(args, summary_table(dataset, compile_s=compile_s))
     say(args, f"wrote {output}")
     return EXIT_OK
+
+
+def _note(text):
+    """A line about the run on stderr (``uq: ...``), beside its progress."""
+    print(f"uq: {text}", file=sys.stderr, flush=True)
 
 
 def load_kernels(args, scenario):

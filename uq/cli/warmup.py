@@ -1,7 +1,7 @@
 """``uq warmup``: compile every numba kernel into the on-disk cache ahead of the first run
 (for people who build images or shared environments: run it once after the install, as
 the user whose cache the runs will read)."""
-from uq.cli.common import EXIT_OK, say
+from uq.cli.common import EXIT_OK, add_overrides, say
 
 
 def add_parser(commands):
@@ -12,8 +12,7 @@ def add_parser(commands):
                         help="compile only what a run of this scenario (YAML file or "
                         "shipped name) calls: its per-scan Monte Carlo, a few trials per "
                         "scene, results discarded (its turbulence records are left out)")
-    warmup.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                        help="with --for: override a scenario value, as in uq run")
+    add_overrides(warmup, "a value of the --for scenario, as in uq run (only with --for)")
     warmup.set_defaults(handler=command)
     return warmup
 
@@ -23,6 +22,12 @@ def command(args):
     and complex arithmetic, the time-resolved model's and the statistics' (or, with
     ``--for``, those a run of one scenario calls)."""
     import time
+    if getattr(args, "set", None) and not getattr(args, "scenario", None):
+        from uq.errors import ScenarioError
+        key = args.set[0].partition("=")[0]
+        raise ScenarioError("--set/--unset", key, "applies only to the scenario of --for "
+                            "(without it every kernel is compiled, no scenario is read); "
+                            "allowed: uq warmup --for SCENARIO --set KEY=VALUE, or no --set")
     started = time.perf_counter()
     if getattr(args, "scenario", None):
         compile_for(args.scenario, getattr(args, "set", []))

@@ -72,6 +72,9 @@ def complex_step_jacobian(model, input_set):
         value[q] = np.real(np.asarray(nominal[q])[0])
         scale = steps.reshape((k,) + (1,) * (out.ndim - 1))
         jacobian[q] = np.imag(out) / scale if np.iscomplexobj(out) else np.zeros(out.shape)
+        # outside the model's domain at the input means (f(x_mean) is NaN): no first-order
+        # GUM there (a NaN output's imaginary part reads as 0, which gave u = 0)
+        jacobian[q] = np.where(np.isfinite(value[q]), jacobian[q], np.nan)
     return value, jacobian
 
 

@@ -18,7 +18,7 @@ from uq.files import check_target, save_figure, write_netcdf
 from uq.pipeline.inputfile import read_csv
 from uq.pipeline.metadata import history
 from uq.pipeline.results import open_results
-from uq.pipeline.scenario import assign_dotted, load_fit_settings, read_yaml
+from uq.pipeline.scenario import apply_overrides, load_fit_settings, read_yaml
 
 #: What a fit configuration (-c) is, in messages about the file.
 FIT_CONFIG_KIND = "a YAML fit configuration"
@@ -90,10 +90,10 @@ def fit_settings(config_path, scenario, overrides):
     if not isinstance(raw, dict):
         raise ScenarioError(source, "fit", "allowed: a mapping of fit settings")
     raw = {"fit": dict(raw)}
-    for key, value in overrides.items():
+    for key in overrides:
         if not key.startswith("fit."):
             raise ScenarioError("--set", key, "allowed: fit.<key>=<value>")
-        assign_dotted(raw, key, value, "--set")
+    apply_overrides(raw, overrides, source)
     try:
         return load_fit_settings(raw["fit"], source)
     except ScenarioError as error:

@@ -152,8 +152,12 @@ def _turbulence(config, unit, reference, centres, scenario):
 
 @functools.lru_cache(maxsize=256)
 def _cached_ratio(source, text, height, speed):
+    """The ratio of the scenario as run (its `text`: ``uq golden --set`` may have changed
+    it from the file at `source`)."""
+    import yaml
     from uq.pipeline.scenario import load_scenario
-    return turbulence.predicted_variance_ratio(load_scenario(source).settings, height, speed)
+    settings = load_scenario(yaml.safe_load(text)).settings
+    return turbulence.predicted_variance_ratio(settings, height, speed)
 
 
 def _predicted_ratio(scenario, height, speed):

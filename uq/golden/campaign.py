@@ -46,8 +46,12 @@ DEFAULTS = {"truth": "brightwind", "verification": ["2016-06-01", "2016-09-01"],
             "seed": 1, "mast": {"calibration": {"absolute": 0.05, "relative": 0.005}}}
 
 
-def validate_synthetic(check, raw):
-    """Validated ``golden.synthetic`` settings (defaults filled in)."""
+def validate_synthetic(check, raw, scenarios=None):
+    """Validated ``golden.synthetic`` settings (defaults filled in); `scenarios` the
+    overrides of the lidars' scenarios by role (``uq golden --set unit:KEY=VALUE``),
+    whose roles are kept in ``overridden``."""
+    from .overrides import load_lidar_scenario
+    scenarios = scenarios or {}
     out = {**DEFAULTS, **raw}
     check.choice(out["truth"], "golden.synthetic.truth", ("brightwind",))
     for key in ("verification", "smc"):
@@ -69,9 +73,10 @@ def validate_synthetic(check, raw):
         check.fail("golden.synthetic.lidars", "allowed: {unit: SCENARIO.yaml, golden: "
                    "SCENARIO.yaml} (the unit under test and the golden lidar)")
     base = Path(check.source).parent
-    out["lidars"] = {role: load_scenario(base / check.text(path, f"golden.synthetic.lidars."
-                                                                 f"{role}"))
+    out["lidars"] = {role: load_lidar_scenario(base / check.text(
+        path, f"golden.synthetic.lidars.{role}"), role, scenarios)
                      for role, path in lidars.items()}
+    out["overridden"] = sorted(role for role in lidars if scenarios.get(role))
     return out
 
 
@@ -176,17 +181,24 @@ def generate_campaign(config, directory):
     for name, table in tables.items():
         table.to_csv(directory / f"{name}.csv", index_label="timestamp", float_format="%.5g")
     path = directory / "campaign.yaml"
-    path.write_text(yaml.safe_dump({"golden": _data_config(config)}, sort_keys=False))
+    path.write_text(yaml.safe_dump({"golden": _data_config(config, directory)},
+                                   sort_keys=False))
     return path
 
 
-def _scenario_path(settings, role):
+def _scenario_path(settings, role, directory=None):
     """The absolute path of a synthetic lidar's scenario (its geometry predicts the TI the
-    lidar reads, :mod:`uq.golden.turbulence`)."""
-    return str(Path(settings["lidars"][role].source).resolve())
+    lidar reads, :mod:`uq.golden.turbulence`); a scenario changed by ``--set`` is written
+    into `directory` as it was run (``<role>.yaml``) and named relative to it."""
+    scenario = settings["lidars"][role]
+    if role in settings.get("overridden", ()) and directory is not None:
+        path = Path(directory) / f"{role}.yaml"
+        path.write_text(scenario.text)
+        return path.name                     # beside campaign.yaml (the folder moves)
+    return str(Path(scenario.source).resolve())
 
 
-def _data_config(config):
+def _data_config(config, directory=None):
     settings = config.synthetic
     heights = {float(h): {"speed": f"speed_{h:g}", "direction": f"direction_{h:g}",
                           "environment": {"turbulence_intensity": f"ti_{h:g}"}}
@@ -198,9 +210,11 @@ def _data_config(config):
     return {"name": config.name, "description": config.description,
             "instruments": {"mast": mast,
                             "flsb": {"file": "flsb.csv", **common,
-                                     "scenario": _scenario_path(settings, "golden")},
+                                     "scenario": _scenario_path(settings, "golden",
+                                                                directory)},
                             "flsa": {"file": "flsa.csv", **common,
-                                     "scenario": _scenario_path(settings, "unit")}},
+                                     "scenario": _scenario_path(settings, "unit",
+                                                                directory)}},
             "comparisons": [{"unit": "flsb", "reference": "mast"},
                             {"unit": "flsa", "reference": "mast"},
                             {"unit": "flsa", "reference": "flsb"}],
@@ -211,4 +225,8 @@ def _data_config(config):
                                "route": config.route},
             "bins": {"width": config.bin_width, "required": list(config.required),
                      "minimum_records": config.minimum_records},
-            "kpi": {"availability": list(config.availability)}}
+            "kpi": {"availability": list(config.availability),
+                    **({"turbulence": {"variable": config.ti_variable,
+                                       "bands": {k: list(v) for k, v in
+                                                 config.ti_bands.items()}}}
+                       if config.ti_bands else {})}}

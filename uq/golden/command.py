@@ -38,11 +38,12 @@ KPI = ("speed_slope", "speed_r_squared", "speed_n_records", "speed_slope_verdict
        "availability_verdict", "coverage_verdict", "class_number")
 
 
-def run_golden(config_path, output=None, stream=None):
+def run_golden(config_path, output=None, stream=None, overrides=None):
     """Analyse the campaign of `config_path` and write the folder; returns its path.
-    The summary goes to `stream` (default stdout), warnings to the log (stderr)."""
+    The summary goes to `stream` (default stdout), warnings to the log (stderr);
+    `overrides` are ``uq golden --set`` (:func:`uq.golden.config.load_golden_config`)."""
     stream = stream or sys.stdout
-    config = load_golden_config(config_path)
+    config = load_golden_config(config_path, overrides)
     folder = Path(output) if output else Path("results") / config.name
     check_folder_target(folder)               # before any work
     partial = new_partial_folder(folder)

@@ -17,6 +17,7 @@ from uq.errors import ScenarioError
 from uq.files import check_name
 from uq.pipeline.scenario import Checker
 from uq.pipeline.yamlfile import read_yaml
+from .overrides import SCENARIO_SEPARATOR, load_lidar_scenario, split_overrides
 
 TOP_KEYS = ("name", "description", "instruments", "comparisons", "smc", "classification",
             "bins", "kpi", "synthetic")
@@ -73,20 +74,66 @@ class GoldenConfig:
     ti_bands: dict = field(default_factory=dict)
 
 
-def load_golden_config(path):
-    """Read and validate a ``uq golden`` configuration file."""
+def load_golden_config(path, overrides=None):
+    """Read and validate a ``uq golden`` configuration file.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    overrides : dict, optional
+        ``uq golden --set`` (:func:`split_overrides`): ``{dotted: value}`` of the
+        configuration's own keys (``golden.bins.width``), and ``{NAME:dotted: value}`` of
+        the uq scenario its lidar NAME names (``unit:lidar.height``; NAME is a role of
+        ``golden.synthetic.lidars``, or an instrument, or ``smc``, with a ``scenario``).
+        A value of None removes the key (``--unset``), as in ``uq run``.
+    """
+    from uq.pipeline.scenario import apply_overrides, blame_override
     path = Path(path)
     raw = read_yaml(path, kind="a YAML golden configuration")
     check = Checker(str(path))
     if not isinstance(raw, dict) or "golden" not in raw:
         check.fail("golden", "missing; allowed: a mapping under the top-level key 'golden'")
-    check.keys(raw, "", ("golden",))
-    return validate_golden(raw["golden"], check, path.parent)
+    own, scenarios = split_overrides(overrides or {})
+    apply_overrides(raw, own, str(path))
+    _known_scenarios(check, raw["golden"], scenarios)
+    try:
+        check.keys(raw, "", ("golden",))
+        return validate_golden(raw["golden"], check, path.parent, scenarios)
+    except ScenarioError as error:
+        raise blame_override(error, own) from None
 
 
-def validate_golden(raw, check, base):
+def scenario_names(raw):
+    """The names of the uq scenarios a ``golden`` mapping names: the roles of a synthetic
+    campaign's lidars, else the instruments (and ``smc``) with a ``scenario``."""
+    if not isinstance(raw, dict):
+        return []
+    if isinstance(raw.get("synthetic"), dict):
+        lidars = raw["synthetic"].get("lidars")
+        return list(lidars) if isinstance(lidars, dict) else []
+    named = {**(raw.get("instruments") if isinstance(raw.get("instruments"), dict) else {}),
+             "smc": raw.get("smc")}
+    return [name for name, spec in named.items() if isinstance(spec, dict) and
+            spec.get("scenario") is not None]
+
+
+def _known_scenarios(check, raw, scenarios):
+    """Refuse an override of a scenario the configuration does not name."""
+    names = scenario_names(raw)
+    for name, keys in scenarios.items():
+        if name not in names:
+            check.fail(f"--set {name}{SCENARIO_SEPARATOR}{next(iter(keys))}",
+                       "no lidar scenario "
+                       f"named {name!r} in this configuration; allowed: "
+                       f"{', '.join(names) or 'none (it names no scenario)'} before "
+                       f"'{SCENARIO_SEPARATOR}'")
+
+
+def validate_golden(raw, check, base, scenarios=None):
     """A :class:`GoldenConfig` from the ``golden`` mapping; relative files are read from
-    `base`."""
+    `base`; `scenarios` the overrides of its lidars' scenarios by name
+    (:func:`split_overrides`)."""
+    scenarios = scenarios or {}
     check.mapping(raw, "golden")
     check.keys(raw, "golden", TOP_KEYS)
     settings = {"name": check_name(raw.get("name", "golden"), check.source, "golden.name"),
@@ -101,24 +148,25 @@ def validate_golden(raw, check, base):
             if key in raw:
                 check.fail(f"golden.{key}", "not allowed with golden.synthetic (the synthetic "
                            "campaign generates its instruments); allowed: one of the two")
-        settings["synthetic"] = _synthetic(check, raw["synthetic"])
+        settings["synthetic"] = _synthetic(check, raw["synthetic"], scenarios)
         return GoldenConfig(**settings)
     for key in ("instruments", "comparisons"):
         if key not in raw:
             check.fail(f"golden.{key}", "missing; allowed: data files and comparisons, or a "
                        "'synthetic' section")
     check.mapping(raw["instruments"], "golden.instruments")
-    instruments = {name: _instrument(check, spec, f"golden.instruments.{name}", name, base)
+    instruments = {name: _instrument(check, spec, f"golden.instruments.{name}", name, base,
+                                     scenarios)
                    for name, spec in raw["instruments"].items()}
     settings["instruments"] = instruments
     settings["comparisons"] = _comparisons(check, raw["comparisons"], instruments)
     if "smc" in raw:
-        settings["smc"] = _instrument(check, raw["smc"], "golden.smc", "smc", base)
+        settings["smc"] = _instrument(check, raw["smc"], "golden.smc", "smc", base, scenarios)
     _references_are_calibrated(check, settings["comparisons"], instruments)
     return GoldenConfig(**settings)
 
 
-def _instrument(check, spec, key, name, base):
+def _instrument(check, spec, key, name, base, scenarios=None):
     check.mapping(spec, key)
     check.keys(spec, key, INSTRUMENT_KEYS)
     for needed in ("file", "heights"):
@@ -152,8 +200,8 @@ def _instrument(check, spec, key, name, base):
         class_number = check.number(class_number, f"{key}.class_number", low=0.0)
     scenario = None
     if spec.get("scenario") is not None:         # the lidar's uq scenario: predicted TI
-        from uq.pipeline.scenario import load_scenario
-        scenario = load_scenario(base / check.text(spec["scenario"], f"{key}.scenario"))
+        scenario = load_lidar_scenario(base / check.text(spec["scenario"], f"{key}.scenario"),
+                                       name, scenarios or {})
     return Instrument(name=name, file=base / check.text(spec["file"], f"{key}.file"),
                       scenario=scenario,
                       time=check.text(spec.get("time", "time"), f"{key}.time"),
@@ -285,11 +333,11 @@ def _turbulence(check, raw):
                                       f"{key}.variable"), "ti_bands": out}
 
 
-def _synthetic(check, raw):
+def _synthetic(check, raw, scenarios=None):
     from .campaign import validate_synthetic
     check.mapping(raw, "golden.synthetic")
     check.keys(raw, "golden.synthetic", SYNTHETIC_KEYS)
-    return validate_synthetic(check, raw)
+    return validate_synthetic(check, raw, scenarios or {})
 
 
 def fail(source, key, problem):

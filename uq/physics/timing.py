@@ -105,6 +105,12 @@ class DwellTooLong(ValueError):
                          f"{MAX_DWELL_TOTAL_NODES} (a phase span of {longest_span:.4g} rad)")
 
 
+#: Largest half sum of the angular amplitudes [rad] :func:`dwell_frequency` resolves: its
+#: order grows as ~e times it (27 000 terms at the bound); the scenario layer bounds the
+#: motion far below (a reach of 45 deg per rotation, 1.2 rad in all).
+MAX_DWELL_HALF_AMPLITUDE = 1e4
+
+
 def dwell_frequency(components, tolerance=DWELL_QUADRATURE_TOLERANCE):
     """Highest angular frequency [rad s-1] of the radial velocity over a dwell that the
     dwell average must resolve: the fastest component's w times the order M + 1.
@@ -127,14 +133,20 @@ def dwell_frequency(components, tolerance=DWELL_QUADRATURE_TOLERANCE):
     Returns
     -------
     float
-        [rad s-1]; 0 without motion.
+        [rad s-1]; 0 without motion; inf for angular amplitudes beyond
+        :data:`MAX_DWELL_HALF_AMPLITUDE` (no order resolves them).
     """
     fastest = max((c.angular_frequency for c in components), default=0.0)
     half = sum(abs(a) for c in components for a in c.amplitudes[:3]) / 2
-    order, term = 0, 1.0                        # term = half^(order+1) / (order+1)!
-    while half > 0:
-        term *= half / (order + 1)
-        if term * math.exp(half) <= tolerance:
+    if not half > 0:
+        return fastest
+    if not half <= MAX_DWELL_HALF_AMPLITUDE:
+        return math.inf                          # no order suffices (the caller refuses)
+    # log of the tail bound half^(M+1) / (M+1)! exp(half), no overflow at any amplitude
+    order, log_term, log_tolerance = 0, half, math.log(tolerance)
+    while True:
+        log_term += math.log(half) - math.log(order + 1)
+        if log_term <= log_tolerance:
             break
         order += 1
     return fastest * (order + 1)

@@ -54,11 +54,14 @@ class Checkpoint:
     directory : str or pathlib.Path
     resume : bool
         Reuse what a previous run of the same scenario left; otherwise start afresh.
+    notify : callable, optional
+        Called with one line of text: what a resumed run reused (:meth:`resumed`).
     """
 
-    def __init__(self, directory, resume=False):
+    def __init__(self, directory, resume=False, notify=None):
         self.directory = Path(directory)
         self.resume = resume
+        self.notify = notify
         self.digest = None
         self.inputs = ()
         self._lock = None
@@ -197,6 +200,18 @@ class Checkpoint:
                 continue
             chunks[int(match.group(1))] = dataset
         return chunks
+
+    def resumed(self, reused, total):
+        """Say (through `notify`, a callable of one line of text) how many of a resumed
+        run's `total` chunks were `reused` from the folder and how many remain."""
+        if not (self.resume and self.notify):
+            return
+        if reused:
+            self.notify(f"resuming from {self.directory}: {reused} of {total} chunks reused, "
+                        f"{total - reused} to compute")
+        else:
+            self.notify(f"--resume: no finished chunk in {self.directory}; all {total} "
+                        "chunks to compute")
 
     def _verify(self, path):
         """'' if the chunk's bytes match its recorded SHA-256, else what is wrong."""

@@ -81,6 +81,7 @@ def validate_fit(check, value):
                               high=MAX_ENSEMBLES)
     max_steps = check.integer(value.get("max_steps", 50_000), "fit.max_steps", low=100,
                               high=MAX_FIT_STEPS)
+    check.limit("fit.max_steps", f"walkers x ensembles x max_steps at most {MAX_FIT_DRAWS:,}")
     if walkers * ensembles * max_steps > MAX_FIT_DRAWS:
         check.fail("fit.max_steps", f"walkers x ensembles x max_steps = {walkers} x "
                    f"{ensembles} x {max_steps} draws; allowed: at most {MAX_FIT_DRAWS} (the "

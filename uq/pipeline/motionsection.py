@@ -77,9 +77,19 @@ SPECTRUM_BAND = (0.5, 4.0)
 SCAN_KEYS = ("beam_duration", "timestamp", "dwell_average")
 SCAN_DEFAULTS = {"beam_duration": 1.0, "timestamp": "mid", "dwell_average": False}
 ANGULAR_DOFS = ("roll", "pitch", "yaw")
-#: Largest motion amplitude [deg] (rotations) accepted: beyond it the platform capsizes
-#: in the model's Euler angles (the static tilt limit is 89 deg).
+#: Largest attitude the motion of a rotation may reach [deg]: the sum of the amplitudes
+#: of every component of roll, pitch or yaw (harmonics, a wave spectrum's components, a
+#: record's Fourier components), which their phases can line up to. Beyond it the
+#: platform capsizes in the model's Euler angles.
 MAX_ANGULAR_AMPLITUDE_DEG = 45.0
+#: Largest static tilt plus the motion's reach [deg] (the static limit, ``ship.pitch``
+#: and ``ship.roll``): at 90 deg the Euler angles of the marine convention are singular.
+MAX_ATTITUDE_DEG = 89.0
+#: Largest reach of a translation (surge, sway, heave) [m]: the sum of its components'
+#: amplitudes. A platform's wave-driven heave is at most half the largest wave heights
+#: recorded (~30 m) and its slow drift tens of metres on its moorings; 1000 m is beyond
+#: any, and keeps every velocity the model forms (w A) far from overflow.
+MAX_TRANSLATION_AMPLITUDE_M = 1000.0
 
 
 def validate_motion(check, value):
@@ -109,6 +119,10 @@ def _series(check, value):
     check.required(value, key, ("file", "columns"),
                    "a record needs its file and the columns of its degrees of freedom")
     path = check.text(value["file"], f"{key}.file")
+    check.limit(f"{key}.file", f"a CSV of at most {MAX_SERIES_ROWS:,} rows and "
+                f"{MAX_SERIES_BYTES >> 20} MiB; at least {MIN_SERIES_SAMPLES} samples, "
+                f"increasing and equally spaced (within {100 * SERIES_SPACING_TOLERANCE:g} %), "
+                f"at most {MAX_SERIES_STEP:g} s apart, lasting at least one scan")
     columns = value["columns"]
     check.mapping(columns, f"{key}.columns")
     check.keys(columns, f"{key}.columns", DEGREES_OF_FREEDOM)
@@ -256,6 +270,8 @@ def _harmonics(check, value, key, angular):
     """One harmonic ``{amplitude, period, phase}`` or a list of them for one degree of
     freedom (e.g. a floater's slow pitch and its wave-frequency pitch), each its own
     component with its own phase."""
+    check.limit("motion.<dof>.amplitude", f"a list of 1 to {MAX_WAVE_COMPONENTS} harmonics "
+                "per degree of freedom")
     if not isinstance(value, list):
         return _harmonic(check, value, key, angular)
     if not value or len(value) > MAX_WAVE_COMPONENTS:
@@ -324,6 +340,95 @@ def validate_ins_timing(check, value, out):
                                             INTERPOLATIONS)
 
 
+def check_motion_reach(check, settings):
+    """Refuse motion that can reach more than the model takes, degree of freedom by
+    degree of freedom: the sum of the amplitudes of all its components (harmonics, a wave
+    spectrum's components through their response factor, a record's Fourier
+    components), which their phases can line up to, against
+    :data:`MAX_ANGULAR_AMPLITUDE_DEG` (rotations; :data:`MAX_ATTITUDE_DEG` with the
+    static ``ship.pitch`` or ``ship.roll``) or :data:`MAX_TRANSLATION_AMPLITUDE_M`.
+    Checked once here, before any work: 8 pitch harmonics of 45 deg each passed the
+    bound of one harmonic, and a spectrum of hs 1e6 m overflowed at the run's start."""
+    reach = (f"the sum of a degree of freedom's amplitudes (its harmonics, a spectrum's "
+             f"components, a record's) at most {MAX_ANGULAR_AMPLITUDE_DEG:g} deg per rotation "
+             f"({MAX_ATTITUDE_DEG:g} with ship.pitch or ship.roll), "
+             f"{MAX_TRANSLATION_AMPLITUDE_M:g} m per translation")
+    for key in ("motion.<dof>.amplitude", "motion.response.<dof>.factor",
+                "motion.series.columns.<dof>"):
+        check.limit(key, reach)
+    motion = settings.get("motion") or {}
+    if not motion:
+        return
+    sources = _reach_by_source(motion)
+    for index, dof in enumerate(DEGREES_OF_FREEDOM):
+        parts = {key: reach[index] for key, reach in sources.items() if reach[index]}
+        total = sum(parts.values())
+        angular = dof in ANGULAR_DOFS
+        unit = "deg" if angular else "m"
+        static = abs(settings["ship"][dof]) if dof in ("pitch", "roll") else 0.0
+        limit = MAX_ANGULAR_AMPLITUDE_DEG if angular else MAX_TRANSLATION_AMPLITUDE_M
+        exceeded = not total <= limit                          # (NaN, inf: exceeded)
+        if not exceeded and not (angular and static + total > MAX_ATTITUDE_DEG):
+            continue
+        key = max(parts, key=lambda k: parts[k] if math.isfinite(parts[k]) else math.inf)
+        said = "; ".join(f"{_source(motion, k, dof)}: {v:.4g} {unit}" for k, v in
+                         parts.items())
+        reach = (f"the {dof} motion can reach {total:.4g} {unit}, the sum of its components' "
+                 f"amplitudes, which their phases can line up ({said})")
+        if exceeded:
+            check.fail(key, f"{reach}; allowed: at most {limit:g} {unit} of {dof} motion in "
+                       "all")
+        check.fail(key, f"{reach}, on top of ship.{dof} {settings['ship'][dof]:g} deg; "
+                   f"allowed: at most {MAX_ATTITUDE_DEG:g} deg of {dof} in all (the Euler "
+                   "angles are singular at 90)")
+
+
+def _source(motion, key, dof):
+    """Where the motion of `dof` that `key` names comes from, in words."""
+    if key.startswith("motion.response."):
+        factor = motion["response"][dof]["factor"]
+        return (f"motion.response.{dof}.factor {factor:g} per m of the waves of "
+                f"motion.spectrum.hs {motion['spectrum']['hs']:g} m")
+    if key.startswith("motion.series."):
+        return f"the record of {key}"
+    count = len(_listed(motion[dof]))
+    return f"{count} harmonic{'s' if count > 1 else ''} of {key}"
+
+
+def _reach_by_source(motion):
+    """Scenario key -> the sum of the amplitudes [deg or m] its components give each
+    degree of freedom (in the order of DEGREES_OF_FREEDOM)."""
+    sources = {}
+    for dof in DEGREES_OF_FREEDOM:
+        if dof in motion:
+            reach = [0.0] * len(DEGREES_OF_FREEDOM)
+            reach[DEGREES_OF_FREEDOM.index(dof)] = sum(one["amplitude"]
+                                                       for one in _listed(motion[dof]))
+            sources[f"motion.{dof}"] = reach
+    with np.errstate(all="ignore"):          # an overflow is an infinite reach, refused
+        for dof, reach in _summed(_wave_components(motion)).items():
+            sources[f"motion.response.{dof}.factor"] = reach
+        for dof, reach in _summed(series_motion(motion)[0]).items():
+            sources[f"motion.series.columns.{dof}"] = reach
+    return sources
+
+
+def _summed(components):
+    """dof -> the sum of |amplitude| of `components` [deg or m] in that degree of freedom
+    alone (in the order of DEGREES_OF_FREEDOM), for each one they move (the components
+    of a spectrum or a record move several)."""
+    if not components:
+        return {}
+    totals = np.sum(np.abs(np.array([c.amplitudes for c in components], dtype=float)), axis=0)
+    out = {}
+    for index, (dof, total) in enumerate(zip(DEGREES_OF_FREEDOM, totals)):
+        if total:
+            reach = [0.0] * len(DEGREES_OF_FREEDOM)
+            reach[index] = float(np.degrees(total) if dof in ANGULAR_DOFS else total)
+            out[dof] = reach
+    return out
+
+
 def check_record(settings, n_beams):
     """Refuse a motion record shorter than one scan (``n_beams`` beams of
     ``lidar.scan.beam_duration``): its Fourier series would repeat it within the scan."""
@@ -345,6 +450,9 @@ def check_dwell(check, settings):
     """Refuse a dwell average whose quadrature would need more nodes than
     :data:`~uq.constants.MAX_DWELL_TOTAL_NODES` (:func:`uq.physics.timing.dwell_rule`),
     before anything is allocated: a dwell of more cycles of the motion than a lidar has."""
+    check.limit("lidar.scan.beam_duration", f"with dwell_average, at most "
+                f"{MAX_DWELL_TOTAL_NODES} quadrature nodes per dwell (a dwell of fewer cycles "
+                "of the motion)")
     scan = settings["lidar"].get("scan") or {}
     if not scan.get("dwell_average") or not is_time_resolved(settings):
         return

@@ -65,6 +65,8 @@ def check_probe(check, lidar):
     error of a probe parameter needs the parameter; a CW focus must lie in the far field
     of the lens (:data:`MAX_FOCUS_FRACTION`)."""
     probe = lidar.get("probe", {})
+    check.limit("lidar.probe.beam_radius", f"a CW focus (the slant distance of the farthest "
+                f"gate) at most {MAX_FOCUS_FRACTION:g} pi a^2 / lambda")
     for name in PROBE_ERROR_KEYS:
         if name in lidar["errors"] and name not in probe:
             check.fail(f"lidar.errors.{name}", f"an error of a probe parameter that "

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from uq.constants import MAX_CONFIG_BYTES, MAX_CONFIG_DEPTH, MAX_CONFIG_NODES, MAX_MAGNITUDE
 from uq.physics import modelinputs
 from uq.physics.correction import CORRECTION_DESCRIPTIONS
 from uq.pipeline import scenario as scenario_module
@@ -137,7 +138,7 @@ MEANINGS = {
                 "needs turbulence)"),
     "motion.<dof>.amplitude": ("deg or m", "amplitude of a harmonic motion of a degree of "
                                "freedom, added to the static attitude: roll, pitch, yaw in "
-                               "deg (at most 45); surge, sway, heave in m"),
+                               "deg; surge, sway, heave in m"),
     "motion.<dof>.period": ("s", "period of the harmonic (a degree of freedom may also "
                             "take a list of harmonics, each {amplitude, period, phase})"),
     "motion.<dof>.phase": ("deg", "phase at the start of the scan (0: at the static "
@@ -278,6 +279,12 @@ class RecordingChecker(Checker):
         super().__init__(source)
         self.records, self._depth, self.overlay = {}, 0, {}
         self.required_keys = set()
+        self.limits = {}
+
+    def limit(self, key, text):
+        texts = self.limits.setdefault(key, [])
+        if text not in texts:
+            texts.append(text)
 
     def required(self, mapping, prefix, names, needs):
         self.required_keys.update(f"{prefix}.{name}" for name in names)
@@ -330,7 +337,8 @@ class RecordingChecker(Checker):
 def recorded_checks():
     """Dotted key -> (kind, value, limits) of every check the validator makes; the value
     is the default wherever the exemplar leaves the key unset, ``REQUIRED`` where the
-    validator requires the key in its section."""
+    validator requires the key in its section; `limits` holds under ``"more"`` the limits
+    the validator declares beyond type and range (:meth:`Checker.limit`)."""
     import tempfile
     with tempfile.TemporaryDirectory() as folder:
         record = Path(folder) / "record.csv"
@@ -349,8 +357,13 @@ def _recorded(series):
         scenario_module._validate(raw, checker.source, checker)
     required = checker.required_keys | {f"lidar.probe.{name}" for name in
                                         KIND_PARAMETERS["pulsed"] + KIND_PARAMETERS["cw"]}
-    return {key: (kind, REQUIRED if key in required else value, limits)
-            for key, (kind, value, limits) in checker.records.items()}
+    records = {key: (kind, REQUIRED if key in required else value, limits)
+               for key, (kind, value, limits) in checker.records.items()}
+    return {**records, MORE: checker.limits}
+
+
+#: The key of :func:`recorded_checks` that holds the declared limits, row key -> texts.
+MORE = "<limits>"
 
 
 #: The default of a key that must be given when its section is (see :func:`render`).
@@ -402,6 +415,8 @@ def meaning(key):
 
 def documented_keys(records):
     """The rows of the reference: error distributions collapsed to their key."""
+    records = dict(records)
+    more = records.pop(MORE, {})
     errors = {key.rpartition(".")[0] for key in records if key.endswith(".dist")
               and not key.startswith("fit.")}
     rows = {}
@@ -427,7 +442,12 @@ def documented_keys(records):
             value = _lookup(DEFAULTS, key) if _is_set(DEFAULTS, key) else None
         rows.setdefault(key, (kind, value, limits))
     rows["sweep"] = ("mapping", None, {})
-    return rows
+    more = {**more, "sweep": [scenario_module.sweep_limits()]}
+    unknown = set(more) - set(rows)
+    if unknown:
+        raise KeyError(f"limits declared for keys with no row: {sorted(unknown)}")
+    return {key: (kind, value, {**limits, "more": tuple(more.get(key, ()))})
+            for key, (kind, value, limits) in rows.items()}
 
 
 def _is_set(overlay, key):
@@ -439,6 +459,11 @@ def _is_set(overlay, key):
 
 
 def _allowed(kind, limits):
+    """The allowed column: the type's range or choices, then the declared limits."""
+    return "; ".join([_range_or_choices(kind, limits), *limits.get("more", ())])
+
+
+def _range_or_choices(kind, limits):
     if kind in ("choice", "list of choices"):
         return ", ".join(str(a) for a in limits["allowed"])
     if kind in ("angle", "list of angles"):
@@ -497,6 +522,12 @@ def render():
              "when its section is (for `lidar.probe`, when its `kind` uses it). Unknown "
              "keys are an error. Angles are in degrees, clockwise; wind direction is "
              "where the wind comes from.", "",
+             f"Every number is finite, of magnitude at most 10^{round(math.log10(MAX_MAGNITUDE))} "
+             "(`inf` in the allowed column stands for that bound). A scenario file is UTF-8 "
+             f"YAML of at most {MAX_CONFIG_BYTES / 2**20:g} MiB, nested at most {MAX_CONFIG_DEPTH} "
+             f"levels deep, of at most {MAX_CONFIG_NODES:,} values once its aliases are "
+             "expanded. `--set KEY=null` or `--unset KEY` removes an optional key from "
+             "the command line.", "",
              "| key | type | unit | default | allowed | meaning |",
              "|---|---|---|---|---|---|"]
     for key in sorted(rows, key=_order):

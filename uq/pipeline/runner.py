@@ -10,6 +10,7 @@ a number.
 """
 import contextlib
 import dataclasses
+import logging
 import time
 
 import numpy as np
@@ -38,6 +39,8 @@ from uq.engine.stopping import STOPPED_BY
 from uq.interrupts import raise_if_stopped
 from uq.pipeline.sweep import batch_scene, group_assignments, sweep_plan, vector_fields
 
+
+log = logging.getLogger(__name__)
 
 #: The values of ``uq run --model`` (and of :func:`run`'s `model`).
 MODEL_CHOICES = ("compiled", "numpy")
@@ -86,7 +89,46 @@ def run(scenario, progress=None, *, client=None, checkpoint=None, model="compile
                            model == "compiled", kernels_ready)
     dataset = _assemble(scenario, plan, results)
     dataset.attrs.update(_global_attributes(scenario, seed, dataset, started, model))
+    said = {}                                 # one line for the outputs said alike
+    for q, text in outside_domain(dataset, scenario.outputs):
+        said.setdefault(text, []).append(q)
+    for text, outputs in said.items():
+        log.warning("%s: %s", ", ".join(outputs), text)
     return dataset
+
+
+def outside_domain(dataset, outputs):
+    """What of each output fell outside the model's domain (non-finite), in words: the
+    scenes (and gates, beams) where every Monte Carlo trial did, whose mean, u and
+    interval are NaN; the trials left out elsewhere (``q_mc_n_invalid``); without Monte
+    Carlo, where the GUM value is NaN. A list of (output, text); empty where nothing
+    did."""
+    lines = []
+    for q in outputs:
+        if f"{q}_gum_value" not in dataset:
+            continue
+        value = dataset[f"{q}_gum_value"].values
+        total = value.size
+        if f"{q}_mc_n_invalid" not in dataset:
+            bad = int(np.sum(~np.isfinite(value)))
+            if bad:
+                lines.append((q, f"outside the model's domain at the input means in {bad} "
+                             f"of {total} scene(s) x gate(s): its GUM value and u there are "
+                             "NaN"))
+            continue
+        invalid = dataset[f"{q}_mc_n_invalid"].values
+        every = (invalid > 0) & ~np.isfinite(dataset[f"{q}_mc_mean"].values)
+        some = (invalid > 0) & ~every
+        if np.any(every):
+            lines.append((q, "every Monte Carlo trial fell outside the model's domain "
+                         f"(non-finite) in {int(np.sum(every))} of {total} scene(s) x "
+                         "gate(s): its mean, u and interval there are NaN, not an estimate"))
+        if np.any(some):
+            lines.append((q, f"{int(np.sum(invalid[some]))} Monte Carlo trials in "
+                         f"{int(np.sum(some))} of {total} scene(s) x gate(s) fell outside "
+                         f"the model's domain (non-finite) and are left out of its "
+                         f"statistics (<output>_mc_n_invalid)"))
+    return lines
 
 
 def _compute(scenario, plan, seed, progress, client, checkpoint, compiled,
@@ -94,6 +136,8 @@ def _compute(scenario, plan, seed, progress, client, checkpoint, compiled,
     """Results of every chunk, by index: from the checkpoint, else computed."""
     results = checkpoint.load() if checkpoint else {}
     todo = [chunk for chunk in plan.chunks if chunk.index not in results]
+    if checkpoint:
+        checkpoint.resumed(len(results), len(plan.chunks))
     finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed, compiled,
                                         kernels_ready), None)
                 for chunk in todo) if client is None else \

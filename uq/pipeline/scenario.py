@@ -21,14 +21,15 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from uq.constants import (COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, MANN_ANISOTROPY, MAX_BEAMS, MAX_CHUNK_SIZE,
+from uq.constants import (COVERAGE_PROBABILITY, DEFAULT_RECORDS, MAX_RECORD_SCANS, FULL_CIRCLE_DEG, MANN_ANISOTROPY, MAX_BEAMS, MAX_CHUNK_SIZE,
                           MAX_GATES, MAX_GROUPS, MAX_MAGNITUDE, MAX_SCENES, MAX_SEED)
 from uq.physics.correction import CORRECTION_MODELS
 from uq.physics.beams import beam_unit_vectors
 from uq.pipeline.distributions import ERROR_DISTRIBUTIONS, validate_error
-from uq.errors import ScenarioError
+from uq.errors import MAX_ECHO, ScenarioError, one_line
 from uq.pipeline.fitconfig import validate_fit
-from uq.pipeline.motionsection import (check_dwell, check_record, random_phase_count,
+from uq.pipeline.motionsection import (check_dwell, check_motion_reach, check_record,
+                                       random_phase_count,
                                        validate_ins_timing, validate_lever_arm, validate_motion,
                                        validate_scan)
 from uq.pipeline.probesection import PROBE_ERROR_KEYS, check_probe, validate_probe
@@ -141,8 +142,7 @@ class Scenario:
     def with_values(self, assignments):
         """A new scenario with ``{dotted: value}`` set and validated (sweep kept)."""
         raw = copy.deepcopy(self.settings)
-        for dotted, value in assignments.items():
-            assign_dotted(raw, dotted, value, self.source)
+        apply_overrides(raw, assignments, self.source)
         settings = _validate(raw, self.source)
         settings["sweep"] = copy.deepcopy(self.settings["sweep"])
         return Scenario(settings["name"], settings["description"], settings, self.sweep,
@@ -192,27 +192,40 @@ def load_scenario(path_or_mapping, overrides=None):
     if not isinstance(raw, dict):
         raise ScenarioError(source, "", "a scenario must be a mapping of the top-level keys "
                             f"{', '.join(DEFAULTS)}")
-    for dotted, value in (overrides or {}).items():
-        assign_dotted(raw, dotted, value, source)
+    apply_overrides(raw, overrides or {}, source)
+    _monte_carlo_switched_off(raw, overrides or {})
     try:
         scenario = _build(raw, source)
     except ScenarioError as error:
-        raise _blame_override(error, overrides or {}) from None
+        raise blame_override(error, overrides or {}) from None
     for key, text in keys_without_effect(scenario.settings, dict(scenario.sweep)):
         log.warning("%s: %s: %s", source, key, text)
     return scenario
 
 
-def _blame_override(error, overrides):
+def blame_override(error, overrides):
     """`error` as an error of the ``--set KEY=VALUE`` that set its key (or a key above
-    it), with the file it was applied to; unchanged where no override set it."""
-    for dotted, value in overrides.items():
-        if error.key == dotted or error.key.startswith((dotted + ".", dotted + "[")):
-            text = yaml.safe_dump(value, default_flow_style=True).strip()
-            text = text[:-4].strip() if text.endswith("...") else text
-            return ScenarioError(f"--set {dotted}={text} (applied to {error.source})",
-                                 error.key, error.problem)
-    return error
+    it, or a key its problem names: the wave height of a spectrum whose motion is too
+    large), with the file it was applied to; unchanged where no override set one."""
+    named = [dotted for dotted in overrides if error.key == dotted or
+             error.key.startswith((dotted + ".", dotted + "[")) or
+             (error.key and dotted.startswith(error.key + "."))]
+    named = named or [dotted for dotted in overrides
+                      if re.search(rf"(?<![\w.]){re.escape(dotted)}(?![\w])", error.problem)]
+    if not named:
+        return error
+    return ScenarioError(f"{override_text(named[0], overrides[named[0]])} (applied to "
+                         f"{error.source})", error.key, error.problem)
+
+
+def override_text(dotted, value):
+    """``--set KEY=VALUE`` (or ``--unset KEY`` for None) as a message echoes it: one
+    line, the value shortened."""
+    if value is None:
+        return f"--unset {one_line(dotted, MAX_ECHO)}"
+    text = yaml.safe_dump(value, default_flow_style=True, width=math.inf).strip()
+    text = text[:-4].strip() if text.endswith("...") else text
+    return f"--set {one_line(dotted, MAX_ECHO)}={one_line(text, MAX_ECHO)}"
 
 
 #: Largest half-cone angle [deg] that is taken for a slip into radians (pi/2 rad is
@@ -250,6 +263,36 @@ def keys_without_effect(settings, sweep=None):
                       f"degrees; {lidar['half_cone']:g} rad would be "
                       f"{math.degrees(lidar['half_cone']):.1f} deg"))
     return found
+
+
+def apply_overrides(raw, overrides, source):
+    """Apply ``{dotted: value}`` (``--set``) to the mapping `raw` in order: a value of
+    None (``--set KEY=null`` or ``--unset KEY``) removes the key
+    (:func:`remove_dotted`), any other sets it (:func:`assign_dotted`)."""
+    for dotted, value in overrides.items():
+        if value is None:
+            remove_dotted(raw, dotted, source)
+        else:
+            assign_dotted(raw, dotted, value, source)
+
+
+def remove_dotted(raw, dotted, source):
+    """Remove the key 'a.b...' from `raw` (``--unset a.b``; ``sweep.<dotted key>``
+    removes that key's sweep): what the file says without it, its default where it has
+    one, else the validator's one line ("missing") for a required key. A key the
+    scenario does not set is refused (nothing to remove)."""
+    parts = dotted.split(".")
+    if parts[0] == "sweep" and len(parts) > 1:
+        parts = ["sweep", ".".join(parts[1:])]
+    node = raw
+    for part in parts[:-1]:
+        node = node.get(part) if isinstance(node, dict) else None
+    where = f"--unset {one_line(dotted, MAX_ECHO)} (applied to {source})"
+    if not isinstance(node, dict) or parts[-1] not in node:
+        present = ", ".join(map(str, node)) if isinstance(node, dict) and node else "none"
+        raise ScenarioError(where, dotted, "the scenario does not set it: nothing to remove; "
+                            f"allowed: a key it sets (here: {one_line(present, MAX_ECHO)})")
+    del node[parts[-1]]
 
 
 def assign_dotted(raw, dotted, value, source):
@@ -335,8 +378,17 @@ def _records(check, raw, settings):
     lidar = settings["lidar"]
     settings["turbulence"] = validate_turbulence(check, raw["turbulence"],
                                                  settings["wind"]["reference_height"])
+    check.limit("record.duration", f"at least one scan and at most {MAX_RECORD_SCANS} scans "
+                "(of lidar.scan.beam_duration per beam)")
+    check.limit("record.count", "only with sampling.method mc, lhs or sobol")
     settings["record"] = validate_record(check, raw.get("record") or {}, len(lidar["azimuths"])
                                          + int(lidar["vertical_beam"]), lidar)
+    count = settings["record"]["count"]
+    if settings["sampling"]["method"] == "none" and count != DEFAULT_RECORDS:
+        check.fail("record.count", f"{count} Monte Carlo records per scene, but "
+                   "sampling.method none draws none (the spectral path alone); allowed: "
+                   "leave record.count out (--unset record.count), or sampling.method mc, "
+                   "lhs or sobol")
 
 
 def _section(check, value, key, optional=()):
@@ -396,6 +448,9 @@ def _ins_error(check, spec, key):
 def _lidar(check, value):
     lid = _section(check, value, "lidar", OPTIONAL_LIDAR_KEYS)
     lid["azimuths"] = _azimuth_steps(check, lid["azimuths"])
+    check.limit("lidar.ranges", f"at most {MAX_GATES} gates, distinct")
+    check.limit("lidar.azimuths", f"at most {MAX_BEAMS} beams, distinct; with the vertical "
+                "beam they must determine the 3-D wind")
     check.length(lid["ranges"], "lidar.ranges", MAX_GATES)
     check.length(lid["azimuths"], "lidar.azimuths", MAX_BEAMS)
     out = {"height": check.number(lid["height"], "lidar.height", low=0.0),
@@ -445,6 +500,12 @@ def _check_time_resolved(check, settings):
     if RECORD_OUTPUTS[0] in settings["outputs"] and "turbulence" not in settings:
         check.fail("outputs", f"{RECORD_OUTPUTS[0]} needs a turbulence section; allowed: "
                    "the other outputs, or add turbulence: {model, intensity}")
+    check.limit("ins.correlation", "beam only with an INS error")
+    if ins["correlation"] == "beam" and not any(key in ins for key in INS_KEYS):
+        check.fail("ins.correlation", "beam (an independent INS reading per beam) has no "
+                   f"effect without an INS error ({', '.join(f'ins.{k}' for k in INS_KEYS)}); "
+                   "allowed: scan, or give an INS error")
+    check_motion_reach(check, settings)
     check_dwell(check, settings)
     lidar = settings["lidar"]
     check_record(settings, len(lidar["azimuths"]) + int(lidar["vertical_beam"]))
@@ -518,7 +579,50 @@ def _sampling(check, value):
     if out["stop_when_gum_valid"] and "digits" not in out:
         check.fail("sampling.stop_when_gum_valid", "needs adaptive sampling; allowed: with "
                    "sampling.digits, not sampling.n")
+    for key in MONTE_CARLO_DEFAULTS:
+        check.limit(f"sampling.{key}", "not with sampling.method none")
+    if out["method"] == "none":
+        _no_monte_carlo_keys(check, value)
     return out
+
+
+#: The keys of ``sampling`` that set the Monte Carlo trials, and their defaults (a
+#: validated scenario carries the defaults, which pass again): with ``method: none``
+#: there are no trials, and a key set otherwise would be ignored.
+MONTE_CARLO_DEFAULTS = {"n": DEFAULT_SAMPLES, "digits": None, "chunk_size": None,
+                        "control_variate": False, "interval": "symmetric",
+                        "stopping": "jcgm101", "stop_when_gum_valid": False}
+
+
+def _monte_carlo_switched_off(raw, overrides):
+    """An override that sets ``sampling.method`` to none (``--set sampling.method=none``,
+    or a whole ``sampling`` section) switches the Monte Carlo off: the file's own Monte
+    Carlo keys (``sampling.n`` ..., ``record.count``) are dropped from `raw`, as the file
+    wrote them for the method the override replaced. One the overrides set themselves
+    stays, and is refused (:func:`_no_monte_carlo_keys`)."""
+    method = overrides.get("sampling.method", (overrides.get("sampling") or {}).get(
+        "method") if isinstance(overrides.get("sampling"), dict) else None)
+    if method != "none":
+        return
+    sampling, record = raw.get("sampling"), raw.get("record")
+    for key in MONTE_CARLO_DEFAULTS:
+        if isinstance(sampling, dict) and f"sampling.{key}" not in overrides and \
+                not (isinstance(overrides.get("sampling"), dict) and
+                     key in overrides["sampling"]):
+            sampling.pop(key, None)
+    if isinstance(record, dict) and "record.count" not in overrides:
+        record.pop("count", None)
+
+
+def _no_monte_carlo_keys(check, value):
+    """Refuse a Monte Carlo key of `value` (``sampling``) set with ``method: none``."""
+    for key, default in MONTE_CARLO_DEFAULTS.items():
+        if key in value and value[key] != default:
+            shown = str(value[key]).lower() if isinstance(value[key], bool) else value[key]
+            check.fail(f"sampling.{key}", f"{shown} sets the Monte Carlo trials, but "
+                       "sampling.method none draws none (the GUM and the paper's model "
+                       f"alone); allowed: leave sampling.{key} out (--unset sampling.{key}), "
+                       "or sampling.method mc, lhs or sobol")
 
 
 def _outputs(check, value):
@@ -606,6 +710,12 @@ def _check_sweep_size(sweep, source):
                             "instead, which are evaluated as arrays)")
 
 
+def sweep_limits():
+    """The limits :func:`_check_sweep_size` enforces, in words (the scenario reference)."""
+    return (f"at most {MAX_SCENES:,} scenes (environment variable UQ_MAX_SCENES) and "
+            f"{MAX_GROUPS:,} combinations of structural keys (each its own model)")
+
+
 def max_scenes():
     """The most scenes a sweep may have: UQ_MAX_SCENES if set, else MAX_SCENES."""
     text = os.environ.get("UQ_MAX_SCENES", "")
@@ -672,6 +782,12 @@ class Checker:
 
     def fail(self, key, problem):
         raise ScenarioError(self.source, key, problem)
+
+    def limit(self, key, text):
+        """Declare a limit the validator enforces on `key` beyond its type and range (a
+        list's length, a file's size, a sum over keys), where it is enforced: nothing
+        here; the scenario reference lists it beside the key
+        (:class:`uq.pipeline.reference.RecordingChecker`)."""
 
     def keys(self, mapping, prefix, allowed):
         for key in mapping:
