@@ -130,10 +130,10 @@ def load_kernels(args, scenario):
     (:mod:`uq.cli.sidecompile`)."""
     if draws_records(scenario):          # every kernel when first called (or beside:
         return                           # :mod:`uq.cli.sidecompile`)
+    if getattr(args, "model", "compiled") == "numpy":
+        return                                    # no kernel is called
     from uq.pipeline import motionsection
     import uq.engine.statkernels  # noqa: F401  (numba compiles or loads on import)
-    if getattr(args, "model", "compiled") == "numpy":
-        return                                    # no model kernel is called
     if motionsection.is_time_resolved(scenario.settings):   # the static model unused
         import uq.physics.fusedmotionkernels  # noqa: F401
         return

@@ -37,7 +37,7 @@ log = logging.getLogger(__name__)
 def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
               correlation=None, circular=(), output_dims=None, interval="symmetric",
               chunk_size=None, control_variate=False, stopping="jcgm101", covariance=(),
-              stop_when_gum_valid=False, auxiliary=()):
+              stop_when_gum_valid=False, auxiliary=(), compiled=True):
     """Propagate input distributions through `model` by Monte Carlo and by the GUM.
 
     Parameters
@@ -96,6 +96,10 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         batch as the others): they take no part in the GUM, the stopping rule, the
         coverage interval, the control variate or the validation. The model may leave
         them out of a call with complex inputs (the GUM's).
+    compiled : bool
+        The statistics' compiled loops (numba, :mod:`uq.engine.statkernels`; default),
+        or False: the same statistics in numpy (:mod:`uq.engine.statnumpy`, equal to
+        rounding), nothing compiled.
 
     Returns
     -------
@@ -148,7 +152,7 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     references = {q: _circular_reference(gum_value[q]) if q in circular else None
                   for q in gum_value}
     runner = _Runner(wrapped, inputs_laid, method, seed, references, interval, chunk_size,
-                     covariance, auxiliary)
+                     covariance, auxiliary, compiled)
     if set(covariance) & circular:
         raise ValueError(f"no covariance of circular outputs: {sorted(set(covariance) & circular)}")
     if control_variate:
@@ -269,7 +273,7 @@ class _Runner:
     """Draws blocks, evaluates the model chunk by chunk, accumulates statistics."""
 
     def __init__(self, model, inputs, method, seed, references, interval, chunk_size,
-                 covariance=(), auxiliary=()):
+                 covariance=(), auxiliary=(), compiled=True):
         self.model, self.inputs, self.method, self.seed = model, inputs, method, seed
         self.references, self.interval = references, interval
         blocks = DEFAULT_BLOCKS_PER_CHUNK if chunk_size is None else -(-int(chunk_size) // RNG_BLOCK_SIZE)
@@ -284,16 +288,17 @@ class _Runner:
         self.control, self.linear = None, {}
         self.covariance, self.comoments = tuple(covariance), {}
         self.auxiliary, self.moments = tuple(auxiliary), {}
+        self.compiled = compiled                     # the statistics' loops
 
     def _start(self, capacity, shapes, expected=None):
         self.moments = {q: Moments(shapes[q]) for q in self.auxiliary}
         shapes = {q: shape for q, shape in shapes.items() if q not in self.auxiliary}
         self.stats = {q: StreamingStatistics(shape, capacity, self.references[q],
-                                             expected=expected)
+                                             expected=expected, compiled=self.compiled)
                       for q, shape in shapes.items()}
         self.batches = {q: {key: [] for key in _BATCH_KEYS} for q in shapes}
         self.linear = {q: Moments(shape) for q, shape in shapes.items()}
-        self.comoments = {q: CoMoments(shapes[q]) for q in self.covariance}
+        self.comoments = {q: CoMoments(shapes[q], self.compiled) for q in self.covariance}
 
     def _pieces(self, first_block, n_blocks, n_samples, drawn=None):
         """Outputs (and linear deviations, with a control variate) of n_samples trials

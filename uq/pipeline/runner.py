@@ -260,7 +260,8 @@ def _propagate(scene, settings, outputs, inputs, seed, compiled, held=None):
                        stopping=sampling["stopping"],
                        stop_when_gum_valid=sampling["stop_when_gum_valid"],
                        covariance=profile_covariances(outputs, n_gates),
-                       auxiliary=(HELD_WIND_SPEED,) if held is not None else ())
+                       auxiliary=(HELD_WIND_SPEED,) if held is not None else (),
+                       compiled=compiled)
 
 
 def profile_covariances(outputs, n_gates):
