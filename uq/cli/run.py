@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from uq.cli.common import EXIT_OK, EXIT_TERMINATED, interrupted_status, parse_overrides, say
+from uq.cli import firstrun
 from uq.cli.sidecompile import draws_records, side_compile
 from uq.errors import OutputError, ScenarioError
 
@@ -22,10 +23,13 @@ def add_parser(commands):
     run.add_argument("--resume", action="store_true",
                      help="continue an interrupted run: reuse the finished chunks kept in "
                      "OUT.nc.partial/ and compute only the missing scenes")
-    run.add_argument("--model", choices=("compiled", "numpy"), default="compiled",
-                     help="the measurement model: 'compiled' (default; numba, wherever it "
-                     "applies, else numpy, said at -v) or 'numpy' (the reference model "
-                     "throughout; the same numbers to 1e-12 m/s, slower)")
+    run.add_argument("--model", choices=("auto", "compiled", "numpy"), default="auto",
+                     help="the measurement model and statistics: 'auto' (default) the "
+                     "compiled ones (numba) where numba's cache holds their kernels, else "
+                     "numpy while the kernels compile in a background process for later "
+                     "runs (first run after an install); 'compiled' compiles what is "
+                     "missing first; 'numpy' the reference model throughout. The same "
+                     "numbers to 1e-12 m/s")
     run.add_argument("--device", choices=("cpu", "gpu"), default="cpu",
                      help="where the turbulence boxes of record mode are made: 'cpu' "
                      "(numpy, default) or 'gpu' (CuPy on a CUDA GPU; exits 2 without one)")
@@ -72,7 +76,10 @@ def command(args):
     check_scale_out(args)
     check_device(args, scenario)
     compiling = getattr(args, "compile_notice", None)
-    load_kernels(args, scenario)
+    if args.model == "auto" and not firstrun.wanted(args):
+        args.model = "compiled"              # compiles what it calls first (module doc)
+    background = Background(args, scenario)
+    load_kernels(args, scenario, background)
     before_run = compiling.seconds if compiling else 0.0     # compiled before the run
     new_folders = missing_folders(output.parent)
     checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume).acquire()
@@ -84,7 +91,8 @@ def command(args):
     try:
         with dask_client(args) as client:
             dataset = run(scenario, progress=progress, client=client, checkpoint=checkpoint,
-                          model=args.model, kernels_ready=beside.wait if beside else None)
+                          model=args.model, kernels_ready=beside.wait if beside else None,
+                          kernels_missing=background.start)
         dataset.attrs["runtime_s"] += before_run  # the user's wait, compiles included
         write_netcdf(dataset, output)
         checkpoint.clear()                   # still locked: no other run can be in it
@@ -117,7 +125,29 @@ def command(args):
     return EXIT_OK
 
 
-def load_kernels(args, scenario):
+class Background:
+    """``--model auto``'s background compile (:mod:`uq.cli.firstrun`), started once,
+    when a kernel is found missing from numba's cache; :meth:`start` is the run's
+    `kernels_missing`."""
+
+    def __init__(self, args, scenario):
+        self.args, self.scenario, self.compile = args, scenario, None
+
+    def start(self, missing=None):
+        """Start the compile (once) and say so; returns its ``ended`` (whether to try
+        the compiled model again)."""
+        if self.compile is None:
+            self.compile = firstrun.BackgroundCompile(self.scenario.settings)
+            whose = (f"process {self.compile.pid}" if self.compile.pid else
+                     "another uq's process")
+            say(self.args, f"uq: numba's cache does not hold this run's compiled kernels "
+                f"({missing or 'first run after an install'}): they compile in the "
+                f"background ({whose}, low priority) for later runs; this run uses the "
+                "numpy model meanwhile (the same numbers to 1e-12)")
+        return self.compile.ended
+
+
+def load_kernels(args, scenario, background=None):
     """Load the compiled kernels the run surely uses before its progress bar starts: the
     statistics', and the static model's geometry (real arithmetic; the complex kernels
     load when a GUM grid of many scenes first calls them) or the time-resolved model's.
@@ -127,11 +157,28 @@ def load_kernels(args, scenario):
     records' boxes are drawn (:func:`uq.pipeline.records.draw_first_records`): numba
     keeps ~100-170 MB of what it compiles, which a box drawn after it would add to; on a
     cold cache a second process compiles them while the boxes are drawn
-    (:mod:`uq.cli.sidecompile`)."""
+    (:mod:`uq.cli.sidecompile`). With ``--model auto`` nothing compiles here: the
+    kernels are loaded where numba's cache holds them (a record-mode run's too: loading
+    keeps far less than compiling), else their compile starts in the background
+    (:mod:`uq.cli.firstrun`)."""
+    model = getattr(args, "model", "compiled")
+    if model == "numpy":
+        return                                    # no kernel is called
+    if model == "auto":                  # loaded where cached; else the compile starts
+        from uq.compileguard import KernelNotCached, cached_only
+        try:                             # (the run finds it missing too: numpy)
+            with cached_only():
+                _load_kernels(scenario)
+        except KernelNotCached as error:
+            background.start(error)
+        return
     if draws_records(scenario):          # every kernel when first called (or beside:
         return                           # :mod:`uq.cli.sidecompile`)
-    if getattr(args, "model", "compiled") == "numpy":
-        return                                    # no kernel is called
+    _load_kernels(scenario)
+
+
+def _load_kernels(scenario):
+    """Load (or compile) the kernels of :func:`load_kernels`."""
     from uq.pipeline import motionsection
     import uq.engine.statkernels  # noqa: F401  (numba compiles or loads on import)
     if motionsection.is_time_resolved(scenario.settings):   # the static model unused

@@ -40,11 +40,11 @@ from uq.pipeline.sweep import batch_scene, group_assignments, sweep_plan, vector
 
 
 #: The values of ``uq run --model`` (and of :func:`run`'s `model`).
-MODEL_CHOICES = ("compiled", "numpy")
+MODEL_CHOICES = ("compiled", "numpy", "auto")
 
 
 def run(scenario, progress=None, *, client=None, checkpoint=None, model="compiled",
-        kernels_ready=None):
+        kernels_ready=None, kernels_missing=None):
     """Run a scenario and return its results.
 
     Parameters
@@ -57,14 +57,24 @@ def run(scenario, progress=None, *, client=None, checkpoint=None, model="compile
         Compute the chunks on this dask cluster; the result is identical to a local run.
     checkpoint : uq.pipeline.checkpoint.Checkpoint, optional
         Keeps finished chunks on disk and reuses those it already has (``--resume``).
-    model : {"compiled", "numpy"}
+    model : {"compiled", "numpy", "auto"}
         ``compiled`` (default): the compiled model wherever it applies (else numpy, logged
-        at ``-v``); ``numpy``: the numpy reference model throughout. Both give the same
-        numbers to 1e-12 m/s (``tests/pipeline/test_model_switch.py``).
+        at ``-v``), compiling what numba's cache does not hold; ``numpy``: the numpy
+        reference model and statistics throughout, nothing compiled; ``auto``: each
+        chunk the compiled model where numba's cache holds every kernel it calls, else
+        the numpy model (nothing compiles in this process but a record's turbulence
+        kernels, :mod:`uq.compileguard`; on a cluster: ``compiled``). They give the
+        same numbers to 1e-12 m/s (``tests/pipeline/test_model_switch.py``).
     kernels_ready : callable, optional
         Called with no argument before a chunk's model first runs, after its turbulence
         records are drawn: ``uq run`` waits there for the kernels it has a second process
         compile beside the boxes (:mod:`uq.cli.sidecompile`). Not called on a cluster.
+    kernels_missing : callable, optional
+        With ``auto``: called once, with the :class:`~uq.compileguard.KernelNotCached`,
+        when a chunk finds a kernel missing from the cache; it may return a callable
+        that says, before each later chunk, whether to try the compiled model again
+        (``uq run``: once the kernels' compile in the background has ended,
+        :mod:`uq.cli.firstrun`).
 
     Returns
     -------
@@ -80,24 +90,68 @@ def run(scenario, progress=None, *, client=None, checkpoint=None, model="compile
         seed = scenario.sampling["seed"]
         if seed is None:             # a resumed run keeps the seed its chunks were drawn with
             seed = checkpoint.seed if checkpoint and checkpoint.seed is not None else new_seed()
-        if checkpoint:
-            checkpoint.start(scenario, seed, plan.chunks, model)
-        results = _compute(scenario, plan, seed, progress, client, checkpoint,
-                           model == "compiled", kernels_ready)
+        if checkpoint:          # (auto's numpy chunks are the compiled ones' to 1e-12)
+            checkpoint.start(scenario, seed, plan.chunks,
+                             "compiled" if model == "auto" else model)
+        choice = ModelChoice(model if client is None or model != "auto" else "compiled",
+                             kernels_missing)
+        results = _compute(scenario, plan, seed, progress, client, checkpoint, choice,
+                           kernels_ready)
     dataset = _assemble(scenario, plan, results)
-    dataset.attrs.update(_global_attributes(scenario, seed, dataset, started, model))
+    dataset.attrs.update(_global_attributes(scenario, seed, dataset, started, choice))
     return dataset
 
 
-def _compute(scenario, plan, seed, progress, client, checkpoint, compiled,
+class ModelChoice:
+    """Which model each chunk runs (:func:`run`'s `model`): :meth:`evaluate` calls
+    ``work(compiled)`` with the model's flag; with ``auto``, inside
+    :func:`uq.compileguard.cached_only`, and again with False where a kernel is
+    missing from numba's cache (then `kernels_missing`, once; the compiled model is
+    tried again only where what it returned says so)."""
+
+    def __init__(self, model, kernels_missing=None):
+        self.model = model
+        self.kernels_missing = kernels_missing
+        self.retry = None                    # after a miss: whether to try again
+        self.numpy_chunks = 0                # chunks auto ran with the numpy model
+        self.chunks = 0
+        self.missing = None                  # the first kernel found missing
+
+    @property
+    def compiled(self):
+        """The flag of a chunk run without the guard (on a cluster, ``compiled`` for
+        ``auto``)."""
+        return self.model != "numpy"
+
+    def evaluate(self, work):
+        """``work(compiled)`` of one chunk with the model chosen for it."""
+        self.chunks += 1
+        if self.model != "auto":
+            return work(self.model == "compiled")
+        if self.missing is None or (self.retry is not None and self.retry()):
+            from uq.compileguard import KernelNotCached, cached_only
+            try:
+                with cached_only():
+                    return work(True)
+            except KernelNotCached as error:
+                first = self.missing is None
+                self.missing = self.missing or str(error)
+                self.retry = None
+                if first and self.kernels_missing is not None:
+                    self.retry = self.kernels_missing(error)
+        self.numpy_chunks += 1
+        return work(False)
+
+
+def _compute(scenario, plan, seed, progress, client, checkpoint, choice,
              kernels_ready=None):
     """Results of every chunk, by index: from the checkpoint, else computed."""
     results = checkpoint.load() if checkpoint else {}
     todo = [chunk for chunk in plan.chunks if chunk.index not in results]
-    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed, compiled,
+    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed, choice,
                                         kernels_ready), None)
                 for chunk in todo) if client is None else \
-        _distributed(client, scenario, plan, todo, seed, compiled,
+        _distributed(client, scenario, plan, todo, seed, choice.compiled,
                      checkpoint.digest if checkpoint else None)
     if progress and results:
         progress(len(results), len(plan.chunks))
@@ -138,8 +192,8 @@ def chunk_task(scenario, plan, chunk, seed, compiled=True, digest=None):
 
 def run_chunk(scenario, plan, chunk, seed, compiled=True, kernels_ready=None):
     """Results of one chunk of scenes: a Dataset with a ``scene`` dimension (`compiled`:
-    the compiled model where it applies, else the numpy model throughout;
-    `kernels_ready`: as :func:`run`'s)."""
+    the compiled model where it applies, else the numpy model throughout, or a
+    :class:`ModelChoice`; `kernels_ready`: as :func:`run`'s)."""
     spectra_of = scenario.settings             # (the file's scene: the records' spectra)
     if plan.group_keys:
         scenario = scenario.with_values(group_assignments(scenario, plan, chunk.group))
@@ -154,12 +208,17 @@ def run_chunk(scenario, plan, chunk, seed, compiled=True, kernels_ready=None):
         prepared = records.prepare_records(scenario, record_fields, seed, spectra_of)
     if kernels_ready is not None:
         kernels_ready()
-    dataset = run_scene(scenario, batch_scene(base, fields), seed, compiled)
-    if record_fields is not None and "wind_speed_true" in dataset:
-        # the records' variables of each scene
-        dataset = dataset.assign(records.record_variables(
-            scenario, record_fields, dataset, seed, compiled, spectra_of, prepared))
-    return dataset
+
+    def evaluate(compiled):
+        dataset = run_scene(scenario, batch_scene(base, fields), seed, compiled)
+        if record_fields is not None and "wind_speed_true" in dataset:
+            # the records' variables of each scene
+            dataset = dataset.assign(records.record_variables(
+                scenario, record_fields, dataset, seed, compiled, spectra_of, prepared))
+        return dataset
+    if isinstance(compiled, ModelChoice):
+        return compiled.evaluate(evaluate)
+    return evaluate(compiled)
 
 
 def run_scene(scenario, scene, seed, compiled=True):
@@ -442,7 +501,20 @@ def _annotate(ds, scenario):
     return cf_encode(ds)
 
 
-def _global_attributes(scenario, seed, dataset, started, model):
+def _model_attribute(choice):
+    """The ``model`` attribute: said where the numpy model ran (none: compiled)."""
+    if choice.model == "numpy":
+        return {"model": "numpy: the numpy reference model throughout (uq run --model "
+                         "numpy)"}
+    if choice.numpy_chunks:
+        return {"model": f"numpy for {choice.numpy_chunks} of {choice.chunks} chunks: "
+                         "numba's cache did not hold the compiled model's kernels "
+                         f"({choice.missing}; uq run --model auto); the same numbers "
+                         "to 1e-12"}
+    return {}
+
+
+def _global_attributes(scenario, seed, dataset, started, choice):
     return {"title": f"uq results: {scenario.name}",
             "skipped": skipped_work(scenario.settings, scenario.outputs,
                                     dict(scenario.sweep).get("lidar.probe.kind", ())),
@@ -460,8 +532,7 @@ def _global_attributes(scenario, seed, dataset, started, model):
             "ins_correlation": _swept_or(scenario, "ins.correlation",
                                          scenario.settings["ins"]["correlation"]),
             "runtime_s": time.perf_counter() - started, **_probe_attributes(scenario),
-            **({"model": "numpy: the numpy reference model throughout (uq run --model "
-                         "numpy)"} if model == "numpy" else {})}
+            **_model_attribute(choice)}
 
 
 def _swept_or(scenario, key, value):

@@ -1,0 +1,157 @@
+"""``uq run``'s first run after an install: no wait for numba.
+
+numba compiles a kernel the first time a process calls it and keeps it in its on-disk
+cache; a run's kernels take 10-40 s of CPU to compile (one core), against 2-6 s for the
+whole run of most shipped scenarios once they are cached. ``uq run`` (``--model auto``,
+its default) therefore never compiles them itself: each chunk runs the compiled model
+where numba's cache holds every kernel it calls (:mod:`uq.compileguard`), else the numpy
+reference model and statistics (the same numbers to 1e-12 m/s; ~1-1.5 times the
+compiled model's time on the shipped scenarios), and the first chunk that finds a kernel
+missing starts :class:`BackgroundCompile`: ``python -m uq.cli.firstrun SETTINGS`` in a
+process of its own (its own session, at a low priority: :data:`BACKGROUND_NICE`), which
+compiles every kernel a run of the same scenario calls (``uq warmup --for``,
+:func:`uq.cli.warmup.compile_for`) into numba's cache and ends. It outlives the run
+when the run ends first (it is then written to the cache for the next run); a later
+chunk of the same run takes the compiled model once it has ended.
+
+One at a time per cache: the parent takes an exclusive lock (``flock``) on a file named
+after the cache folder and hands it to the child, which holds it until it ends; a run
+that finds the lock taken starts none (another compile is filling the same cache).
+Not started (the run then compiles in its own process, as ``--model compiled``): with
+``UQ_BACKGROUND_COMPILE=0`` in the environment (batch jobs, CI), on a dask cluster (its
+workers compile for themselves) or with less than
+:data:`~uq.cli.sidecompile.SIDE_COMPILE_MIN_AVAILABLE_MB` of memory free.
+"""
+import fcntl
+import hashlib
+import logging
+import os
+import subprocess
+import sys
+import tempfile
+
+import yaml
+
+#: The environment variable that turns the background compile off ("0"): the run then
+#: compiles what it calls in its own process first (``--model compiled``).
+BACKGROUND_VARIABLE = "UQ_BACKGROUND_COMPILE"
+#: The background compile's niceness (``nice``): it takes a core only when the user's
+#: own work leaves one idle.
+BACKGROUND_NICE = 10
+
+LOG = logging.getLogger(__name__)
+
+
+def wanted(args):
+    """Whether ``uq run`` `args` may leave its kernels to a background compile (else it
+    compiles them itself, ``--model compiled``)."""
+    from uq.cli.sidecompile import SIDE_COMPILE_MIN_AVAILABLE_MB, available_memory_mb
+    return (os.environ.get(BACKGROUND_VARIABLE, "1") != "0"
+            and getattr(args, "workers", None) is None
+            and getattr(args, "scheduler", None) is None
+            and available_memory_mb() >= SIDE_COMPILE_MIN_AVAILABLE_MB)
+
+
+def lock_path():
+    """The lock file of the background compile of this process's numba cache (one per
+    cache folder and user, in the temporary folder)."""
+    import numba
+    folder = numba.config.CACHE_DIR or os.path.dirname(os.path.dirname(__file__))
+    digest = hashlib.sha256(os.path.abspath(folder).encode()).hexdigest()[:16]
+    return os.path.join(tempfile.gettempdir(), f"uq-compile-{os.getuid()}-{digest}.lock")
+
+
+def _take_lock():
+    """An open file descriptor holding the exclusive lock, or None if another process
+    holds it (or it cannot be made)."""
+    try:
+        handle = os.open(lock_path(), os.O_RDWR | os.O_CREAT, 0o600)
+    except OSError:
+        return None
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(handle)
+        return None
+    return handle
+
+
+def compile_running():
+    """Whether a background compile of this cache is running (its lock is held)."""
+    handle = _take_lock()
+    if handle is None:
+        return True
+    os.close(handle)                      # (closing releases it)
+    return False
+
+
+class BackgroundCompile:
+    """The background compile of a run's kernels (module docstring).
+
+    Parameters
+    ----------
+    settings : dict
+        The run's validated settings (written to a temporary file for the child).
+
+    Attributes
+    ----------
+    child : subprocess.Popen or None
+        The compiling process; None where another one held the lock (it fills the same
+        cache).
+    """
+
+    def __init__(self, settings):
+        self.child = None
+        lock = _take_lock()
+        if lock is None:
+            return
+        try:
+            handle, path = tempfile.mkstemp(prefix="uq-compile-", suffix=".yaml")
+            with os.fdopen(handle, "w") as file:
+                yaml.safe_dump(settings, file)
+            # its own session (a Ctrl-C at the terminal is the run's, not its); nothing
+            # of it on the terminal; the lock's descriptor inherited: it holds the lock
+            # until it ends (the run may end first)
+            self.child = subprocess.Popen(
+                [sys.executable, "-m", "uq.cli.firstrun", path, str(lock)],
+                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL, start_new_session=True, pass_fds=(lock,))
+        except OSError as error:
+            LOG.info("the background compile could not start (%s)", error)
+        finally:
+            os.close(lock)
+
+    @property
+    def pid(self):
+        return self.child.pid if self.child else None
+
+    def ended(self):
+        """Whether the kernels' compile has ended well (this run's child, or the one that
+        held the lock)."""
+        if self.child is None:
+            return not compile_running()
+        return self.child.poll() == 0
+
+
+def main(argv=None):
+    """``python -m uq.cli.firstrun SETTINGS.yaml LOCK_FD``: compile, at a low priority,
+    every kernel a run of the scenario calls (then remove the settings file); the lock
+    is released when this process ends."""
+    path, _lock = (sys.argv[1:] if argv is None else argv)[:2]
+    try:
+        os.nice(BACKGROUND_NICE)
+    except OSError:
+        pass
+    try:
+        from uq.cli.warmup import compile_for
+        compile_for(path)
+    finally:
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
