@@ -52,11 +52,13 @@ def wanted(args):
             and available_memory_mb() >= SIDE_COMPILE_MIN_AVAILABLE_MB)
 
 
-def lock_path():
-    """The lock file of the background compile of this process's numba cache (one per
-    cache folder and user, in the temporary folder)."""
-    import numba
-    folder = numba.config.CACHE_DIR or os.path.dirname(os.path.dirname(__file__))
+def lock_path(folder=None):
+    """The lock file of the background compile of numba's cache in `folder` (default:
+    this process's, ``NUMBA_CACHE_DIR`` or beside the code): one per cache folder and
+    user, in the temporary folder."""
+    if folder is None:
+        import numba
+        folder = numba.config.CACHE_DIR or os.path.dirname(os.path.dirname(__file__))
     digest = hashlib.sha256(os.path.abspath(folder).encode()).hexdigest()[:16]
     return os.path.join(tempfile.gettempdir(), f"uq-compile-{os.getuid()}-{digest}.lock")
 

@@ -140,10 +140,11 @@ class Background:
             self.compile = firstrun.BackgroundCompile(self.scenario.settings)
             whose = (f"process {self.compile.pid}" if self.compile.pid else
                      "another uq's process")
-            say(self.args, f"uq: numba's cache does not hold this run's compiled kernels "
-                f"({missing or 'first run after an install'}): they compile in the "
-                f"background ({whose}, low priority) for later runs; this run uses the "
-                "numpy model meanwhile (the same numbers to 1e-12)")
+            if not getattr(self.args, "quiet", False):     # a notice, as "compiling"
+                print(f"uq: numba's cache does not hold this run's compiled kernels "
+                      f"({missing}): they compile in the background ({whose}, low "
+                      "priority) for later runs; this run uses the numpy model meanwhile "
+                      "(the same numbers to 1e-12)", file=sys.stderr, flush=True)
         return self.compile.ended
 
 
