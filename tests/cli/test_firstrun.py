@@ -51,23 +51,23 @@ def test_one_compile_at_a_time_per_cache(tmp_path, monkeypatch):
         return real([sys.executable, "-c", "import sys; sys.stdin.read()"],
                     **{**kwargs, "stdin": subprocess.PIPE})
     monkeypatch.setattr(firstrun.subprocess, "Popen", popen)
-    first = firstrun.BackgroundCompile({"name": "x"})
+    first = firstrun.BackgroundCompile([{"name": "x"}])
     assert first.child is not None and firstrun.compile_running()
-    second = firstrun.BackgroundCompile({"name": "x"})
+    second = firstrun.BackgroundCompile([{"name": "x"}])
     assert second.child is None and not second.ended() and len(started) == 1
     first.child.stdin.close()
     first.child.wait()
     assert first.ended() and second.ended() and not firstrun.compile_running()
 
 
-def test_the_child_compiles_the_scenario_and_removes_its_file(tmp_path, monkeypatch):
+def test_the_child_compiles_each_scenario_and_removes_its_file(tmp_path, monkeypatch):
     settings = tmp_path / "s.yaml"
-    settings.write_text("name: x\n")
+    settings.write_text("name: x\n---\nname: y\n")
     compiled = []
     monkeypatch.setattr("uq.cli.warmup.compile_for", lambda path: compiled.append(path))
     monkeypatch.setattr(firstrun.os, "nice", lambda value: compiled.append(value))
     assert firstrun.main([str(settings), "3"]) == 0
-    assert compiled == [firstrun.BACKGROUND_NICE, str(settings)]
+    assert compiled == [firstrun.BACKGROUND_NICE, {"name": "x"}, {"name": "y"}]
     assert not settings.exists()
 
 

@@ -87,13 +87,44 @@ def compile_running():
     return False
 
 
+class Background:
+    """A command's background compile, started once, when a kernel is found missing
+    from numba's cache; :meth:`start` is :func:`uq.run`'s `kernels_missing`.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The command's (``-q``: nothing said).
+    settings : list of dict
+        The validated settings of the scenarios whose kernels to compile.
+    """
+
+    def __init__(self, args, settings):
+        self.args, self.settings, self.compile = args, settings, None
+
+    def start(self, missing=None):
+        """Start the compile (once) and say so on stderr; returns its ``ended``
+        (whether to try the compiled model again)."""
+        if self.compile is None:
+            self.compile = BackgroundCompile(self.settings)
+            whose = (f"process {self.compile.pid}" if self.compile.pid else
+                     "another uq's process")
+            if not getattr(self.args, "quiet", False):     # a notice, as "compiling"
+                print(f"uq: numba's cache does not hold this run's compiled kernels "
+                      f"({missing}): they compile in the background ({whose}, low "
+                      "priority) for later runs; this run uses the numpy model meanwhile "
+                      "(the same numbers to 1e-12)", file=sys.stderr, flush=True)
+        return self.compile.ended
+
+
 class BackgroundCompile:
     """The background compile of a run's kernels (module docstring).
 
     Parameters
     ----------
-    settings : dict
-        The run's validated settings (written to a temporary file for the child).
+    settings : list of dict
+        The validated settings of the scenarios whose kernels to compile (written to a
+        temporary file for the child, one YAML document each).
 
     Attributes
     ----------
@@ -110,7 +141,7 @@ class BackgroundCompile:
         try:
             handle, path = tempfile.mkstemp(prefix="uq-compile-", suffix=".yaml")
             with os.fdopen(handle, "w") as file:
-                yaml.safe_dump(settings, file)
+                yaml.safe_dump_all(settings, file)
             # its own session (a Ctrl-C at the terminal is the run's, not its); nothing
             # of it on the terminal; the lock's descriptor inherited: it holds the lock
             # until it ends (the run may end first)
@@ -137,8 +168,8 @@ class BackgroundCompile:
 
 def main(argv=None):
     """``python -m uq.cli.firstrun SETTINGS.yaml LOCK_FD``: compile, at a low priority,
-    every kernel a run of the scenario calls (then remove the settings file); the lock
-    is released when this process ends."""
+    every kernel a run of each scenario of the file calls (then remove the file); the
+    lock is released when this process ends."""
     path, _lock = (sys.argv[1:] if argv is None else argv)[:2]
     try:
         os.nice(BACKGROUND_NICE)
@@ -146,7 +177,10 @@ def main(argv=None):
         pass
     try:
         from uq.cli.warmup import compile_for
-        compile_for(path)
+        with open(path, encoding="utf-8") as file:
+            documents = list(yaml.safe_load_all(file))
+        for settings in documents:
+            compile_for(settings)
     finally:
         try:
             os.unlink(path)

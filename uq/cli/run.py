@@ -77,7 +77,7 @@ def command(args):
     compiling = getattr(args, "compile_notice", None)
     if args.model == "auto" and not firstrun.wanted(args):
         args.model = "compiled"              # compiles what it calls first (module doc)
-    background = Background(args, scenario)
+    background = firstrun.Background(args, [scenario.settings])
     load_kernels(args, scenario, background)
     before_run = compiling.seconds if compiling else 0.0     # compiled before the run
     new_folders = missing_folders(output.parent)
@@ -122,29 +122,6 @@ def command(args):
     say(args, summary_table(dataset, compile_s=compile_s))
     say(args, f"wrote {output}")
     return EXIT_OK
-
-
-class Background:
-    """``--model auto``'s background compile (:mod:`uq.cli.firstrun`), started once,
-    when a kernel is found missing from numba's cache; :meth:`start` is the run's
-    `kernels_missing`."""
-
-    def __init__(self, args, scenario):
-        self.args, self.scenario, self.compile = args, scenario, None
-
-    def start(self, missing=None):
-        """Start the compile (once) and say so; returns its ``ended`` (whether to try
-        the compiled model again)."""
-        if self.compile is None:
-            self.compile = firstrun.BackgroundCompile(self.scenario.settings)
-            whose = (f"process {self.compile.pid}" if self.compile.pid else
-                     "another uq's process")
-            if not getattr(self.args, "quiet", False):     # a notice, as "compiling"
-                print(f"uq: numba's cache does not hold this run's compiled kernels "
-                      f"({missing}): they compile in the background ({whose}, low "
-                      "priority) for later runs; this run uses the numpy model meanwhile "
-                      "(the same numbers to 1e-12)", file=sys.stderr, flush=True)
-        return self.compile.ended
 
 
 def load_kernels(args, scenario, background=None):

@@ -38,9 +38,11 @@ KPI = ("speed_slope", "speed_r_squared", "speed_n_records", "speed_slope_verdict
        "availability_verdict", "coverage_verdict", "class_number")
 
 
-def run_golden(config_path, output=None, stream=None):
+def run_golden(config_path, output=None, stream=None, model="compiled", kernels_missing=None):
     """Analyse the campaign of `config_path` and write the folder; returns its path.
-    The summary goes to `stream` (default stdout), warnings to the log (stderr)."""
+    The summary goes to `stream` (default stdout), warnings to the log (stderr). `model`
+    and `kernels_missing`: the synthetic lidars' model, as :func:`uq.run`'s (the
+    campaign is generated again from its seed where ``auto`` finds a kernel missing)."""
     stream = stream or sys.stdout
     config = load_golden_config(config_path)
     folder = Path(output) if output else Path("results") / config.name
@@ -48,8 +50,11 @@ def run_golden(config_path, output=None, stream=None):
     partial = new_partial_folder(folder)
     try:
         if config.synthetic is not None:
+            from uq.pipeline.runner import ModelChoice
             from .campaign import generate_campaign
-            config = load_golden_config(generate_campaign(config, partial / "data"))
+            choice = ModelChoice(model, kernels_missing)
+            config = load_golden_config(choice.evaluate(
+                lambda compiled: generate_campaign(config, partial / "data", compiled)))
         ds = analyse(config)
         _write(ds, partial, config.name)
     except BaseException:
