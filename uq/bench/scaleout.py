@@ -7,8 +7,8 @@ worker, :func:`uq.pipeline.cluster.local_cluster`) and each workload, the wall t
 :func:`uq.run` (the cluster's start excluded: the client is made first, then the run
 is timed), the speed-up S(N) = T(1) / T(N) against the same run in one process without
 a cluster, the efficiency S(N) / N (target >= 0.6 up to 8 workers), and whether the
-results are bit-identical to the single process's (every variable's bytes; they must
-be: each chunk's draws come from the seed alone).
+results are bit-identical to the single process's (every variable's bytes; each
+chunk's draws come from the seed alone) and their largest difference otherwise.
 
 Workloads:
 
@@ -51,6 +51,16 @@ def workloads(small=False):
     return {"rubio2022_misalignment": load_scenario(
                 scenario_path("rubio2022_misalignment"), {"sampling.n": 100_000}),
             "floating_lidar_ti": load_scenario(scenario_path("floating_lidar_ti"))}
+
+
+def largest_difference(one, other):
+    """The largest absolute difference of the numeric variables two results share."""
+    gaps = [float(np.nanmax(np.abs(one.variables[name].values.astype(float)
+                                   - other.variables[name].values.astype(float))))
+            for name in set(one.variables) & set(other.variables)
+            if one.variables[name].dtype.kind in "fiu" and one.variables[name].size
+            and np.isfinite(one.variables[name].values.astype(float)).any()]
+    return max(gaps, default=0.0)
 
 
 def identical(one, other):
@@ -96,7 +106,8 @@ def measure(workers=(1, 2, 4, 8, 16), small=False, progress=None, names=None):
             rows["workers"][str(count)] = {
                 "seconds": seconds, "speedup": speedup, "efficiency": speedup / count,
                 "load_before": load, "load_after": os.getloadavg(),
-                "identical": identical(single, result)}
+                "identical": identical(single, result),
+                "largest_difference": largest_difference(single, result)}
             say(f"{name}: {count} workers {seconds:.1f} s, speed-up {speedup:.2f} "
                 f"({speedup / count:.2f} N), identical {rows['workers'][str(count)]['identical']}")
         rows["target_met"] = all(row["efficiency"] >= TARGET_EFFICIENCY and row["identical"]
@@ -114,6 +125,9 @@ def main(argv=None):
     parser.add_argument("-o", "--output", default="results/scaleout.json")
     parser.add_argument("--small", action="store_true", help="small workloads")
     args = parser.parse_args(argv)
+    import logging
+    for name in ("distributed", "tornado", "asyncio"):     # the cluster's own chatter
+        logging.getLogger(name).setLevel(logging.ERROR)
     workers = [int(value) for value in args.workers.split(",")]
     figures = measure(workers, args.small, progress=lambda text: print(text, file=sys.stderr))
     from uq.files import write_text
