@@ -129,3 +129,23 @@ def test_a_cold_cache_runs_numpy_compiles_nothing_and_agrees(tmp_path, name, cha
     _assert_agree(warm, cold, scenario.settings["wind"]["speed"])
     for variable in ("wind_speed_mc_mean", "wind_speed_mc_u"):    # not only NaN-free
         assert np.all(np.isfinite(cold[variable].values))
+
+
+def test_numpy_chunks_on_threads_are_the_sequential_ones_bit_for_bit(tmp_path):
+    """A cold cache's sweep of many chunks: after the first, auto's numpy chunks run on
+    threads; each is the same bytes as the numpy model's sequential run (model="numpy")."""
+    changes = {"sampling.n": 300}                # rubio2022_half_cone: 7 chunks of scenes
+    cache = tmp_path / "numba"
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(cache), "PYTHONPATH": str(ROOT)}
+    out = tmp_path / "auto.nc"
+    done = subprocess.run([sys.executable, "-c", CHILD,
+                           json.dumps({"name": "rubio2022_half_cone", **changes}), str(out)],
+                          env=env, capture_output=True, text=True, preexec_fn=cpu_limited())
+    assert done.returncode == 0, child_failure(done)
+    with xr.open_dataset(out) as cold:
+        cold = cold.load()
+    assert cold.attrs["model"].startswith("numpy for 7 of 7 chunks")
+    sequential = run(load_scenario(scenario_path("rubio2022_half_cone"), changes),
+                     model="numpy")
+    for name in sequential.data_vars:
+        np.testing.assert_array_equal(cold[name].values, sequential[name].values, name)

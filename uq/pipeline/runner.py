@@ -10,6 +10,8 @@ a number.
 """
 import contextlib
 import dataclasses
+import os
+import threading
 import time
 
 import numpy as np
@@ -116,6 +118,7 @@ class ModelChoice:
         self.numpy_chunks = 0                # chunks auto ran with the numpy model
         self.chunks = 0
         self.missing = None                  # the first kernel found missing
+        self._lock = threading.Lock()        # (numpy chunks may run on threads)
 
     @property
     def compiled(self):
@@ -125,7 +128,8 @@ class ModelChoice:
 
     def evaluate(self, work):
         """``work(compiled)`` of one chunk with the model chosen for it."""
-        self.chunks += 1
+        with self._lock:
+            self.chunks += 1
         if self.model != "auto":
             return work(self.model == "compiled")
         if self.missing is None or (self.retry is not None and self.retry()):
@@ -134,12 +138,14 @@ class ModelChoice:
                 with cached_only():
                     return work(True)
             except KernelNotCached as error:
-                first = self.missing is None
-                self.missing = self.missing or str(error)
-                self.retry = None
+                with self._lock:
+                    first = self.missing is None
+                    self.missing = self.missing or str(error)
+                    self.retry = None
                 if first and self.kernels_missing is not None:
                     self.retry = self.kernels_missing(error)
-        self.numpy_chunks += 1
+        with self._lock:
+            self.numpy_chunks += 1
         return work(False)
 
 
@@ -148,9 +154,8 @@ def _compute(scenario, plan, seed, progress, client, checkpoint, choice,
     """Results of every chunk, by index: from the checkpoint, else computed."""
     results = checkpoint.load() if checkpoint else {}
     todo = [chunk for chunk in plan.chunks if chunk.index not in results]
-    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed, choice,
-                                        kernels_ready), None)
-                for chunk in todo) if client is None else \
+    finished = _local(scenario, plan, todo, seed, choice, kernels_ready) \
+        if client is None else \
         _distributed(client, scenario, plan, todo, seed, choice.compiled,
                      checkpoint.digest if checkpoint else None)
     if progress and results:
@@ -163,6 +168,42 @@ def _compute(scenario, plan, seed, progress, client, checkpoint, choice,
         if progress:
             progress(len(results), len(plan.chunks))
     return results
+
+
+#: Threads that evaluate ``auto``'s numpy chunks together (the cores this process may
+#: use, at most 4): the numpy model is 1-4x slower than the compiled one per core, and
+#: its ufuncs release the GIL; the background compile, at a low priority, waits.
+NUMPY_CHUNK_THREADS = min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                          else os.cpu_count() or 1)
+
+
+def _local(scenario, plan, chunks, seed, choice, kernels_ready=None):
+    """Chunks in this process, yielded in order as ``(index, dataset, None)``. Once
+    ``auto`` runs the numpy model (a kernel missing from numba's cache), the remaining
+    chunks of a run without records go to :data:`NUMPY_CHUNK_THREADS` threads (each chunk
+    is the same whichever thread computes it: its draws come from the seed alone)."""
+    chunks = list(chunks)
+    while chunks:
+        chunk = chunks.pop(0)
+        yield chunk.index, run_chunk(scenario, plan, chunk, seed, choice, kernels_ready), None
+        if (choice.missing and len(chunks) > 1 and NUMPY_CHUNK_THREADS > 1
+                and "turbulence" not in scenario.settings):
+            yield from _in_threads(scenario, plan, chunks, seed, choice)
+            return
+
+
+def _in_threads(scenario, plan, chunks, seed, choice):
+    """:func:`_local`'s numpy chunks on threads, yielded in order; at a stop (Ctrl-C) the
+    chunks not started are cancelled (those running end with their chunk)."""
+    from concurrent.futures import ThreadPoolExecutor
+    pool = ThreadPoolExecutor(NUMPY_CHUNK_THREADS, thread_name_prefix="uq-chunk")
+    try:
+        futures = [pool.submit(run_chunk, scenario, plan, chunk, seed, choice)
+                   for chunk in chunks]
+        for chunk, future in zip(chunks, futures):
+            yield chunk.index, future.result(), None
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
 
 
 def _distributed(client, scenario, plan, chunks, seed, compiled, digest):
