@@ -42,14 +42,11 @@ def _timed(command, env):
 
 
 def _wait_for_background(cache):
-    """Wait until no background compile holds the lock of numba's cache in `cache`;
-    the seconds waited."""
-    from uq.cli.firstrun import lock_path
-    import fcntl
+    """Wait until the background compile of numba's cache in `cache` has ended; the
+    seconds waited."""
+    from uq.cli.firstrun import wait_for_background
     started = time.perf_counter()
-    with open(lock_path(cache), "a+") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)             # blocks while it compiles
-        fcntl.flock(handle, fcntl.LOCK_UN)
+    wait_for_background(cache)
     return time.perf_counter() - started
 
 

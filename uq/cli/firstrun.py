@@ -87,6 +87,20 @@ def compile_running():
     return False
 
 
+def wait_for_background(folder=None):
+    """Wait until no background compile of numba's cache in `folder` (default this
+    process's) holds its lock, i.e. until one running has ended; returns at once when
+    none runs."""
+    try:
+        handle = os.open(lock_path(folder), os.O_RDWR | os.O_CREAT, 0o600)
+    except OSError:
+        return
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX)                 # blocks while one compiles
+    finally:
+        os.close(handle)
+
+
 class Background:
     """A command's background compile, started once, when a kernel is found missing
     from numba's cache; :meth:`start` is :func:`uq.run`'s `kernels_missing`.
