@@ -23,14 +23,11 @@ workers compile for themselves) or with less than
 :data:`~uq.cli.sidecompile.SIDE_COMPILE_MIN_AVAILABLE_MB` of memory free.
 """
 import fcntl
-import hashlib
 import logging
 import os
 import subprocess
 import sys
 import tempfile
-
-import yaml
 
 #: The environment variable that turns the background compile off ("0"): the run then
 #: compiles what it calls in its own process first (``--model compiled``).
@@ -56,6 +53,7 @@ def lock_path(folder=None):
     """The lock file of the background compile of numba's cache in `folder` (default:
     this process's, ``NUMBA_CACHE_DIR`` or beside the code): one per cache folder and
     user, in the temporary folder."""
+    import hashlib
     if folder is None:
         import numba
         folder = numba.config.CACHE_DIR or os.path.dirname(os.path.dirname(__file__))
@@ -152,6 +150,7 @@ class BackgroundCompile:
         lock = _take_lock()
         if lock is None:
             return
+        import yaml
         try:
             handle, path = tempfile.mkstemp(prefix="uq-compile-", suffix=".yaml")
             with os.fdopen(handle, "w") as file:
@@ -189,6 +188,7 @@ def main(argv=None):
         os.nice(BACKGROUND_NICE)
     except OSError:
         pass
+    import yaml
     try:
         from uq.cli.warmup import compile_for
         with open(path, encoding="utf-8") as file:

@@ -8,7 +8,6 @@ import sys
 from pathlib import Path
 
 from uq.cli.common import EXIT_OK, EXIT_TERMINATED, interrupted_status, parse_overrides, say
-from uq.cli import firstrun
 from uq.cli.sidecompile import draws_records, side_compile
 from uq.errors import OutputError, ScenarioError
 
@@ -74,6 +73,7 @@ def command(args):
     check_target(output)                     # before any work: refused targets cost nothing
     check_scale_out(args)
     check_device(args, scenario)
+    from uq.cli import firstrun
     compiling = getattr(args, "compile_notice", None)
     if args.model == "auto" and not firstrun.wanted(args):
         args.model = "compiled"              # compiles what it calls first (module doc)

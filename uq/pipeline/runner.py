@@ -19,7 +19,7 @@ import xarray as xr
 
 from uq._version import __version__
 from uq.pipeline.distributions import error_distribution
-from uq.engine.inputs import Input
+from uq.engine.inputs import Input, moments
 from uq.pipeline import probesection, records
 from uq.pipeline.checkpoint import encode_chunk
 from uq.pipeline.modelsetup import (MOTION_INPUTS, error_inputs, input_label, scene_from_settings,
@@ -334,7 +334,7 @@ def _mean_of(spec):
     distribution = spec.distribution if isinstance(spec, Input) else spec
     if isinstance(distribution, float):
         return distribution
-    return float(distribution.mean())
+    return moments(distribution)[0]
 
 
 def _propagate(scene, settings, outputs, inputs, seed, compiled, held=None):
@@ -461,7 +461,7 @@ def _standard_uncertainty(spec):
     if spec is None:
         return 0.0
     dist = error_distribution(spec)
-    return 0.0 if isinstance(dist, float) else float(dist.std())
+    return 0.0 if isinstance(dist, float) else moments(dist)[1]
 
 
 def _assemble(scenario, plan, results):
