@@ -5,8 +5,9 @@ cache; a run's kernels take 10-40 s of CPU to compile (one core), against 2-6 s 
 whole run of most shipped scenarios once they are cached. ``uq run`` (``--model auto``,
 its default) therefore never compiles them itself: each chunk runs the compiled model
 where numba's cache holds every kernel it calls (:mod:`uq.compileguard`), else the numpy
-reference model and statistics (the same numbers to 1e-12 m/s; ~1-1.5 times the
-compiled model's time on the shipped scenarios), and the first chunk that finds a kernel
+reference model and statistics (the same numbers to 1e-12 m/s; 1-4 times the compiled
+model's CPU time on the shipped scenarios; a sweep's numpy chunks run on the cores'
+threads, :func:`uq.pipeline.runner.run`), and the first chunk that finds a kernel
 missing starts :class:`BackgroundCompile`: ``python -m uq.cli.firstrun SETTINGS`` in a
 process of its own (its own session, at a low priority: :data:`BACKGROUND_NICE`), which
 compiles every kernel a run of the same scenario calls (``uq warmup --for``,
