@@ -61,10 +61,11 @@ def test_bench_file_passes_the_cf_checker(monkeypatch, tmp_path, cf_compliance):
     assert (tmp_path / "bench.txt").read_text() == "not uq's"
     cf_compliance(path)
     document = json.loads(path.with_suffix(".json").read_text())
-    names = {row["name"] for row in document["figures"]}
     assert {"floating_lidar_full_mc_over_draw_floor", "pointwise_motion_over_static",
-            "rubio2022_case_i_best_speedup"} <= names
-    assert document["machine"]["processor"] and len(document["load_average"]["start"]) == 3
+            "rubio2022_case_i_best_speedup"} <= set(document["targets"])
+    assert document["machine_details"]["processor"] and document["command"] == "uq bench --quick"
+    assert len(document["load_averages"]["start"]) == 3
+    assert len(document["time_to_target"]) == 5                    # one scene, 5 methods
     run_bench(path, quick=True, sizes=[2**10, 2**11], repeats=2, scale=2**-12)  # replaced
     with xr.open_dataset(path) as ds:
         assert all(re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", name) for name in ds.attrs), \
@@ -72,6 +73,7 @@ def test_bench_file_passes_the_cf_checker(monkeypatch, tmp_path, cf_compliance):
         assert "rubio2022_case_i_sobol_cv_time_to_1e_3_s" in ds.attrs
         assert ds["time_to_target"].sizes == {"scene": 1, "method": 5}
         assert ds["time_to_target_extrapolated"].dtype == bool
+        assert ds.attrs["bench_command"] == "uq bench --quick" and "cores" in ds.attrs["machine"]
 
 
 def test_the_numpy_scans_and_uq_measure_the_same_u():
@@ -169,18 +171,22 @@ def test_paired_times_alternate_and_keep_each_side(monkeypatch):
 def test_the_json_document_gives_each_figure_its_target_and_verdict():
     from uq.bench import report
     document = report.document({"pointwise_motion_over_static": 3.5,
-                                "rubio2022_case_i_best_speedup": 12.0, "other_s": 1.0},
+                                "rubio2022_case_i_best_speedup": 12.0, "other_s": 1.0,
+                                "first_run_worst_name": "x"},
                                {"pointwise_motion_over_static": (4.0, "max"),
                                 "rubio2022_case_i_best_speedup": (20.0, "min")},
-                               report.now(), {"start": [0.5, 0.4, 0.3]})
-    rows = {row["name"]: row for row in document["figures"]}
-    assert rows["pointwise_motion_over_static"]["met"] is True
-    assert rows["rubio2022_case_i_best_speedup"]["met"] is False
-    assert rows["pointwise_motion_over_static"]["units"] == "1"
-    assert "target" not in rows["other_s"] and "met" not in rows["other_s"]
-    machine = document["machine"]
-    assert machine["usable_cores"] >= 1 and machine["memory_gib"] > 0
-    assert document["load_average"]["start"] == [0.5, 0.4, 0.3]
+                               report.now(), {"start": [0.5, 0.4, 0.3]},
+                               [("s", "mc", 1.5, True)])
+    targets = document["targets"]
+    assert targets["pointwise_motion_over_static"]["met"] is True
+    assert targets["rubio2022_case_i_best_speedup"]["met"] is False
+    assert targets["pointwise_motion_over_static"]["units"] == "1"
+    assert document["figures"]["other_s"] == 1.0 and "other_s" not in targets
+    assert document["notes"] == {"first_run_worst_name": "x"}
+    assert document["time_to_target"] == [["s", "mc", 1.5, True]]
+    assert document["machine_details"]["usable_cores"] >= 1
+    assert document["load_average"] == "start 0.50, 0.40, 0.30"
+    assert "usable cores" in document["machine"]
 
 
 def test_every_target_is_described():

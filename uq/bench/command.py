@@ -73,11 +73,16 @@ def run_bench(output, quick=False, sizes=None, repeats=None, scale=1):
         print(f"10^8 trials of the same scene: {seconds:.1f} s, peak resident memory "
               f"{megabytes:.0f} MB")
     loads["end"] = list(os.getloadavg())
+    command = "uq bench" + (" --quick" if quick else "")
+    rows = [(scene, method, seconds, extrapolated)
+            for (scene, method), (seconds, extrapolated) in targets.items()]
+    document = report.document(figures, speed.TARGETS, started, loads, rows, command)
+    dataset.attrs.update(machine=document["machine"], load_average=document["load_average"],
+                         measured_at=started, bench_command=command)
     write_netcdf(annotate(dataset), output)
     figure = plot_bench(dataset)
     save_figure(figure, output.with_suffix(".png"), dpi=120)
-    report.write(output.with_suffix(".json"),
-                 report.document(figures, speed.TARGETS, started, loads))
+    report.write(output.with_suffix(".json"), document)
     print(f"wrote {output}, {output.with_suffix('.png')} and {output.with_suffix('.json')}")
     return dataset
 

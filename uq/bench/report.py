@@ -97,26 +97,48 @@ def now():
     return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
-def document(figures, targets, started, loads):
+def machine_line(machine):
+    """:func:`machine_description` in one line."""
+    return (f"{machine['processor']}, {machine['usable_cores']} usable cores of "
+            f"{machine['logical_cores']}, {machine['memory_gib']} GiB, {machine['system']}, "
+            f"Python {machine['python']}, numpy {machine['numpy']}, numba {machine['numba']}")
+
+
+def load_line(loads):
+    """The load averages (1, 5, 15 min) at the named moments, in one line."""
+    return "; ".join(f"{moment} " + ", ".join(f"{value:.2f}" for value in values)
+                     for moment, values in loads.items())
+
+
+def document(figures, targets, started, loads, time_to_target=(), command="uq bench"):
     """The JSON document of a benchmark run: `figures` {name: value}, `targets` {name:
-    (limit, "max" or "min")}, `started` (:func:`now` at the start), `loads` {"start":,
-    "end": load averages}."""
-    rows = []
-    for name, value in figures.items():
-        row = {"name": name, "value": value}
-        if name in DESCRIPTIONS:
-            row["units"], row["description"] = DESCRIPTIONS[name]
-        if name in targets:
-            limit, sense = targets[name]
-            row["target"] = {"limit": limit, "sense": sense}
-            row["met"] = bool(value <= limit if sense == "max" else value >= limit)
-        rows.append(row)
+    (limit, "max" or "min")}, `started` (:func:`now` at the start), `loads` {moment:
+    load averages}, `time_to_target` rows (scene, method, seconds, extrapolated).
+
+    The keys the documentation's reader takes (``figures`` {name: number},
+    ``time_to_target``, ``machine``, ``load_average``, ``measured_at``, ``command``) come
+    with ``targets`` (each target's limit, sense, verdict, unit and description),
+    ``notes`` (the figures that are not numbers) and the machine's and loads' details."""
     from uq._version import __version__
     from uq.files import SIGNATURE
+    numbers = {name: value for name, value in figures.items()
+               if isinstance(value, (int, float)) and not isinstance(value, bool)}
+    rows = {}
+    for name, (limit, sense) in targets.items():
+        if name in numbers:
+            value = numbers[name]
+            units, description = DESCRIPTIONS.get(name, ("", ""))
+            rows[name] = {"value": value, "limit": limit, "sense": sense,
+                          "met": bool(value <= limit if sense == "max" else value >= limit),
+                          "units": units, "description": description}
+    machine = machine_description()
     return {"title": "uq bench", "generator": f"{SIGNATURE} {__version__}",
-            "started": started, "ended": now(),
-            "machine": machine_description(), "load_average": loads,
-            "figures": rows}
+            "command": command, "measured_at": started, "ended": now(),
+            "machine": machine_line(machine), "machine_details": machine,
+            "load_average": load_line(loads), "load_averages": loads,
+            "figures": numbers, "targets": rows,
+            "notes": {name: value for name, value in figures.items() if name not in numbers},
+            "time_to_target": [list(row) for row in time_to_target]}
 
 
 def write(path, document_):
