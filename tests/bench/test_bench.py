@@ -228,3 +228,15 @@ def test_scale_out_is_bit_identical_to_one_process():
     row = figures["workloads"]["rubio2022_misalignment"]["workers"]["2"]
     assert row["identical"] is True and row["seconds"] > 0
     assert figures["machine"]["usable_cores"] >= 1
+
+
+def test_a_child_s_peak_is_its_own_not_its_parents():
+    """child_usage (the cold-start figures) reads the child's own high-water mark: under
+    a 640 MB parent, ``uq list`` reports what it needs itself (~100 MB), not the parent."""
+    import sys
+    from uq.bench import targets
+    if not sys.platform.startswith("linux"):
+        pytest.skip("VmHWM is Linux's")
+    parent = np.ones(80_000_000)                       # 640 MB, touched
+    cpu, megabytes = targets.child_usage(["list"])
+    assert parent[-1] == 1.0 and 0 < megabytes < 500 and cpu > 0, megabytes

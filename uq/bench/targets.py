@@ -420,30 +420,59 @@ def probe_against_point(n=2**16, repeats=5):
     return tuple(times)
 
 
-def child_usage(argv, env=None, cwd=None):
-    """(CPU time [s], peak resident memory [MB]) of a child process `argv`: user + system
-    time of the process and its own children (numba compiles in the process itself),
-    and its largest resident set, from wait4's resource usage."""
-    child = subprocess.Popen(argv, env=env, cwd=cwd, stdout=subprocess.DEVNULL)
-    _, status, usage = os.wait4(child.pid, 0)
-    child.returncode = os.waitstatus_to_exitcode(status)
-    if child.returncode != 0:
-        raise RuntimeError(f"{' '.join(argv)} failed with status {child.returncode}")
-    return usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
+#: A child that runs a command of uq's and writes its peak resident memory [MB] to the
+#: file named by UQ_BENCH_PEAK_FILE: its own high-water mark (VmHWM, which starts afresh
+#: at exec) or its waited-for children's, the larger (ru_maxrss, which Linux keeps across
+#: fork and exec, would report the size of ``uq bench`` itself, ~700 MB).
+PEAK_SCRIPT = """
+import os, resource, sys
+from uq.cli import main
+try:
+    status = main(sys.argv[1:])
+finally:
+    try:
+        own = next(float(line.split()[1]) / 1024 for line in open("/proc/self/status")
+                   if line.startswith("VmHWM:"))
+    except OSError:
+        own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+    with open(os.environ["UQ_BENCH_PEAK_FILE"], "w") as file:
+        file.write(repr(max(own, children)))
+sys.exit(status)
+"""
+
+
+def child_usage(arguments, env=None, cwd=None):
+    """(CPU time [s], peak resident memory [MB]) of ``uq ARGUMENTS`` in a child process:
+    user + system time of the process and its waited-for children (numba compiles in
+    the process itself; a record-mode run's compile beside it), from wait4, and the
+    larger peak of the process and those children (:data:`PEAK_SCRIPT`)."""
+    with tempfile.NamedTemporaryFile("r", suffix=".peak") as peak:
+        child = subprocess.Popen([sys.executable, "-c", PEAK_SCRIPT, *arguments], cwd=cwd,
+                                 env={**(env or os.environ), "UQ_BENCH_PEAK_FILE": peak.name},
+                                 stdout=subprocess.DEVNULL)
+        _, status, usage = os.wait4(child.pid, 0)
+        child.returncode = os.waitstatus_to_exitcode(status)
+        if child.returncode != 0:
+            raise RuntimeError(f"uq {' '.join(arguments)} failed with status "
+                               f"{child.returncode}")
+        return usage.ru_utime + usage.ru_stime, float(peak.read())
 
 
 def cold_start(name="rubio2022_case_i", prefix="cold_start"):
-    """The README's first command, ``uq run NAME``, in a new process with an empty numba
-    cache (a fresh ``NUMBA_CACHE_DIR``: every kernel it calls compiles), then again with
-    that cache filled: {cold CPU [s], cold wall [s], cold peak RSS [MB], warm CPU [s]},
-    named ``{prefix}_cpu_s`` and so on. CPU time, not
-    wall time: on a loaded machine the wall time says how busy it is; on an idle one
+    """``uq run NAME --model compiled`` (compile what it calls first, in its own process:
+    the cost ``--model auto``, the default, leaves to a background process, measured by
+    :mod:`uq.bench.firstrun`) in a new process with an empty numba cache (a fresh
+    ``NUMBA_CACHE_DIR``), then again with that cache filled: {cold CPU [s], cold wall
+    [s], cold peak RSS [MB], warm CPU [s]}, named ``{prefix}_cpu_s`` and so on. CPU time,
+    not wall time: on a loaded machine the wall time says how busy it is; on an idle one
     the wall time of the single-threaded compile is about its CPU time (a record-mode
     run compiles in a second process beside its boxes: its wall time is the figure; its
-    peak is the larger of the two processes', wait4's resource usage)."""
+    peak is the larger of the two processes', :func:`child_usage`)."""
     with tempfile.TemporaryDirectory() as folder:
         env = {**os.environ, "NUMBA_CACHE_DIR": os.path.join(folder, "numba")}
-        argv = uq_command() + ["run", name, "-q", "-o", os.path.join(folder, "out.nc")]
+        argv = ["run", name, "-q", "--model", "compiled", "-o",
+                os.path.join(folder, "out.nc")]
         started = time.perf_counter()
         cold_cpu, cold_mb = child_usage(argv, env)
         cold_wall = time.perf_counter() - started
