@@ -251,3 +251,17 @@ def test_least_squares_interval_carries_the_data_uncertainty(results):
     assert posterior / 1.5 < least <= posterior * 1.05, (least, posterior)
     assert "least squares, propagated: the given covariance (it explains the residuals" \
         in fit_table(fit)
+
+
+def test_fit_figures_are_readable(fitted):
+    """The profile-fit figure and the corner plot pass the figure hygiene check (no
+    clipped or overlapping text, legends that match what is drawn)."""
+    import matplotlib.pyplot as plt
+    from tests.outputs.figure_hygiene import problems
+    from uq.fit.plots import plot_profile_fit
+    for draw in (plot_profile_fit, plot_corner):
+        figure = draw(fitted)
+        try:
+            assert problems(figure) == [], draw.__name__
+        finally:
+            plt.close(figure)

@@ -84,14 +84,14 @@ def test_plot_and_report_commands(results, tmp_path, capsys):
     page = (tmp_path / "tilt_report.html").read_text()
     images = re.findall(r"src='data:image/png;base64,([^']+)'", page)
     assert len(images) == 2 and all(base64.b64decode(i)[:4] == b"\x89PNG" for i in images)
-    for section in ("Campaign-planning answers", "Uncertainty budget", "Bias",
+    for section in ("<h2>Each output", "Uncertainty budget", "Bias",
                     "Findings of Rubio", "Scenario as run", "tilt lowers u(Vh)"):
         assert section in page, section
     assert "http" not in page.replace("http-equiv", "")   # self-contained: no links out
 
 
 def test_report_answers_the_planning_questions(results):
-    page = render_report(results["rubio2022_velocity_ratio"], targets=(0.06,))
+    page = render_report(results["rubio2022_velocity_ratio"], targets={"wind_speed": (0.06,)})
     assert "Largest velocity ratio" in page and "0.06" in page
     page = render_report(results["rubio2022_misalignment"])
     assert "Best misalignment" in page
@@ -120,8 +120,10 @@ def test_a_single_scene_has_figures_and_its_report_the_single_scene_ones(tmp_pat
     page = render_report(single)
     assert len(re.findall("<img ", page)) == len(re.findall("<figcaption><b>[a-z_]+.</b> [A-Za-z]",
                                                              page)) == 4
-    answers = page.split("Campaign-planning answers")[1].split("<h2>Figures")[0]
-    assert "for 3 of 3 (3 range gates)" in answers and "scene" not in answers
+    outputs = page.split("<h2>Each output")[1].split("<h2>Figures")[0]
+    assert re.search(r"\d+ (validated|not validated|undecided)[a-z, 0-9]* of 3 "
+                     r"\(3 range gates\)", outputs)
+    assert "scene" not in outputs.split("<h2>Scene by scene")[0]
 
 
 def test_every_requested_output_is_shown(tmp_path):
@@ -134,9 +136,10 @@ def test_every_requested_output_is_shown(tmp_path):
     single = uq.run(uq.load_scenario(ROOT / "scenarios" / "floating_lidar_full.yaml",
                                      {"sampling.n": 4000}))
     page = render_report(single)
-    for words in ("gate height", "radial velocity"):
-        assert f"Uncertainty budget of {words}" in page and f"<h3>u({words})" in page
-        assert f"<h4>Bias: {words}</h4>" in page
+    for words in ("Gate height", "Radial velocity"):
+        section = page.split(f"<h3>{words}</h3>")[1].split("<h3>")[0]
+        assert "<h4>Uncertainty budget</h4>" in section and "<h4>Bias</h4>" in section
+        assert f"<h3>u({words.lower()})" in page
     assert "beam at 90 deg" in page and "vertical beam" in page
     assert "gate_height" in sweep_quantities(single)
     failed = ~single["gate_height_gum_valid"].values
@@ -153,7 +156,8 @@ def test_report_says_zero_for_rounding_and_folds_the_scenario(results):
     rounding, is reported as none (within NUMERICAL_ZERO), not as a finding; the vertical
     wind has no uncertainty at all and says so; the scenario is folded."""
     page = render_report(results["rubio2022_case_i"])
-    bias = page.split("<h4>Bias: wind speed</h4>")[1].split("</p>")[0]
+    speed = page.split("<h3>Wind speed</h3>")[1].split("<h3>")[0]
+    bias = speed.split("<h4>Bias</h4>")[1].split("</p>")[0]
     assert "none (at most" in bias and "e-1" not in bias.split("within")[1]
     assert "No uncertainty in these scenes" in page
     assert re.search(r"<details><summary>the scenario's YAML \(\d+ lines", page)
@@ -235,7 +239,7 @@ def test_a_correction_sweep_gets_a_budget_column_per_correction():
                  "ship": {"sog": 2.0}, "sampling": {"method": "none"},
                  "outputs": ["wind_direction"], "sweep": {"correction": ["none", "yaw"]}})
     page = render_report(ds)
-    budget = page.split("Uncertainty budget of wind direction")[1].split("</table>")[0]
+    budget = page.split("<h3>Wind direction</h3>")[1].split("</table>")[0]
     assert "share, none" in budget and "share, yaw" in budget
     assert "<td>ins.heading</td><td>-</td><td>100.0 %</td>" in budget, budget
 

@@ -6,6 +6,7 @@ import xarray as xr
 
 matplotlib.use("Agg")
 
+import uq  # noqa: E402
 from uq.outputs import figures, recordfigures  # noqa: E402
 from uq.pipeline.records import spectral_variances  # noqa: E402
 from uq.pipeline.scenario import load_scenario  # noqa: E402
@@ -55,22 +56,6 @@ def test_record_plan_only_in_record_mode():
     assert "record_plan" in dir(figures.recordfigures)
 
 
-def test_summary_reports_record_mode():
-    from uq.outputs.summary import summary_table
-    ds = xr.Dataset({
-        "turbulence_intensity_true": ((), 0.095),
-        "turbulence_intensity_spectral": (("range",), [0.0886, 0.0857]),
-        "turbulence_intensity_mc_mean": (("range",), [0.0873, 0.0835]),
-        "turbulence_intensity_mc_low": (("range",), [0.0807, 0.0754]),
-        "turbulence_intensity_mc_high": (("range",), [0.1, 0.0944]),
-        "turbulence_intensity_spectral_valid": (("range",), [True, False])},
-        coords={"range": [40.0, 100.0]})
-    lines = summary_table(ds).splitlines()
-    assert "turbulence intensity over a record [%]: true 9.5" in lines
-    assert "  apparent @100 m: spectral 8.57, Monte Carlo 8.35 (95 % of records 7.54 to " \
-           "9.44); spectral validated 0/1" in lines
-
-
 SMALL = {"name": "small", "wind": {"speed": 10.0, "direction": 180.0, "reference_height": 100.0},
          "lidar": {"height": 0.0, "ranges": [60.0, 100.0], "half_cone": 30.0,
                    "scan": {"beam_duration": 0.5},
@@ -78,6 +63,24 @@ SMALL = {"name": "small", "wind": {"speed": 10.0, "direction": 180.0, "reference
          "turbulence": {"intensity": 0.1}, "record": {"duration": 30, "count": 3},
          "sampling": {"n": 64, "seed": 7}, "outputs": ["wind_speed"],
          "sweep": {"turbulence.intensity": [0.05, 0.1]}}
+
+
+def test_summary_lists_each_scenes_turbulence_intensities():
+    """A record-mode sweep's summary has a row per scene and gate under its swept values,
+    each TI the stored one, named for what it is (the field's point TI, the field's over a
+    record, the lidar's spectral and records' TI)."""
+    from uq.outputs.summary import TI_COLUMNS, TI_LEGEND, summary_table
+    ds = uq.run(SMALL)
+    lines = summary_table(ds).splitlines()
+    start = lines.index(TI_LEGEND)
+    header = lines[start + 1].split()
+    assert header[:3] == ["turbulence.intensity", "range", "gate"]
+    rows = [line.split() for line in lines[start + 2:start + 6]]
+    for row, (intensity, gate) in zip(rows, [(0.05, 60.0), (0.05, 100.0), (0.1, 60.0),
+                                              (0.1, 100.0)]):
+        at = ds.sel(turbulence_intensity=intensity, range=gate)
+        assert row[:3] == [f"{intensity:g}", f"{gate:g}", f"{100 * intensity:.4g}"]
+        assert row[3:3 + 6] == [f"{100 * float(at[n]):.4g}" for n in TI_COLUMNS.values()]
 
 
 def test_spectra_figure_reads_what_the_run_stored_and_an_older_file_draws_it_again(capsys):
@@ -88,16 +91,17 @@ def test_spectra_figure_reads_what_the_run_stored_and_an_older_file_draws_it_aga
     import matplotlib.pyplot as plt
     from uq.pipeline.runner import run
     ds = run({**SMALL, "turbulence": {"intensity": 0.1}})
-    settings = recordfigures.file_settings(ds)
+    settings, chosen, words = recordfigures.shown_scene(ds, lines=("correction",))
+    assert chosen == {"turbulence_intensity": 0.1} and words == "turbulence.intensity = 0.1"
     stored = recordfigures.spectra_lines(recordfigures.record_spectra_data(ds, settings),
-                                         settings)
+                                         chosen, settings)
     np.testing.assert_array_equal(stored[1], ds["record_psd_u_true"].sel(
         turbulence_intensity=0.1).values)
     assert list(stored[2]) == ["lidar, fixed"]
     assert capsys.readouterr().err == ""
     older = ds.drop_vars([name for name in ds.variables if name.startswith("record_")])
     again = recordfigures.spectra_lines(recordfigures.record_spectra_data(older, settings),
-                                        settings)
+                                        chosen, settings)
     assert "no stored record spectra" in capsys.readouterr().err
     for one, two in zip(stored, again):
         if isinstance(one, dict):
@@ -105,3 +109,25 @@ def test_spectra_figure_reads_what_the_run_stored_and_an_older_file_draws_it_aga
             one, two = list(one.values()), list(two.values())
         np.testing.assert_array_equal(one, two)
     plt.close(recordfigures.record_spectra(ds))
+
+
+def test_record_figures_draw_the_selected_scene():
+    """`uq plot --select turbulence_intensity=0.05`: the spectra are that scene's stored
+    ones and the budget that scene's (not the file's intensity, 0.1), and the titles
+    say which scene they draw."""
+    import matplotlib.pyplot as plt
+    from uq.outputs.figures import select_scenes
+    ds = uq.run({**SMALL, "turbulence": {"intensity": 0.1}})
+    at = select_scenes(ds, {"turbulence_intensity": "0.05"})
+    settings, chosen, words = recordfigures.shown_scene(at, lines=("correction",))
+    assert settings["turbulence"]["intensity"] == 0.05 and chosen == {}
+    lines = recordfigures.spectra_lines(recordfigures.record_spectra_data(at, settings),
+                                        chosen, settings)
+    np.testing.assert_array_equal(lines[1], ds["record_psd_u_true"].sel(
+        turbulence_intensity=0.05).values)
+    for function in (recordfigures.record_spectra, recordfigures.ti_budget):
+        figure = function(at)
+        titles = [figure._suptitle.get_text() if figure._suptitle else ""] + \
+            [ax.get_title() for ax in figure.axes]
+        assert any("turbulence.intensity = 0.05" in t.replace("\n", " ") for t in titles)
+        plt.close(figure)

@@ -522,6 +522,7 @@ def _mc_variables(runner, gum_results, circular, digits):
         value = gum_results[f"{q}_gum_value"][1]
         result = runner.result(q)
         error = runner.numerical_error(q)
+        delta = gum.numerical_tolerance(u_gum, digits)    # clause 8's delta (JCGM 101 8.2)
         _warn_overflow(q, result)
         data.update({
             f"{q}_mc_mean": (dims, result["mean"]),
@@ -534,8 +535,8 @@ def _mc_variables(runner, gum_results, circular, digits):
             f"{q}_mc_numerical_tolerance": (dims, gum.numerical_tolerance(result["u"], digits)),
             f"{q}_gum_valid": (dims, gum.gum_interval_valid(
                 value, u_gum, result["low"], result["high"], digits, q in circular)),
-            f"{q}_gum_validation_conclusive": (dims, error <= gum.numerical_tolerance(u_gum,
-                                                                                     digits)),
+            f"{q}_gum_validation_tolerance": (dims, delta),
+            f"{q}_gum_validation_conclusive": (dims, error <= delta),
         })
         if q in circular:
             data[f"{q}_mc_circular_std"] = (dims, result["circular_std"])

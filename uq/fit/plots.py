@@ -7,6 +7,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+
+from uq.outputs import layout  # noqa: E402
 
 LABELS = {"reference_speed": "$U_{ref}$ [m s$^{-1}$]", "shear": r"$\alpha$ [1]",
           "friction_velocity": "$u_*$ [m s$^{-1}$]", "roughness_length": r"ln $z_0$ [ln m]",
@@ -98,9 +101,15 @@ def plot_corner(dataset, fit=None):
                            show_titles=True, title_fmt=".3g", title_kwargs={"fontsize": 9},
                            label_kwargs={"fontsize": 9}, truths=truths, truth_color="C3",
                            quiet=True)   # corner nudges degenerate contour levels itself
-    figure.suptitle(f"posterior: {name} (median, 95 % interval; axes: central "
+    figure.subplots_adjust(top=0.86, left=0.14, bottom=0.2, wspace=0.15, hspace=0.15)
+    layout.suptitle(figure, f"posterior: {name} (median, 95 % interval; axes: central "
                     f"{100 * CORNER_RANGE:g} % of {len(samples)} draws)", fontsize=10)
-    figure.subplots_adjust(top=0.9, left=0.14, bottom=0.14)
+    key = [Line2D([], [], color="k", label="posterior: histograms, density contours"),
+           Line2D([], [], color="k", ls="--", label="2.5, 50 and 97.5 % quantiles")]
+    if truths is not None:
+        key.append(Line2D([], [], color="C3", label="true value"))
+    figure.legend(handles=key, loc="lower center", fontsize=8, frameon=False,
+                  ncols=layout.legend_columns(figure, [h.get_label() for h in key], 8))
     return figure
 
 

@@ -130,7 +130,11 @@ def _turbulence(config, unit, reference, centres, scenario):
         return {}
     stats = turbulence.ti_bin_kpis(reference[name].values, unit[name].values,
                                    reference["speed"].values, centres, config.bin_width)
+    copied = turbulence.copies(reference[name].values, unit[name].values)
+    if copied:                  # not a measurement of the unit: no error to state
+        stats.update({k: np.full_like(stats[k], np.nan) for k in turbulence.UNIT_STATISTICS})
     data = {f"ti_{k}": ("bin", v) for k, v in stats.items()}
+    data["ti_unit_copies_reference"] = ((), copied)
     for kpi_name in turbulence.TI_KPIS:
         data[f"ti_{kpi_name}_verdict"] = ("bin", turbulence.band_verdicts(
             stats[kpi_name], config.ti_bands.get(kpi_name)))
@@ -357,6 +361,8 @@ METADATA = {
                            "with a scenario"),
     "ti_predicted_mean": ("percent", "apparent TI the unit is predicted to read: reference "
                           "mean TI times sqrt(ti_predicted_ratio)"),
+    "ti_unit_copies_reference": ("", "the unit's TI is the reference's record for record (not "
+                                 "a measurement: its TI statistics are NaN)"),
     "time": ("", "start of the paired 10-min record"),
     "comparison": ("", "comparison: unit-reference"),
     "framework": ("", "framework of the deviation term: iec (IEC 61400-12-1) or lusr"),

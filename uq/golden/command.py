@@ -78,7 +78,8 @@ def _write(ds, folder, name):
     (folder / "figures").mkdir(exist_ok=True)
     write_netcdf(ds, folder / f"{name}.nc")
     for table, frame in golden_tables(ds).items():
-        write_text(folder / "tables" / f"{table}.csv", frame.to_csv(float_format="%.6g"))
+        write_text(folder / "tables" / f"{table}.csv",
+                   with_units(frame, ds).to_csv(float_format="%.6g"))
     height = float(ds["height"].max())
     figures = {}
     drawings = {"scatter": (plots.plot_scatter, "Unit against reference with the KPI "
@@ -112,6 +113,25 @@ def golden_tables(ds):
         tables["turbulence"] = ds[[v for v in ds.data_vars if v.startswith("ti_")
                                    and "bin" in ds[v].dims]].to_dataframe()
     return tables
+
+
+#: Columns whose unit depends on the row's environmental variable (no one CF unit).
+PER_VARIABLE_UNITS = {"slope": "percent per unit of the variable",
+                      "slope_standard_error": "percent per unit of the variable"}
+
+
+def with_units(frame, ds):
+    """The table with each column's and index's unit in its header (``bin [m s-1]``),
+    as the Dataset's ``units`` give them (UDUNITS; a variable without units, a name or
+    a verdict, keeps its bare name)."""
+    def named(name):
+        units = ds[name].attrs.get("units") if name in ds.variables else None
+        if name in PER_VARIABLE_UNITS:
+            units = PER_VARIABLE_UNITS[name]
+        return f"{name} [{units}]" if units else name
+    frame = frame.rename(columns=named)
+    frame.index = frame.index.set_names([named(n) for n in frame.index.names])
+    return frame
 
 
 def _summary(ds):

@@ -45,7 +45,7 @@ def plot_scatter(ds, height):
 
 def _scatter_speed(ax, c):
     x, y = c["paired_reference_speed"].values, c["paired_unit_speed"].values
-    ax.plot(x, y, ".", ms=1.5, alpha=0.3, color="grey")
+    ax.plot(x, y, ".", ms=1.5, alpha=0.3, color="grey", label="10-min records")
     top = np.nanmax(x)
     slope = float(c["speed_slope"])
     ax.plot([0, top], [0, top], "k:", lw=1, label="1:1")
@@ -60,9 +60,9 @@ def _scatter_direction(ax, c):
     x = np.mod(c["paired_reference_direction"].values, 360.0)
     y = c["paired_unit_direction"].values
     y = x + np.mod(y - x + 180.0, 360.0) - 180.0          # wrap-around, as in the KPI
-    ax.plot(x, y, ".", ms=1.5, alpha=0.3, color="grey")
+    ax.plot(x, y, ".", ms=1.5, alpha=0.3, color="grey", label="10-min records")
     slope, offset = float(c["direction_slope"]), float(c["direction_offset"])
-    ax.plot([0, 360], [0, 360], "k:", lw=1)
+    ax.plot([0, 360], [0, 360], "k:", lw=1, label="1:1")
     ax.plot([0, 360], [offset, offset + 360 * slope], "r-", lw=1.2,
             label=f"y = {slope:.4f} x {offset:+.2f}°, R² = "
             f"{float(c['direction_r_squared']):.4f}")
@@ -86,7 +86,8 @@ def plot_deviation_against_environment(ds, height):
         for ax, variable in zip(row, variables):
             x = c["paired_environment"].sel(variable=variable).values
             x = np.where(np.isfinite(deviation), x, np.nan)        # the records regressed
-            ax.plot(x, deviation, ".", ms=1.5, alpha=0.25, color="grey")
+            ax.plot(x, deviation, ".", ms=1.5, alpha=0.25, color="grey",
+                    label="10-min records")
             s = c.sel(variable=variable)
             line = np.nanpercentile(x, [0.5, 99.5])
             ax.set_xlim(line)
@@ -145,15 +146,21 @@ def plot_turbulence(ds, height):
         top, bottom = axes[0][column], axes[1][column]
         top.plot(c["bin"], c["ti_reference_mean"], "o-", ms=3,
                  label=f"{_name(c, 'reference')} (reference)")
-        top.plot(c["bin"], c["ti_unit_mean"], "s-", ms=3, label=f"{_name(c, 'unit')} measured")
+        copied = bool(c.get("ti_unit_copies_reference", False))
+        if not copied:           # a copy of the reference's TI is not the unit's measurement
+            top.plot(c["bin"], c["ti_unit_mean"], "s-", ms=3,
+                     label=f"{_name(c, 'unit')} measured")
         if np.isfinite(float(c["ti_predicted_ratio"])):
             top.plot(c["bin"], c["ti_predicted_mean"], "--", color="k",
                      label=f"{_name(c, 'unit')} predicted by uq")
         top.set(ylabel="mean turbulence intensity [%]")
-        top.set_title(f"{_pair(c)}, {height:g} m", fontsize=10)
+        top.set_title(f"{_pair(c)}, {height:g} m" + (
+            f"\n{_name(c, 'unit')}'s TI: the reference's, not measured" if copied else ""),
+            fontsize=9)
         top.legend(fontsize=7)
         bottom.axhline(0.0, color="0.6", lw=0.8)
-        bottom.plot(c["bin"], c["ti_mean_bias"], "o-", ms=3, label="measured")
+        if not copied:
+            bottom.plot(c["bin"], c["ti_mean_bias"], "o-", ms=3, label="measured")
         bottom.plot(c["bin"], c["ti_predicted_mean"] - c["ti_reference_mean"], "--",
                     color="k", label="predicted")
         bottom.set(xlabel="reference wind speed bin [m/s]",

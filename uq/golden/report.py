@@ -50,12 +50,75 @@ def report_blocks(ds, figures, height):
                ("table", ["comparison", "height [m]", "variable", "slope [%/unit]",
                           "std. error", "p", "R²", "records", "significant"],
                 _sensitivity_rows(ds)),
-               ("h2", f"Calibration uncertainty per bin at {height:g} m (Eqs. 2-3)")]
+               ]
+    blocks += _classification_blocks(ds)
+    blocks += _smc_blocks(ds, height)
+    blocks += [("h2", f"Calibration uncertainty per bin at {height:g} m (Eqs. 2-3)")]
     blocks += _calibration_tables(ds, height)
     blocks += _turbulence_blocks(ds, height)
     blocks += [("h2", "Figures")] + [("figure", path, caption)
                                      for caption, path in figures.items()]
     return blocks
+
+
+def _classification_blocks(ds):
+    """The class number of each comparison and height (IEC 61400-12-1 Annex L: the
+    largest sum of the significant slopes' effects over the variables' ranges) and the
+    classification uncertainty each route gives over the required bins."""
+    required = np.flatnonzero(ds["required"].values)
+    rows = []
+    for k in ds["comparison"].values:
+        for h in ds["height"].values:
+            c = ds.sel(comparison=k, height=h).isel(bin=required)
+            rows.append([str(k), f"{h:g}", _cell(float(c["class_number"])),
+                         _span(c["classification_class_number"].values),
+                         _span(c["classification_per_variable"].values),
+                         _span(c["classification"].values)])
+    return [("h2", "Classification (IEC 61400-12-1 Annex L)"),
+            ("p", f"Route used: {ds.attrs.get('route', '')}. The class number [%] comes from "
+             "the significant sensitivity slopes over the classification ranges; its "
+             "uncertainty is class number / sqrt(3) % of the bin's speed. The per-variable "
+             "route (Eq. 1) uses the SMC's environmental means against the verification's. "
+             "Each column gives the smallest and largest value over the required bins "
+             "[m/s]."),
+            ("table", ["comparison", "height [m]", "class number [%]",
+                       "u_class, class-number route [m/s]",
+                       "u_class, per-variable route (SMC) [m/s]", "u_class used [m/s]"],
+             rows)]
+
+
+def _smc_blocks(ds, height):
+    """The specific measurement campaign the configuration names: its records per bin
+    and its environmental means against the verification campaign's, at `height`."""
+    if "smc_n_records" not in ds:
+        return [("h2", "Specific measurement campaign (SMC)"),
+                ("p", "The configuration names no SMC (golden.smc): the per-variable route "
+                 "has no campaign to apply the slopes to.")]
+    required = np.flatnonzero(ds["required"].values)
+    c = ds.sel(height=height).isel(comparison=0, bin=required)
+    first = str(ds["comparison"].values[0])
+    records = int(np.nansum(ds["smc_n_records"].sel(height=height).isel(comparison=0)))
+    rows = [[f"{b:g}", str(int(c["smc_n_records"].values[i]))]
+            + [_cell(c["verification_mean"].sel(variable=v).values[i]) + " / "
+               + _cell(c["smc_mean"].sel(variable=v).values[i])
+               for v in ds["variable"].values]
+            for i, b in enumerate(c["bin"].values)]
+    return [("h2", f"Specific measurement campaign (SMC) at {height:g} m"),
+            ("p", f"{records} SMC records at {height:g} m. Per required bin: the SMC's "
+             "records and each environmental variable's mean in the verification campaign "
+             f"(as the reference of {first} measured it) / in the SMC, in the variable's "
+             "own units; the per-variable classification (Eq. 1) applies each comparison's "
+             "sensitivity slopes to that difference."),
+            ("table", ["bin [m/s]", "SMC records"] + [f"{v}: verification / SMC"
+                                                      for v in ds["variable"].values], rows)]
+
+
+def _span(values):
+    values = np.asarray(values, float)
+    if not np.isfinite(values).any():
+        return ""
+    low, high = np.nanmin(values), np.nanmax(values)
+    return _cell(low) if np.isclose(low, high) else f"{_cell(low)} to {_cell(high)}"
 
 
 def _campaign_rows(ds):
@@ -88,6 +151,13 @@ def _finding_blocks(ds, height):
     blocks = [("h2", f"Golden lidar: {unit} against {golden} and against {mast}")]
     for r in rows:
         fw = "IEC 61400-12-1" if r["framework"] == "iec" else "LUSR"
+        lower = r["calibration_golden"] < r["calibration_mast"]
+        blocks.append(("p", (
+            f"**{fw}: the golden lidar {'lowers' if lower else 'does not lower'} {unit}'s "
+            f"calibration uncertainty** at {height:g} m: {r['calibration_golden']:.4f} m/s "
+            f"with {golden} as reference against {r['calibration_mast']:.4f} m/s with the "
+            f"{mast} (mean over {r['bins']} bins; lower in "
+            f"{r['bins_calibration_smaller']} of them).")))
         blocks.append(("p", (
             f"{fw}, {height:g} m, {r['bins']} bins: the deviation term of {unit} is "
             f"{r['deviation_golden']:.4f} m/s with {golden} as reference and "
@@ -183,6 +253,10 @@ def _turbulence_blocks(ds, height):
                 for i, b in enumerate(c["bin"].values) if c["ti_n_records"].values[i] > 0]
         note = (f"predicted u-variance ratio {ratio:.3f} (TI x {np.sqrt(ratio):.3f})"
                 if np.isfinite(ratio) else "no scenario: no prediction")
+        if bool(c.get("ti_unit_copies_reference", False)):
+            note += (f"; {c['unit'].values}'s TI is {c['reference'].values}'s, record for "
+                     "record (a synthetic campaign's lidars carry the mast's TI): not a "
+                     "measurement, so no TI error is stated")
         blocks += [("h3", f"{k}: {note}"),
                    ("table", ["bin [m/s]"] + [h for _, h in TI_COLUMNS] + ["verdicts"], rows)]
     return blocks
@@ -225,7 +299,7 @@ def render_html(blocks):
         if kind in ("h1", "h2", "h3"):
             parts.append(f"<{kind}>{_e(block[1])}</{kind}>")
         elif kind == "p" and block[1]:
-            parts.append(f"<p>{_e(block[1])}</p>")
+            parts.append(f"<p>{_strong(_e(block[1]))}</p>")
         elif kind == "table":
             head = "".join(f"<th>{_e(h)}</th>" for h in block[1])
             body = "".join("<tr>" + "".join(f"<td>{_e(c)}</td>" for c in row) + "</tr>"
@@ -237,6 +311,12 @@ def render_html(blocks):
                          f"<figcaption>{_e(block[2])}</figcaption></figure>")
     parts.append("</body></html>")
     return "\n".join(parts)
+
+
+def _strong(text):
+    """Markdown's ``**bold**`` as HTML's ``<b>bold</b>`` (in escaped text)."""
+    parts = text.split("**")
+    return "".join(f"<b>{p}</b>" if k % 2 else p for k, p in enumerate(parts))
 
 
 def _e(text):

@@ -51,6 +51,20 @@ TI_KPIS = {"mean_bias": "percent", "relative_error": "1", "rmse": "percent",
 PREDICTION_INTENSITY = 0.1
 
 
+#: The statistics of the unit's own TI (NaN where its TI is a copy of the reference's).
+UNIT_STATISTICS = ("unit_mean", "mean_bias", "relative_error", "rmse", "unit_representative",
+                   "representative_error")
+
+
+def copies(reference_ti, unit_ti):
+    """Is the unit's TI the reference's, record for record (every record where both have
+    one, and at least one)? A synthetic campaign whose lidars carry the mast's TI, say:
+    then there is no TI error to measure, and an error of exactly zero would read as one."""
+    ref, unit = np.asarray(reference_ti, float), np.asarray(unit_ti, float)
+    both = np.isfinite(ref) & np.isfinite(unit)
+    return bool(both.any() and np.array_equal(ref[both], unit[both]))
+
+
 def ti_bin_kpis(reference_ti, unit_ti, reference_speed, centres, width):
     """Per-bin TI statistics and KPIs (module docstring); arrays of shape (n_bins,)."""
     ref, unit = np.asarray(reference_ti, float), np.asarray(unit_ti, float)

@@ -35,7 +35,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 
 from uq.errors import ScenarioError  # noqa: E402
 from uq.files import check_target, output_folder, save_figure  # noqa: E402
-from uq.outputs import motionfigures, plots, recordfigures  # noqa: E402
+from uq.outputs import layout, motionfigures, plots, recordfigures  # noqa: E402
 from uq.outputs.labels import MODELS as LABEL_MODELS  # noqa: E402
 from uq.outputs.labels import coordinate_label, model_style  # noqa: E402
 from uq.outputs.planning import VELOCITY_RATIOS, velocity_ratio_line  # noqa: E402
@@ -226,7 +226,7 @@ def fig5_radial_against_direction(dataset):
         axes[row, -1].legend(handles=handles, title=tilt.split("_")[1], fontsize=7,
                              title_fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1))
     styles = [Line2D([], [], **{**model_style(m), "color": "k"}) for m in models]
-    figure.legend(handles=styles, fontsize=7, loc="outside lower center", ncols=len(styles))
+    layout.legend_below(figure, styles, [h.get_label() for h in styles], fontsize=7)
     return figure
 
 
@@ -343,11 +343,32 @@ CAPTIONS = {
     "biases Vh low in every direction; a sinusoidal tilt during the scan biases it up or "
     "down with the wind direction, by far more than the same static tilt. The title states "
     "the time-stamp and phase conventions.",
-    "motion_correction_comparison": "The scatter of the reconstructed minus the true "
-    "horizontal and vertical wind, per correction model, from the run's own trials; the "
-    "bars are bias +- u. One INS reading per scan applied to beams measured at other "
-    "phases of the motion (full) can scatter more than no correction; point-wise "
-    "correction removes the motion.",
+    "motion_correction_comparison": "Histograms (probability density, a step line per "
+    "correction model) of the reconstructed minus the true horizontal wind speed and "
+    "vertical wind, from the run's own trials drawn again; the legend gives each model's "
+    "bias and u, the title the range gate shown. One INS reading per scan applied to beams "
+    "measured at other phases of the motion (full) can scatter more than no correction; "
+    "point-wise correction removes the motion.",
+    "record_spectra": "Power spectral densities, once a scan, of one beam's radial velocity "
+    "(left) and of the horizontal wind speed the lidar reports (right), the mean over the "
+    "run's Monte Carlo records of each record's periodogram: the field's u at the reference "
+    "point (thick), the lidar at rest and moving with each swept correction; the dashed "
+    "line is the -5/3 slope of the inertial range, the dotted one where the motion's peak "
+    "folds into the once-a-scan sampling. The title names the scene and range gate.",
+    "ti_budget": "What makes the lidar's apparent TI differ from the field's: the record "
+    "variance of the reported wind speed split into the field's own u-variance and what "
+    "the beams' separation, the scan's timing and the probe volume take away (negative "
+    "bars), then the per-scan errors the motion, the INS and the noise add (spectral path "
+    "and the GUM of one scan); the bars add up to the total in the legend. The title names "
+    "the scene.",
+    "apparent_against_true_ti": "The lidar's apparent TI against the field's TI over a "
+    "record, which it is compared with (not the point TI the scenario sets, on the top "
+    "axis): the spectral path's expectation (line) and the Monte Carlo records' mean with "
+    "the 95 % of records (markers), each against its own field TI; on the dashed line the "
+    "lidar would read the field's TI.",
+    "uncertainty_against_preview": "u of the hub-height wind speed, the yaw misalignment "
+    "and the shear exponent against the preview distance, a colour per correction model: "
+    "Monte Carlo as markers, the GUM as dashed lines, on a log scale.",
     "probe_bias_against_range": "The systematic error of the horizontal wind speed from "
     "the probe volume (the radial velocities weighted along the beams, minus the same at "
     "the gate centres) against the range gate, a line per probe kind. Under a power-law "
@@ -570,8 +591,9 @@ def mark_selection(figure, dataset, select):
         f"{coordinate_label(dataset, dim).split(' [')[0]} = {_text(dataset[dim].values.item())}"
         + (f" {dataset[dim].attrs['units']}" if dataset[dim].attrs.get("units") else "")
         for dim in select)
-    title = figure._suptitle.get_text() if figure._suptitle is not None else ""
-    figure.suptitle(f"{title}\n{text}" if title else text, fontsize=9)
+    title = figure._suptitle.get_text().replace("\n", " ") \
+        if figure._suptitle is not None else ""
+    layout.suptitle(figure, f"{title}\n{text}" if title else text, fontsize=9)
     return figure
 
 

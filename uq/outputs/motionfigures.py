@@ -24,7 +24,8 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
-from uq.outputs.samples import HISTOGRAM_TRIALS, trials_with  # noqa: E402
+from uq.outputs import layout  # noqa: E402
+from uq.outputs.samples import HISTOGRAM_TRIALS, scene_assignments, trials_with  # noqa: E402
 
 TILT_DIMENSIONS = ("motion_pitch_amplitude", "ship_pitch", "motion_roll_amplitude",
                    "ship_roll")
@@ -51,7 +52,8 @@ def tiana_plan(dataset, dims):
 
 def tiana2017_error_map(dataset, tilt):
     """HWS error (error-free reconstruction minus truth) [m s-1] over wind direction and
-    tilt amplitude, diverging colours centred on 0, with contours."""
+    tilt amplitude, diverging colours centred on 0, with contours (their levels marked on
+    the colour bar: labels in the map would collide)."""
     error = (dataset["wind_speed_nominal"] - dataset["wind_speed_true"]).transpose(
         tilt, "wind_direction").values
     x, y = dataset["wind_direction"].values, dataset[tilt].values
@@ -59,11 +61,12 @@ def tiana2017_error_map(dataset, tilt):
     figure, ax = plt.subplots(figsize=(7.2, 4.2), constrained_layout=True)
     mesh = ax.pcolormesh(x, y, error, cmap="RdBu_r", vmin=-limit, vmax=limit,
                          shading="nearest")
+    bar = figure.colorbar(mesh, ax=ax, label="HWS error, reconstructed minus true "
+                          "[m s$^{-1}$]")
     levels = [v for v in CONTOURS if np.nanmin(error) < v < np.nanmax(error)]
     if levels:
         lines = ax.contour(x, y, error, levels=levels, colors="k", linewidths=0.6)
-        ax.clabel(lines, fmt="%.2f", fontsize=7)
-    figure.colorbar(mesh, ax=ax, label="HWS error, reconstructed minus true [m s$^{-1}$]")
+        bar.add_lines(lines)
     ax.set_xlabel("wind direction [deg]")
     ax.set_ylabel(_tilt_label(tilt))
     scenario = yaml.safe_load(dataset.attrs.get("scenario", "")) or {}
@@ -137,28 +140,33 @@ def uncertainty_against_preview(dataset):
     axes[0][0].legend(fontsize=8)
     scenario = yaml.safe_load(dataset.attrs.get("scenario", "")) or {}
     n = int(np.max(dataset["mc_n_samples"]))
-    figure.suptitle(f"{scenario.get('name', '')}: {_sea(scenario)}; {n} Monte Carlo scans "
-                    "per model", fontsize=9)
+    layout.suptitle(figure, f"{scenario.get('name', '')}: {_sea(scenario)}; {n} Monte Carlo "
+                    "scans per model", fontsize=9)
     return figure
 
 
 def correction_comparison(dataset, n_max=HISTOGRAM_TRIALS):
-    """Histograms of (reconstructed - true) horizontal wind speed and vertical wind for
-    each correction model, from the run's own trials (drawn again), with bias +- u."""
+    """Histograms (density, step lines) of the reconstructed minus the true horizontal
+    wind speed and vertical wind for each correction model, from the run's own trials
+    (drawn again), the legend giving each model's bias and u; with several range gates,
+    at the middle one (the title says which)."""
     corrections = [str(c) for c in dataset["correction"].values]
+    gate = dataset.sizes["range"] // 2 if "range" in dataset.dims else 0
     quantities = [q for q in ("wind_speed", "vertical_wind") if f"{q}_mc_u" in dataset]
     figure, axes = plt.subplots(1, len(quantities), figsize=(5.2 * len(quantities), 4.0),
                                 constrained_layout=True, squeeze=False)
-    trials = {c: trials_with(dataset, {"correction": c}, tuple(quantities), n_max)
+    trials = {c: trials_with(dataset, scene_assignments(dataset, {"correction": c}),
+                                 tuple(quantities), n_max)
               for c in corrections}
     for ax, q in zip(axes[0], quantities):
-        errors = {c: trials[c][q][:, 0] - float(_at(dataset, f"{q}_true", c))
+        errors = {c: trials[c][q][:, gate] - float(_at(dataset, f"{q}_true", c, gate))
                   for c in corrections}
         for c in corrections:                 # each model on bins of its own spread
             finite = errors[c][np.isfinite(errors[c])]
             edges = np.linspace(*np.percentile(finite, [0.1, 99.9]), HISTOGRAM_BINS)
-            bias = float(_at(dataset, f"{q}_mc_mean", c) - _at(dataset, f"{q}_true", c))
-            u = float(_at(dataset, f"{q}_mc_u", c))
+            bias = float(_at(dataset, f"{q}_mc_mean", c, gate)
+                         - _at(dataset, f"{q}_true", c, gate))
+            u = float(_at(dataset, f"{q}_mc_u", c, gate))
             ax.hist(errors[c], bins=edges, histtype="step", lw=1.4,
                     color=CORRECTION_COLOURS.get(c), density=True,
                     label=f"{c}: bias {bias:+.3f}, u {u:.3f}")
@@ -170,8 +178,11 @@ def correction_comparison(dataset, n_max=HISTOGRAM_TRIALS):
         ax.legend(fontsize=8, title="correction", title_fontsize=8)
     n = int(np.max(dataset["mc_n_samples"]))
     scenario = yaml.safe_load(dataset.attrs.get("scenario", "")) or {}
-    figure.suptitle(f"{_sea(scenario)}; {n} Monte Carlo scans per model"
-                    f"{'' if n <= n_max else f' (histograms: the first {n_max})'}", fontsize=9)
+    where = f"; range gate {float(dataset['range'].values[gate]):g} m (middle of " \
+        f"{dataset.sizes['range']})" if "range" in dataset.dims else ""
+    layout.suptitle(figure, f"{_sea(scenario)}; {n} Monte Carlo scans per model"
+                    f"{'' if n <= n_max else f' (histograms: the first {n_max})'}{where}",
+                    fontsize=9)
     return figure
 
 
@@ -192,6 +203,6 @@ def _sea(scenario):
     return "harmonic motion: " + ", ".join(parts) if parts else "motion"
 
 
-def _at(dataset, name, correction):
+def _at(dataset, name, correction, gate=0):
     value = dataset[name].sel(correction=correction)
-    return value.isel(range=0) if "range" in value.dims else value
+    return value.isel(range=gate) if "range" in value.dims else value

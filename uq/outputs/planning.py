@@ -348,3 +348,67 @@ def fixed_phase_note(dataset):
         text += ("; the motion shows as the systematic error of the wind speed instead "
                  f"(error-free reconstruction minus true up to {largest['value']:+.3g} m/s)")
     return text + "; set the phases to random to sample the scatter over the motion's phase"
+
+
+def scene_uncertainty(dataset, quantity):
+    """u of `quantity` in every scene and gate as a reader gets it: Monte Carlo where the
+    run sampled it, else the GUM. Returns (DataArray, model suffix)."""
+    name = f"{quantity}_mc_u"
+    if name in dataset and np.isfinite(dataset[name].values).any():
+        return dataset[name], "mc_u"
+    return dataset[f"{quantity}_gum_u"], "gum_u"
+
+
+def categorical_dimensions(dataset):
+    """The swept dimensions whose values are names (a correction model, a probe kind):
+    a target's answer is given for each of their values."""
+    return [d for d in dataset["mc_n_samples"].dims if dataset[d].dtype.kind in "OUS"]
+
+
+def target_answer(dataset, quantity, target):
+    """Which swept values and range gates keep u(`quantity`) at or under `target`.
+
+    For each value of each categorical swept key (one group without any), and for each
+    numeric swept key and the range gate: the values at which every scene of the group
+    keeps u <= target ("always", whatever the other keys), and those at which some scene
+    does ("somewhere"); the scenes meeting the target out of all; the best scene. u is
+    Monte Carlo's where sampled, else the GUM's (:func:`scene_uncertainty`).
+
+    Returns
+    -------
+    dict
+        {"model": suffix, "groups": [{"group": {dim: value}, "meeting": int, "total": int,
+        "keys": {dim: {"always": [...], "somewhere": [...]}}, "best": {"value", "where"}},
+        ...]}
+    """
+    u, model = scene_uncertainty(dataset, quantity)
+    categorical = categorical_dimensions(dataset)
+    groups = [dict(zip(categorical, values)) for values in
+              np.ndindex(*[dataset.sizes[d] for d in categorical])]
+    answer = []
+    for index in groups:
+        group = {d: _value(dataset[d].values[i]) for d, i in index.items()}
+        at = u.isel(index) if index else u
+        keys = {}
+        for dim in [d for d in at.dims if d != "input"]:
+            others = [d for d in at.dims if d != dim]
+            worst = at.max(others) if others else at
+            best = at.min(others) if others else at
+            values = [_value(v) for v in at[dim].values] if dim in at.coords else \
+                list(range(at.sizes[dim]))
+            keys[dim] = {"always": [v for v, w in zip(values, worst.values) if w <= target],
+                         "somewhere": [v for v, b in zip(values, best.values) if b <= target]}
+        meeting = int(np.sum(at.values <= target))
+        smallest = {"value": float("nan"), "where": {}} if not np.isfinite(at.values).any() \
+            else _smallest(at)
+        answer.append({"group": group, "meeting": meeting, "total": int(at.size),
+                       "keys": keys, "best": smallest})
+    return {"model": model, "groups": answer}
+
+
+def _smallest(variable):
+    flat = int(np.nanargmin(variable.values))
+    index = np.unravel_index(flat, variable.shape)
+    return {"value": float(variable.values.flat[flat]),
+            "where": {d: _value(variable[d].values[i]) if d in variable.coords else int(i)
+                      for d, i in zip(variable.dims, index)}}

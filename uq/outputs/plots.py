@@ -26,6 +26,7 @@ from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 from scipy.stats import norm  # noqa: E402
 
 from uq.constants import COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, NUMERICAL_ZERO  # noqa: E402
+from uq.outputs import layout  # noqa: E402
 from uq.outputs.labels import (QUANTITIES, SWEEP_QUANTITIES, coordinate_label,  # noqa: E402
                                model_style, quantity_label)
 from uq.outputs.planning import models as available_models  # noqa: E402
@@ -43,10 +44,9 @@ SHOWN_GATES = 3
 MAP_MIN_RELATIVE_SPAN = 0.01
 #: Largest number of values of a numeric sweep axis that get a tick each [1].
 MAP_VALUE_TICKS = 12
-#: The bench figure fits its lines to the runs whose error is above this many times the
-#: reference's own relative error [1]: the observed error is ~sqrt(e^2 + floor^2), 5 %
-#: above e at 3x the floor.
-BENCH_FLOOR_FACTOR = 3.0
+#: A log axis spanning fewer decades than this labels its minor ticks at 2 and 5 times
+#: a power of ten; a longer one only its decades (the labels would collide).
+MINOR_LABEL_DECADES = 2.0
 #: Most columns of a legend under the panels.
 LEGEND_COLUMNS = 4
 #: Histogram bins of the Monte Carlo trials.
@@ -113,12 +113,14 @@ def _two_and_five(value, _position):
 
 def plot_bench(dataset):
     """Relative error of u(wind speed) against wall time, one panel per scene: every
-    repeated run as a point, the median per method and sample size as a marker, and a
-    power law fitted per method to the runs whose error is above BENCH_FLOOR_FACTOR times
-    the reference's own relative error (the floor, drawn as a grey band): medians of a few
-    repeats zig-zag, and below the floor the error measured is the reference's."""
+    repeated run as a point and the median per method and sample size as a diamond,
+    joined in order of sample size (measurements, no fitted line: a handful of noisy wall
+    times gives no slope worth stating). A dashed guide of slope -1/2 through plain Monte
+    Carlo's largest run shows how its error falls with time (error ~ n^-1/2 and time ~ n);
+    the reference's own relative error, below which no error can be measured, is the grey
+    floor; the dotted line the 1e-3 target."""
     scenes = list(dataset["scene"].values)
-    figure, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4.2),
+    figure, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4.4),
                                 constrained_layout=True, squeeze=False)
     for ax, scene in zip(axes[0], scenes):
         floor = float(dataset["reference_relative_error"].sel(scene=scene)) \
@@ -126,44 +128,51 @@ def plot_bench(dataset):
         for method in dataset["method"].values:
             data = dataset.sel({"scene": scene, "method": method})
             times, errors = data["time_s"].values.ravel(), data["relative_error"].values.ravel()
-            points, = ax.plot(times, errors, ".", alpha=0.4, ms=4, label=str(method))
+            points, = ax.plot(times, errors, ".", alpha=0.4, ms=4, label=f"{method}: runs")
             colour = points.get_color()
             ax.plot(data["time_s"].median("repeat"), data["relative_error"].median("repeat"),
-                    "D", color=colour, ms=4, markerfacecolor="none")
-            fit = _power_law(times, errors, BENCH_FLOOR_FACTOR * floor)
-            if fit is not None:
-                ax.plot(*fit, "-", color=colour, lw=1.2)
-        if floor > 0:
-            ax.axhspan(ax.get_ylim()[0] if ax.get_yscale() == "log" else 0, floor,
-                       color="0.85", zorder=0)
-            ax.axhline(floor, color="0.5", lw=0.8)
-        ax.axhline(1e-3, color="k", lw=0.8, ls="--")
+                    "D-", color=colour, ms=4, lw=0.8, markerfacecolor="none",
+                    label=f"{method}: medians")
+        guide = _half_slope_guide(dataset.sel(scene=scene))
+        if guide is not None:
+            ax.plot(*guide, "--", color="0.3", lw=1, label="slope -1/2 (error ~ time^-1/2)")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.xaxis.set_minor_formatter(FuncFormatter(_two_and_five))   # 0.02, 0.05, ...
+        if floor > 0:
+            ax.axhspan(ax.get_ylim()[0], floor, color="0.85", zorder=0,
+                       label="below the reference's own error")
+        ax.axhline(1e-3, color="k", lw=0.8, ls=":", label="1e-3 target")
+        low, high = ax.get_xlim()
+        if np.log10(high / low) < MINOR_LABEL_DECADES:      # room for 0.02, 0.05, ...
+            ax.xaxis.set_minor_formatter(FuncFormatter(_two_and_five))
+        else:
+            ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_title(str(scene), fontsize=9)
         ax.set_xlabel("wall time [s]")
         ax.set_ylabel("relative error of u(wind speed) [1]")
         ax.grid(alpha=0.3, which="both")
     # below the panels: inside, the legend would cover runs' points
-    figure.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside lower center",
-                  ncols=len(dataset["method"]), fontsize=8, markerscale=3,
-                  title="method (points: runs; diamonds: medians;\nlines: power law fitted "
-                  f"above {BENCH_FLOOR_FACTOR:g}x the floor); dashed: the 1e-3 target;\n"
-                  "grey: below the reference's own error (the floor)", title_fontsize=8)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    layout.legend_below(figure, handles, labels, fontsize=8, markerscale=2)
     return figure
 
 
-def _power_law(times, errors, above):
-    """(times, fitted errors) of log error = a + b log time over the runs with an error
-    above `above`, across their time range; None with fewer than 3 such runs or one
-    time only."""
-    keep = np.isfinite(times) & np.isfinite(errors) & (errors > max(above, 0.0)) & (times > 0)
-    if np.count_nonzero(keep) < 3 or np.ptp(np.log(times[keep])) == 0:
+def _half_slope_guide(dataset, method="mc"):
+    """(times, errors) of a line of slope -1/2 on log axes through plain Monte Carlo's
+    median at its largest sample size, over the times measured; None without it."""
+    if method not in dataset["method"].values:
         return None
-    slope, intercept = np.polyfit(np.log(times[keep]), np.log(errors[keep]), 1)
-    span = np.geomspace(times[keep].min(), times[keep].max(), 20)
-    return span, np.exp(intercept + slope * np.log(span))
+    data = dataset.sel(method=method)
+    times = np.asarray(data["time_s"].median("repeat").values, float).ravel()
+    errors = np.asarray(data["relative_error"].median("repeat").values, float).ravel()
+    finite = np.isfinite(times) & np.isfinite(errors) & (times > 0) & (errors > 0)
+    if not finite.any():
+        return None
+    anchor = np.flatnonzero(finite)[np.argmax(times[finite])]
+    every = np.asarray(dataset["time_s"].values, float).ravel()
+    every = every[np.isfinite(every) & (every > 0)]
+    span = np.geomspace(every.min(), every.max(), 20)
+    return span, errors[anchor] * np.sqrt(times[anchor] / span)
 
 
 def sweep_quantities(dataset):
@@ -303,15 +312,14 @@ def plot_beams(dataset, quantity="radial_velocity"):
 
 
 def legend_below(figure, ax, fontsize=7):
-    """The legend of `ax`'s lines under the panels, off the data."""
+    """The legend of `ax`'s lines under the panels, off the data, in as many columns as
+    fit the canvas (:func:`uq.outputs.layout.legend_below`)."""
     handles, labels = ax.get_legend_handles_labels()
-    if handles:
-        figure.legend(handles, labels, loc="outside lower center", fontsize=fontsize,
-                      ncols=min(len(handles), LEGEND_COLUMNS), frameon=False)
+    layout.legend_below(figure, handles, labels, fontsize=fontsize, longest=LEGEND_COLUMNS)
 
 
 #: Legend entry of the error bars on the Monte Carlo u: what they are, in the PNG.
-ERROR_BAR_LABEL = "MC u ±2 Monte Carlo standard errors"
+ERROR_BAR_LABEL = "Monte Carlo u ± 2 standard errors"
 
 
 def u_standard_error(dataset, quantity):
@@ -349,8 +357,10 @@ def plot_histogram(dataset, trials):
         values = trials[quantity].reshape(len(trials[quantity]), -1)[:, gate]
         _histogram_panel(ax, at, quantity, values, _gate_name(dataset, gate))
     n = len(next(iter(trials.values())))
-    figure.suptitle(f"Monte Carlo ({n:,} trials) against the GUM; each panel at the range "
-                    "gate where the GUM fails, else the middle one", fontsize=10)
+    gates = "; each panel at the range gate where the GUM fails, else the middle one" \
+        if "range" in dataset.dims and dataset.sizes["range"] > 1 else ""
+    layout.suptitle(figure, f"Monte Carlo ({n:,} trials) against the GUM{gates}",
+                    fontsize=10)
     return figure
 
 
@@ -450,7 +460,7 @@ def plot_against_sweep(dataset, dim=None, lines=None, panels=None):
             ax.set_title(title, fontsize=9)
         ax.grid(alpha=0.3)
     if lines is not None and "range" in dataset.dims:
-        figure.suptitle(middle_gate(dataset)[1], fontsize=9)
+        layout.suptitle(figure, middle_gate(dataset)[1], fontsize=9)
     if len(curves) > 1:          # colours for the lines, styles for the models: a short key
         _key_below(figure, [name for _, name in curves],
                    available_models(dataset, panels[0][0]))
@@ -470,8 +480,8 @@ def _key_below(figure, names, models):
     if "mc_u" in models:
         handles.append(Line2D([], [], color="k", marker="|", linestyle="none", markersize=8,
                               label=ERROR_BAR_LABEL))
-    figure.legend(handles=handles, loc="outside lower center", fontsize=7, frameon=False,
-                  ncols=min(len(handles), LEGEND_COLUMNS))
+    layout.legend_below(figure, handles, [h.get_label() for h in handles], fontsize=7,
+                        longest=LEGEND_COLUMNS)
 
 
 def _curves(dataset, lines):
@@ -545,7 +555,7 @@ def plot_maps(dataset, quantity, x, y, facet=None):
         bar = figure.colorbar(mesh, ax=axes, label=quantity_label(quantity))
         bar.formatter.set_useOffset(False)
     scale = "one colour scale" if shared else "one colour scale per panel"
-    figure.suptitle(f"u({QUANTITIES[quantity][0]}), {scale}"
+    layout.suptitle(figure, f"u({QUANTITIES[quantity][0]}), {scale}"
                     + (f", {gate_text}" if gate_text else ""), fontsize=10)
     return figure
 
@@ -670,7 +680,7 @@ def plot_probe_bias(dataset):
     axes[0, 0].set_ylabel("probe bias of " + QUANTITIES["wind_speed"][0] + " [m s$^{-1}$]")
     axes[1, 0].set_ylabel("probe bias / true " + QUANTITIES["wind_speed"][0] + " [%]")
     axes[0, 0].legend(fontsize=8, title="lidar.probe.kind", title_fontsize=8)
-    figure.suptitle("Systematic error of the wind speed from the probe volume "
+    layout.suptitle(figure, "Systematic error of the wind speed from the probe volume "
                     "(range weighting along the beams)", fontsize=10)
     return figure
 

@@ -33,6 +33,9 @@ from uq.pipeline import records
 from uq.pipeline.records import turbulence_model
 from uq.pipeline.scenario import load_scenario
 from uq.pipeline.turbulencesection import scan_geometry
+from uq.outputs import layout
+from uq.outputs.samples import scene_assignments
+from uq.outputs.scenes import swept_keys, value_text
 
 
 def record_plan(dataset):
@@ -45,11 +48,44 @@ def record_plan(dataset):
     return plan
 
 
-def file_settings(dataset):
-    """The validated settings of the scene as written in the file (no sweep)."""
+def shown_scene(dataset, lines=()):
+    """The one scene a record figure shows, for every swept key but those in `lines`
+    (dimensions drawn as a line each): a value selected with ``--select`` (a scalar
+    coordinate), else the scenario's own value where it is one of the swept ones, else the
+    first swept value.
+
+    Returns
+    -------
+    settings : dict
+        The validated settings of that scene (the keys in `lines` at the scenario's value).
+    chosen : dict
+        ``{dimension: value}`` to select the scene's data with.
+    words : str
+        The scene in words for a title (``turbulence.intensity = 0.06``), '' for none.
+    """
     raw = yaml.safe_load(dataset.attrs["scenario"])
-    raw["sweep"] = {}
-    return load_scenario(raw).settings
+    raw.pop("sweep", None)
+    file_values = load_scenario(raw).settings
+    keys = swept_keys(dataset)
+    chosen = {}
+    for dim, key in keys.items():
+        if dim in lines:
+            continue
+        own = _get(file_values, key)
+        values = [v.item() if hasattr(v, "item") else v for v in dataset[dim].values]
+        chosen[dim] = own if own in values else values[0]
+    fixed = {keys[d]: _get(file_values, keys[d]) for d in lines if d in keys}
+    assignments = scene_assignments(dataset.sel(chosen), fixed)
+    words = ", ".join(f"{key} = {value_text(value)}" for key, value in assignments.items()
+                      if key not in fixed)
+    return load_scenario(raw, assignments).settings, chosen, words
+
+
+def _get(settings, dotted):
+    node = settings
+    for part in dotted.split("."):
+        node = node.get(part) if isinstance(node, dict) else None
+    return node
 
 
 def record_spectra_data(dataset, settings):
@@ -77,12 +113,12 @@ def record_spectra_data(dataset, settings):
                                     "record_frequency": variables["record_frequency"][1]})
 
 
-def spectra_lines(data, settings):
+def spectra_lines(data, chosen, settings):
     """(frequency [Hz], true u's PSD, {label: Vh's PSD}, {label: radial PSD}) at the
-    first gate of the file's scene (every swept correction a line; the lidar at rest
-    where the platform moves) [m2 s-2 Hz-1]."""
+    first gate of the scene `chosen` (:func:`shown_scene`; every swept correction a line;
+    the lidar at rest where the platform moves) [m2 s-2 Hz-1]."""
     names = [name for name in records.SPECTRA_ATTRIBUTES if name in data]
-    data = file_scene(data[names], settings, keep=("correction", "range", "record_frequency"))
+    data = data[names].sel({d: v for d, v in chosen.items() if d in data[names].dims})
     if "range" in data.dims:
         data = data.isel(range=0)
     moving = bool(settings.get("motion"))
@@ -130,9 +166,9 @@ def record_spectra(dataset):
     periodogram, as the run stored it (:func:`record_spectra_data`); the -5/3 slope, and
     the motion's peak where the scan's sampling aliases it (a DBS samples each beam once
     a scan: the wave motion folds below 1 / (2 T_s))."""
-    settings = file_settings(dataset)
+    settings, chosen, words = shown_scene(dataset, lines=("correction",))
     frequency, true, speeds, radials = spectra_lines(record_spectra_data(dataset, settings),
-                                                     settings)
+                                                     chosen, settings)
     period = records.spectrum_axis(settings)[0]
     figure, axes = plt.subplots(1, 2, figsize=(11.0, 4.4), constrained_layout=True,
                                 sharey=True)
@@ -152,8 +188,10 @@ def record_spectra(dataset):
         ax.grid(alpha=0.3, which="both")
     axes[0].set_ylabel("PSD [m$^2$ s$^{-2}$ Hz$^{-1}$]")
     axes[1].legend(fontsize=7, loc="lower left")
-    figure.suptitle(f"{dataset.attrs.get('title', '')}: gate {settings['lidar']['ranges'][0]:g}"
-                    f" m, mean of {settings['record']['count']} records", fontsize=9)
+    layout.suptitle(figure, f"{dataset.attrs.get('title', '')}: "
+                    + (f"{words}, " if words else "")
+                    + f"range gate {settings['lidar']['ranges'][0]:g} m, mean of "
+                    f"{settings['record']['count']} records", fontsize=9)
     return figure
 
 
@@ -173,7 +211,8 @@ def _slope(ax, f, psd):
     middle = len(f) // 2
     anchor = f[middle], psd[middle] * 3
     line = anchor[1] * (f[middle:] / anchor[0]) ** (-5.0 / 3.0)
-    ax.loglog(f[middle:], line, color="k", ls="--", lw=1)
+    ax.loglog(f[middle:], line, color="k", ls="--", lw=1,
+              label="-5/3 slope (inertial range)")
     ax.text(f[-1], line[-1], " -5/3", fontsize=8, va="center")
 
 
@@ -206,12 +245,12 @@ def _probe(settings):
 ERROR_GROUPS = (("motion", "motion"), ("ins.", "INS"), ("lidar.errors.radial_velocity", "noise"))
 
 
-def error_contributions(dataset, settings):
+def error_contributions(dataset, chosen):
     """The per-scan error variances of Vh [m2 s-2] at each gate, grouped (module
-    docstring), from the result's GUM budget of the file's scene."""
+    docstring), from the result's GUM budget of the scene `chosen` (:func:`shown_scene`)."""
     if "wind_speed_budget" not in dataset:
         return [], []
-    budget = file_scene(dataset["wind_speed_budget"], settings)
+    budget = dataset["wind_speed_budget"].sel(chosen)
     groups = {}
     for name in budget["input"].values:
         label = next((bar for prefix, bar in ERROR_GROUPS if str(name).startswith(prefix)),
@@ -223,31 +262,12 @@ def error_contributions(dataset, settings):
     return names, [groups[n] for n in names]
 
 
-def file_scene(variable, settings, keep=("input", "range", "beam")):
-    """`variable` (a DataArray or Dataset) at the scene of the file's values of the swept
-    keys (the nearest swept value; the first where the key is not a number); the
-    dimensions in `keep` are kept whole."""
-    for dim in [d for d in variable.dims if d not in keep]:
-        node = settings
-        for part in dim.split("_", 1):
-            node = node.get(part, {}) if isinstance(node, dict) else {}
-        value = node if not isinstance(node, dict) else settings.get(dim)
-        coordinate = variable[dim].values
-        if isinstance(value, (int, float)) and coordinate.dtype.kind in "iuf":
-            variable = variable.isel({dim: int(np.argmin(np.abs(coordinate - value)))})
-        elif value in list(coordinate):
-            variable = variable.isel({dim: list(coordinate).index(value)})
-        else:
-            variable = variable.isel({dim: 0})
-    return variable
-
-
 def ti_budget(dataset):
     """Bars: the contributions to the variance of the record's Vh at each gate (module
     docstring), with the total, the spectral path's apparent variance."""
-    settings = file_settings(dataset)
+    settings, chosen, words = shown_scene(dataset)
     names, values = geometry_contributions(settings)
-    more, errors = error_contributions(dataset, settings)
+    more, errors = error_contributions(dataset, chosen)
     names, values = names + more, values + errors
     ranges = settings["lidar"]["ranges"]
     figure, ax = plt.subplots(figsize=(7.0, 1.4 + 0.45 * len(names)), constrained_layout=True)
@@ -260,42 +280,50 @@ def ti_budget(dataset):
     ax.set_yticks(np.arange(len(names)), names, fontsize=8)
     ax.invert_yaxis()
     ax.set_xlabel("contribution to the record variance of Vh [m$^2$ s$^{-2}$]")
-    ax.set_title(f"variance budget of the apparent TI, correction {settings['correction']} "
-                 "(spectral path and the GUM of a scan; bars add up to the total)", fontsize=9)
+    layout.title(ax, "variance budget of the lidar's apparent TI"
+                 + (f" at {words}" if words else f", correction {settings['correction']}")
+                 + " (spectral path and the GUM of a scan; the bars add up to the total)")
     ax.grid(alpha=0.3, axis="x")
     ax.legend(fontsize=7, loc="lower right")
     return figure
 
 
 def apparent_against_true(dataset):
-    """The apparent TI (spectral, and Monte Carlo mean with its 95 % interval over
-    records) against the true TI, a line per other swept value (e.g. the correction)."""
-    figure, ax = plt.subplots(figsize=(6.2, 4.6), constrained_layout=True)
-    data = dataset
-    for dim in [d for d in data["turbulence_intensity_spectral"].dims
-                if d not in ("turbulence_intensity",)]:
-        if dim == "range":
-            data = data.isel(range=0)
+    """The lidar's apparent TI against the field's TI over a record, the one it is
+    compared with: the spectral path's expectation against the field's expected record TI
+    (a line), the Monte Carlo records' mean with the 95 % of records against the records'
+    own field TI (markers with bars); a colour per value of the other swept key (e.g. the
+    correction), at the first range gate. The scenario's point TI (the input,
+    ``turbulence.intensity``) is each point's label on the top axis."""
+    figure, ax = plt.subplots(figsize=(6.4, 4.8), constrained_layout=True)
+    data = dataset.isel(range=0) if "range" in dataset["turbulence_intensity_spectral"].dims \
+        else dataset
     others = [d for d in data["turbulence_intensity_spectral"].dims
               if d != "turbulence_intensity"]
     panels = [{}] if not others else [{others[0]: v} for v in data[others[0]].values]
-    true = data["turbulence_intensity"].values
     for k, where in enumerate(panels):
         at = data.sel(where) if where else data
         label = ", ".join(f"{v}" for v in where.values()) or "lidar"
-        ax.plot(true * 100, at["turbulence_intensity_spectral"].values * 100, color=f"C{k}",
-                label=f"{label}: spectral")
+        field = at["turbulence_intensity_true"].values * 100
+        ax.plot(field, at["turbulence_intensity_spectral"].values * 100, color=f"C{k}",
+                marker=".", label=f"{label}: spectral path")
         if "turbulence_intensity_mc_mean" in at:
             mean = at["turbulence_intensity_mc_mean"].values * 100
-            ax.errorbar(true * 100, mean, yerr=[mean - at["turbulence_intensity_mc_low"].values
-                                                * 100, at["turbulence_intensity_mc_high"].values
-                                                * 100 - mean],
-                        fmt="o", ms=4, color=f"C{k}", capsize=3,
-                        label=f"{label}: Monte Carlo (95 % of records)")
-    ax.plot(true * 100, true * 100, color="k", ls="--", lw=1, label="apparent = true")
-    ax.set_xlabel("true TI at the reference point, turbulence.intensity [%]")
-    ax.set_ylabel("apparent TI of the lidar [%]")
-    ax.set_title(dataset.attrs.get("title", ""), fontsize=9)
+            ax.errorbar(at["turbulence_intensity_true_mc_mean"].values * 100, mean,
+                        yerr=[mean - at["turbulence_intensity_mc_low"].values * 100,
+                              at["turbulence_intensity_mc_high"].values * 100 - mean],
+                        fmt="o", ms=4, color=f"C{k}", capsize=3, linestyle="none",
+                        label=f"{label}: Monte Carlo records (mean, 95 % of records)")
+    field = data["turbulence_intensity_true"]
+    field = (field.isel({others[0]: 0}) if others else field).values * 100
+    ax.plot(field, field, color="k", ls="--", lw=1, label="apparent = field")
+    ax.set_xlabel("the field's TI over a record [%]")
+    ax.set_ylabel("the lidar's apparent TI [%]")
+    top = ax.secondary_xaxis("top")
+    top.set_ticks(field, [f"{100 * v:g}" for v in data["turbulence_intensity"].values])
+    top.set_xlabel("the field's point TI, turbulence.intensity [%]", fontsize=8)
+    top.tick_params(labelsize=7)
+    layout.title(ax, dataset.attrs.get("title", ""))
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
+    layout.legend_below(figure, *ax.get_legend_handles_labels(), fontsize=7)
     return figure

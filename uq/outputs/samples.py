@@ -25,10 +25,42 @@ HISTOGRAM_TRIALS = 2**17
 
 
 def can_redraw(dataset):
-    """Does the result hold what :func:`scene_trials` needs (one scene, sampled)?"""
+    """Does the result hold what :func:`scene_trials` needs (one scene, sampled)?
+    A sweep's result qualifies once one scene is selected (``--select``, every swept
+    dimension a scalar coordinate: :func:`scene_assignments`)."""
     attrs = dataset.attrs
     return ("scenario" in attrs and "seed" in attrs and attrs.get("sampling_method") != "none"
             and dataset["mc_n_samples"].ndim == 0 and int(dataset["mc_n_samples"]) > 0)
+
+
+def scene_assignments(dataset, fixed=None):
+    """``{dotted key: value}`` of the scene `dataset` holds: every swept key of its
+    scenario (links included) at the value of its coordinate, which must be a scalar
+    (one scene, e.g. picked by ``--select``), except the keys in `fixed`, which are
+    given. The trials of :func:`trials_with` are then exactly that scene's.
+
+    Raises
+    ------
+    ValueError
+        A swept key that is neither fixed nor a scalar coordinate (several scenes).
+    """
+    fixed = dict(fixed or {})
+    sweep = (yaml.safe_load(dataset.attrs["scenario"]) or {}).get("sweep") or {}
+    values = {}
+    for key in sweep:
+        if key in fixed:
+            continue
+        coordinate = dataset[key.replace(".", "_")]
+        if coordinate.ndim:
+            raise ValueError(f"the result holds {coordinate.size} values of the swept key "
+                             f"{key}: select one scene to draw its trials")
+        values[key] = _plain(coordinate.values.item())
+    return {**values, **fixed}
+
+
+def _plain(value):
+    """A coordinate's value as the scenario file writes it (text from bytes)."""
+    return value.decode() if isinstance(value, bytes) else value
 
 
 def scene_trials(dataset, outputs, n_max=HISTOGRAM_TRIALS):
@@ -46,15 +78,18 @@ def scene_trials(dataset, outputs, n_max=HISTOGRAM_TRIALS):
     dict
         output -> real array of shape (n, n_gates) (radial velocity (n, beams, gates)).
     """
-    return trials_with(dataset, {}, outputs, n_max)
+    return trials_with(dataset, scene_assignments(dataset), outputs, n_max)
 
 
 def trials_with(dataset, assignments, outputs, n_max=HISTOGRAM_TRIALS):
     """The first min(n, n_max) trials of one scene of a result: its scenario with the
-    swept keys set to `assignments` (``{dotted key: value}``) and no sweep; the run's
-    seed and sampler (every scene of a sweep draws the same numbers)."""
+    swept keys set to `assignments` (``{dotted key: value}``, every swept key:
+    :func:`scene_assignments`) and no sweep; the run's seed and sampler (every scene of
+    a sweep draws the same numbers)."""
     raw = yaml.safe_load(dataset.attrs["scenario"])
-    raw.pop("sweep", None)
+    missing = set(raw.pop("sweep", None) or {}) - set(assignments)
+    if missing:                 # else the trials would be the file's default scene's
+        raise ValueError(f"no value for the swept keys {', '.join(sorted(missing))}")
     scenario = load_scenario(raw, assignments)
     settings = scenario.settings
     scene = _stored_nodes(scene_from_settings(settings), dataset)

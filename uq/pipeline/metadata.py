@@ -69,6 +69,9 @@ STATISTICS = {
     "gum_valid": ("GUM interval validated by Monte Carlo (JCGM 101 clause 8)", None),
     "gum_validation_conclusive": ("Monte Carlo numerical error within the tolerance of the "
                                   "validation, so gum_valid is conclusive", None),
+    "gum_validation_tolerance": ("tolerance delta of the JCGM 101 clause 8 validation: half "
+                                 "a unit of the last of the validation's significant digits "
+                                 "of the GUM u (JCGM 101 7.9.2, 8.2)", None),
     "paper_u": ("Rubio and Gottschall (2022) analytic standard uncertainty", "standard_error"),
     "budget": ("contribution of each input to the GUM variance, c_i^2 u_i^2", None),
     "mc_covariance": ("Monte Carlo covariance between range gates", None),
@@ -127,7 +130,8 @@ DIMENSIONLESS_PARAMETERS = ("dof",)
 ANCILLARY = {"mc_mean": ("mc_low", "mc_high", "mc_u", "mc_u_standard_error",
                          "mc_numerical_error", "mc_numerical_tolerance", "mc_n_invalid",
                          "mc_circular_std", "mc_covariance"),
-             "gum_value": ("gum_u", "gum_valid", "gum_validation_conclusive", "budget",
+             "gum_value": ("gum_u", "gum_valid", "gum_validation_conclusive",
+                           "gum_validation_tolerance", "budget",
                            "gum_covariance")}
 
 
