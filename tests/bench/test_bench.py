@@ -49,6 +49,7 @@ def test_bench_file_passes_the_cf_checker(monkeypatch, tmp_path, cf_compliance):
     """Issue 16: bench.nc (here from a tiny run: one scene, 2^10 and 2^11 trials, two
     repeats) has valid attribute names (letters, digits, underscores: no '+cv' or
     '1e-3'), the time to target as variables, and passes compliance-checker CF 1.10."""
+    import json
     import re
 
     from uq.bench.command import run_bench
@@ -59,12 +60,20 @@ def test_bench_file_passes_the_cf_checker(monkeypatch, tmp_path, cf_compliance):
     run_bench(path, quick=True, sizes=[2**10, 2**11], repeats=2, scale=2**-12)
     assert (tmp_path / "bench.txt").read_text() == "not uq's"
     cf_compliance(path)
+    document = json.loads(path.with_suffix(".json").read_text())
+    assert {"floating_lidar_full_mc_over_draw_floor", "pointwise_motion_over_static",
+            "rubio2022_case_i_best_speedup"} <= set(document["targets"])
+    assert document["machine_details"]["processor"] and document["command"] == "uq bench --quick"
+    assert len(document["load_averages"]["start"]) == 3
+    assert len(document["time_to_target"]) == 5                    # one scene, 5 methods
+    run_bench(path, quick=True, sizes=[2**10, 2**11], repeats=2, scale=2**-12)  # replaced
     with xr.open_dataset(path) as ds:
         assert all(re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", name) for name in ds.attrs), \
             list(ds.attrs)
         assert "rubio2022_case_i_sobol_cv_time_to_1e_3_s" in ds.attrs
         assert ds["time_to_target"].sizes == {"scene": 1, "method": 5}
         assert ds["time_to_target_extrapolated"].dtype == bool
+        assert ds.attrs["bench_command"] == "uq bench --quick" and "cores" in ds.attrs["machine"]
 
 
 def test_the_numpy_scans_and_uq_measure_the_same_u():
@@ -157,3 +166,77 @@ def test_paired_times_alternate_and_keep_each_side(monkeypatch):
     result = targets.paired_cpu_times(costing("a", 2.0), costing("b", 1.0), 4)
     assert result == (2.0, 1.0, 2.0)
     assert "".join(order) == "ab" + "abba" * 2
+
+
+def test_the_json_document_gives_each_figure_its_target_and_verdict():
+    from uq.bench import report
+    document = report.document({"pointwise_motion_over_static": 3.5,
+                                "rubio2022_case_i_best_speedup": 12.0, "other_s": 1.0,
+                                "first_run_worst_name": "x"},
+                               {"pointwise_motion_over_static": (4.0, "max"),
+                                "rubio2022_case_i_best_speedup": (20.0, "min")},
+                               report.now(), {"start": [0.5, 0.4, 0.3]},
+                               [("s", "mc", 1.5, True)])
+    targets = document["targets"]
+    assert targets["pointwise_motion_over_static"]["met"] is True
+    assert targets["rubio2022_case_i_best_speedup"]["met"] is False
+    assert targets["pointwise_motion_over_static"]["units"] == "1"
+    assert document["figures"]["other_s"] == 1.0 and "other_s" not in targets
+    assert document["notes"] == {"first_run_worst_name": "x"}
+    assert document["time_to_target"] == [["s", "mc", 1.5, True]]
+    assert document["machine_details"]["usable_cores"] >= 1
+    assert document["load_average"] == "start 0.50, 0.40, 0.30"
+    assert "usable cores" in document["machine"]
+
+
+def test_every_target_is_described():
+    from uq.bench import report, targets
+    assert set(targets.TARGETS) <= set(report.DESCRIPTIONS)
+
+
+def test_the_record_count_of_the_shipped_record_scenarios():
+    """record.count per scene with wind, over the sweep's scenes (floating_lidar_ti: six
+    intensities, two corrections, five records each)."""
+    from uq.bench import records
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.shipped import scenario_path
+    counts = {name: records.record_count(load_scenario(scenario_path(name)))
+              for name in records.SCENARIOS}
+    assert counts == {"sathe2011_ti": 8, "sathe2011_ti_cw": 4, "floating_lidar_ti": 60}
+    calm = load_scenario(scenario_path("sathe2011_ti"), {"sweep.wind.speed": [0.0, 8.0]})
+    assert records.record_count(calm) == 8                   # the calm scene has none
+
+
+def test_the_first_run_figures_name_the_worst(monkeypatch):
+    from uq.bench import firstrun
+    rows = {"a": 1.5, "b": 4.0}
+    monkeypatch.setattr(firstrun, "first_run", lambda name: {
+        "cold_s": 2.0 + rows[name], "warm_s": 2.0, "over_warm_s": rows[name],
+        "cold_load": 0.1, "background_after_s": 9.0, "warm_compiled": True,
+        "largest_difference": 1e-15})
+    figures = firstrun.measure(["a", "b"])
+    assert figures["first_run_worst_over_warm_s"] == 4.0
+    assert figures["first_run_worst_name"] == "b"
+    assert figures["first_run_a_warm_compiled"] == 1
+
+
+def test_scale_out_is_bit_identical_to_one_process():
+    """The scale-out benchmark's small sweep on a local cluster of 2 workers: the same
+    bytes as in one process (the efficiency on a shared 2-core machine is not a test)."""
+    from uq.bench import scaleout
+    figures = scaleout.measure(workers=(2,), small=True, names=("rubio2022_misalignment",))
+    row = figures["workloads"]["rubio2022_misalignment"]["workers"]["2"]
+    assert row["identical"] is True and row["seconds"] > 0
+    assert figures["machine"]["usable_cores"] >= 1
+
+
+def test_a_child_s_peak_is_its_own_not_its_parents():
+    """child_usage (the cold-start figures) reads the child's own high-water mark: under
+    a 640 MB parent, ``uq list`` reports what it needs itself (~100 MB), not the parent."""
+    import sys
+    from uq.bench import targets
+    if not sys.platform.startswith("linux"):
+        pytest.skip("VmHWM is Linux's")
+    parent = np.ones(80_000_000)                       # 640 MB, touched
+    cpu, megabytes = targets.child_usage(["list"])
+    assert parent[-1] == 1.0 and 0 < megabytes < 500 and cpu > 0, megabytes

@@ -1,5 +1,7 @@
 """``uq bench``: run the benchmarks of :mod:`uq.bench.methods`, print the figures, write
-``bench.nc`` and its plot."""
+``bench.nc``, its plot and ``bench.json`` (:mod:`uq.bench.report`: the machine, its load,
+the date and every figure with its target, for a documentation page)."""
+import os
 import re
 import sys
 from pathlib import Path
@@ -15,16 +17,18 @@ def run_bench(output, quick=False, sizes=None, repeats=None, scale=1):
     """Measure, print and write; returns the benchmark Dataset. `sizes` and `repeats`
     replace the defaults of a full or ``--quick`` run, `scale` shrinks the trial counts
     of the speed targets (:func:`uq.bench.targets.measure`; a small run for tests)."""
+    from uq.bench import firstrun, records, report
     from uq.outputs.plots import plot_bench
     output = Path(output)
     if output.suffix != ".nc":
         raise ScenarioError("-o", str(output), "the output file must end in .nc")
     check_target(output)                           # before minutes of measuring
     check_target(output.with_suffix(".png"))
+    check_target(output.with_suffix(".json"))
+    started, loads = report.now(), {"start": list(os.getloadavg())}
     sizes = sizes or [2**k for k in ((10, 13, 16, 18) if quick else (10, 12, 14, 16, 18, 19))]
     repeats = repeats or (3 if quick else 8)
-    dataset = bench.measure(sizes, repeats,
-                            progress=lambda text: print(f"  {text}", file=sys.stderr))
+    dataset = bench.measure(sizes, repeats, progress=_say)
     floors = {name: bench.draw_floor(name, sizes[-1]) for name in bench.SCENES}
     median = dataset["time_s"].median("repeat")
     ratios = []
@@ -39,6 +43,7 @@ def run_bench(output, quick=False, sizes=None, repeats=None, scale=1):
         "to draw its standard normals alone"})
     targets = bench.time_to_target(dataset)
     _time_to_target(dataset, targets)
+    best = {}
     for name in bench.SCENES:
         plain = targets[name, "mc"][0]
         for method in bench.METHODS:
@@ -47,23 +52,44 @@ def run_bench(output, quick=False, sizes=None, repeats=None, scale=1):
             print(f"{name:22s} {method:9s} time to 1e-3 in 95 % of runs: {seconds:9.3f} s"
                   f"{' (extrapolated)' if extrapolated else ''}  speed-up vs mc "
                   f"{plain / seconds:7.1f}x")
-    figures = speed.measure(quick, progress=lambda text: print(f"  {text}",
-                                                                  file=sys.stderr),
-                              scale=scale)
+        best[f"{name}_best_speedup"] = max(plain / targets[name, method][0]
+                                           for method in bench.METHODS if method != "mc")
+    loads["methods_end"] = list(os.getloadavg())
+    figures = speed.measure(quick, progress=_say, scale=scale)
+    figures.update(best)
+    for name, (value, _) in targets.items():
+        figures[attribute_name(f"{name[0]}_{name[1]}_time_to_1e-3_s")] = value
+    if not quick:
+        figures.update(records.measure(progress=_say))
+        figures.update(firstrun.measure(progress=_say))
     dataset.attrs.update({attribute_name(name): value for name, value in figures.items()})
     print("targets (each a ratio of two times measured in this run):")
     for line in speed.verdicts(figures):
         print(f"  {line}")
     if not quick:
         seconds, megabytes = bench.scale()
+        figures.update(scale_1e8_s=seconds, scale_1e8_peak_rss_mb=megabytes)
         dataset.attrs.update(scale_1e8_s=seconds, scale_1e8_peak_rss_mb=megabytes)
         print(f"10^8 trials of the same scene: {seconds:.1f} s, peak resident memory "
               f"{megabytes:.0f} MB")
+    loads["end"] = list(os.getloadavg())
+    command = "uq bench" + (" --quick" if quick else "")
+    rows = [(scene, method, seconds, extrapolated)
+            for (scene, method), (seconds, extrapolated) in targets.items()]
+    document = report.document(figures, speed.TARGETS, started, loads, rows, command)
+    dataset.attrs.update(machine=document["machine"], load_average=document["load_average"],
+                         measured_at=started, bench_command=command)
     write_netcdf(annotate(dataset), output)
     figure = plot_bench(dataset)
     save_figure(figure, output.with_suffix(".png"), dpi=120)
-    print(f"wrote {output} and {output.with_suffix('.png')}")
+    report.write(output.with_suffix(".json"), document)
+    print(f"wrote {output}, {output.with_suffix('.png')} and {output.with_suffix('.json')}")
     return dataset
+
+
+def _say(text):
+    """A progress line on stderr."""
+    print(f"  {text}", file=sys.stderr)
 
 
 #: Characters allowed in a netCDF/CF attribute name besides letters and digits (CF 2.3).

@@ -5,13 +5,13 @@ run on the same machine, so that a busy or slow host moves both alike.
 figure                                 against                                     target
 =====================================  ==========================================  ======
 plain ``mc``, ``floating_lidar_full``   drawing its normals alone                   <= 3x
-as shipped (all five outputs), 2^19
+as shipped (all five outputs), 2 x 10^6
 every shipped scenario, ``uq run``      drawing its normals + the process start     <= 4x
 (or ``uq golden``) in a new process
 Monte Carlo sweep, 10^4 draws/scene     drawing one scene's normals                 <= 2.5x
 Fig. 2 GUM grid, 518,400 scenes         the numpy model's complex step (before)     >= 5x
 10^6 four-beam scans, radial noise      numpy: 4 x 10^6 normals, differences, hypot  <= 1x
-10^6 point-wise scans in motion         10^6 static scans                           <= 4x
+10^6 point-wise scans in motion         10^6 static scans (wall time)               <= 4x
 conical scan, 50 lines of sight         a 4-beam scan in motion, per trial          <= 15x
 pulsed probe, ``floating_lidar_full``   the compiled point model, ``uq.run``        <= 3x
 nacelle lidar (tilt 90), 4 beams,       a 4-beam DBS scan, the same run otherwise   <= 1x
@@ -25,6 +25,10 @@ mode), numba's cache empty             second process beside the boxes); peak of
                                        the larger process [MB]
 driver CPU of a distributed sweep not   the single-process run's CPU time (serial    <= 0.05
 overlapping its workers, 10^5 draws     fraction f; Amdahl's S(8)/8 >= 0.6)
+first run of every shipped scenario,    the same command once numba's cache is      <= 5 s
+numba's cache empty (wall time)         filled (:mod:`uq.bench.firstrun`)           more
+time to 1e-3 on ``rubio2022_case_i``,   plain ``mc``'s (:mod:`uq.bench.methods`)    >= 20x
+the fastest method                                                                  faster
 =====================================  ==========================================  ======
 
 The probe's figure (issue 26) is a whole ``uq.run`` of ``floating_lidar_full`` with a
@@ -77,7 +81,9 @@ TARGETS = {"floating_lidar_full_mc_over_draw_floor": (3.0, "max"),
            "cold_start_motion_peak_rss_mb": (600.0, "max"),
            "cold_start_record_wall_s": (30.0, "max"),
            "cold_start_record_peak_rss_mb": (600.0, "max"),
-           "serial_fraction": (0.05, "max"), "serial_amdahl_efficiency_8": (0.6, "min")}
+           "serial_fraction": (0.05, "max"), "serial_amdahl_efficiency_8": (0.6, "min"),
+           "first_run_worst_over_warm_s": (5.0, "max"),
+           "rubio2022_case_i_best_speedup": (20.0, "min")}
 #: The first run of a time-resolved scenario (the motion kernels: the slowest to compile).
 COLD_MOTION_SCENARIO = "floating_lidar_waves"
 #: The first run of a record-mode scenario (the slowest of the three shipped: boxes,
@@ -139,7 +145,11 @@ def run_floor(scenario):
     return draw_floor(shapes)
 
 
-def floating_lidar_full_as_shipped(n=2**19, repeats=5):
+#: Trials of the run of ``floating_lidar_full`` as shipped against its draws.
+FULL_AS_SHIPPED_TRIALS = 2_000_000
+
+
+def floating_lidar_full_as_shipped(n=FULL_AS_SHIPPED_TRIALS, repeats=5):
     """(seconds, floor) of plain mc on ``floating_lidar_full`` with every shipped
     output, at n trials."""
     scenario = load_scenario(scenario_path("floating_lidar_full"),
@@ -253,16 +263,31 @@ def scans_against_numpy(n=10**6, repeats=5):
 
 
 def motion_scans(n=10**6, repeats=5):
-    """(CPU seconds of n point-wise corrected DBS scans under harmonic roll and pitch of
-    random phase, 1 s per beam, with radial noise; CPU seconds of n static scans): the
-    process's CPU time (:func:`median_cpu_time`), both threads of the engine (the draws
-    of the next chunk overlap the model's), which a busy machine does not move."""
+    """(wall seconds of n point-wise corrected DBS scans under harmonic roll and pitch of
+    random phase, 1 s per beam, with radial noise; wall seconds of n static scans; the
+    same two in CPU time): each the median of `repeats` :func:`uq.run` calls, the two
+    kinds in alternating pairs (ABBA) so that a drift of the machine falls on both. The
+    wall time is the user's (the draws of the next chunk run in a second thread beside
+    the model); the process's CPU time (both threads) is what a busy machine does not
+    move."""
     moving = _scans(n, **{"correction": "pointwise", "lidar.scan.beam_duration": 1.0,
                           "motion.roll": {"amplitude": 5.0, "period": 6.0},
                           "motion.pitch": {"amplitude": 3.0, "period": 5.0}})
     static = _scans(n)
-    return (median_cpu_time(lambda: run(moving), repeats),
-            median_cpu_time(lambda: run(static), repeats))
+    run(moving), run(static)
+    wall, cpu = [], []
+    for index in range(repeats):
+        pair = (moving, static) if index % 2 == 0 else (static, moving)
+        times = {}
+        for scenario in pair:
+            started, used = time.perf_counter(), time.process_time()
+            run(scenario)
+            times[id(scenario)] = (time.perf_counter() - started,
+                                   time.process_time() - used)
+        wall.append((times[id(moving)][0], times[id(static)][0]))
+        cpu.append((times[id(moving)][1], times[id(static)][1]))
+    wall, cpu = np.median(wall, axis=0), np.median(cpu, axis=0)
+    return float(wall[0]), float(wall[1]), float(cpu[0]), float(cpu[1])
 
 
 def conical_scans(n=2**17, repeats=5):
@@ -395,30 +420,59 @@ def probe_against_point(n=2**16, repeats=5):
     return tuple(times)
 
 
-def child_usage(argv, env=None, cwd=None):
-    """(CPU time [s], peak resident memory [MB]) of a child process `argv`: user + system
-    time of the process and its own children (numba compiles in the process itself),
-    and its largest resident set, from wait4's resource usage."""
-    child = subprocess.Popen(argv, env=env, cwd=cwd, stdout=subprocess.DEVNULL)
-    _, status, usage = os.wait4(child.pid, 0)
-    child.returncode = os.waitstatus_to_exitcode(status)
-    if child.returncode != 0:
-        raise RuntimeError(f"{' '.join(argv)} failed with status {child.returncode}")
-    return usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
+#: A child that runs a command of uq's and writes its peak resident memory [MB] to the
+#: file named by UQ_BENCH_PEAK_FILE: its own high-water mark (VmHWM, which starts afresh
+#: at exec) or its waited-for children's, the larger (ru_maxrss, which Linux keeps across
+#: fork and exec, would report the size of ``uq bench`` itself, ~700 MB).
+PEAK_SCRIPT = """
+import os, resource, sys
+from uq.cli import main
+try:
+    status = main(sys.argv[1:])
+finally:
+    try:
+        own = next(float(line.split()[1]) / 1024 for line in open("/proc/self/status")
+                   if line.startswith("VmHWM:"))
+    except OSError:
+        own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+    with open(os.environ["UQ_BENCH_PEAK_FILE"], "w") as file:
+        file.write(repr(max(own, children)))
+sys.exit(status)
+"""
+
+
+def child_usage(arguments, env=None, cwd=None):
+    """(CPU time [s], peak resident memory [MB]) of ``uq ARGUMENTS`` in a child process:
+    user + system time of the process and its waited-for children (numba compiles in
+    the process itself; a record-mode run's compile beside it), from wait4, and the
+    larger peak of the process and those children (:data:`PEAK_SCRIPT`)."""
+    with tempfile.NamedTemporaryFile("r", suffix=".peak") as peak:
+        child = subprocess.Popen([sys.executable, "-c", PEAK_SCRIPT, *arguments], cwd=cwd,
+                                 env={**(env or os.environ), "UQ_BENCH_PEAK_FILE": peak.name},
+                                 stdout=subprocess.DEVNULL)
+        _, status, usage = os.wait4(child.pid, 0)
+        child.returncode = os.waitstatus_to_exitcode(status)
+        if child.returncode != 0:
+            raise RuntimeError(f"uq {' '.join(arguments)} failed with status "
+                               f"{child.returncode}")
+        return usage.ru_utime + usage.ru_stime, float(peak.read())
 
 
 def cold_start(name="rubio2022_case_i", prefix="cold_start"):
-    """The README's first command, ``uq run NAME``, in a new process with an empty numba
-    cache (a fresh ``NUMBA_CACHE_DIR``: every kernel it calls compiles), then again with
-    that cache filled: {cold CPU [s], cold wall [s], cold peak RSS [MB], warm CPU [s]},
-    named ``{prefix}_cpu_s`` and so on. CPU time, not
-    wall time: on a loaded machine the wall time says how busy it is; on an idle one
+    """``uq run NAME --model compiled`` (compile what it calls first, in its own process:
+    the cost ``--model auto``, the default, leaves to a background process, measured by
+    :mod:`uq.bench.firstrun`) in a new process with an empty numba cache (a fresh
+    ``NUMBA_CACHE_DIR``), then again with that cache filled: {cold CPU [s], cold wall
+    [s], cold peak RSS [MB], warm CPU [s]}, named ``{prefix}_cpu_s`` and so on. CPU time,
+    not wall time: on a loaded machine the wall time says how busy it is; on an idle one
     the wall time of the single-threaded compile is about its CPU time (a record-mode
     run compiles in a second process beside its boxes: its wall time is the figure; its
-    peak is the larger of the two processes', wait4's resource usage)."""
+    peak is the larger of the two processes', :func:`child_usage`)."""
     with tempfile.TemporaryDirectory() as folder:
         env = {**os.environ, "NUMBA_CACHE_DIR": os.path.join(folder, "numba")}
-        argv = uq_command() + ["run", name, "-q", "-o", os.path.join(folder, "out.nc")]
+        argv = ["run", name, "-q", "--model", "compiled", "-o",
+                os.path.join(folder, "out.nc")]
         started = time.perf_counter()
         cold_cpu, cold_mb = child_usage(argv, env)
         cold_wall = time.perf_counter() - started
@@ -442,7 +496,7 @@ def measure(quick=False, progress=None, scale=1):
     def trials(n):
         return max(MIN_SAMPLES, int(n * scale))
 
-    n = trials(2**17 if quick else 2**19)
+    n = trials(2**17 if quick else FULL_AS_SHIPPED_TRIALS)
     seconds, floor = floating_lidar_full_as_shipped(n)
     figures.update(floating_lidar_full_mc_n=n, floating_lidar_full_mc_s=seconds,
                    floating_lidar_full_draw_floor_s=floor,
@@ -453,11 +507,13 @@ def measure(quick=False, progress=None, scale=1):
     figures.update(scans_1e6_s=seconds, scans_1e6_numpy_s=numpy_s,
                    scans_over_numpy=seconds / numpy_s)
     say(f"10^6 four-beam scans: {seconds:.3f} s, numpy {numpy_s:.3f} s")
-    seconds, static_s = motion_scans(trials(10**6))
+    seconds, static_s, cpu_s, static_cpu_s = motion_scans(trials(10**6))
     figures.update(pointwise_motion_1e6_s=seconds, static_1e6_s=static_s,
-                   pointwise_motion_over_static=seconds / static_s)
+                   pointwise_motion_over_static=seconds / static_s,
+                   pointwise_motion_1e6_cpu_s=cpu_s, static_1e6_cpu_s=static_cpu_s,
+                   pointwise_motion_over_static_cpu=cpu_s / static_cpu_s)
     say(f"10^6 point-wise scans in motion: {seconds:.3f} s, static {static_s:.3f} s "
-        f"(CPU time)")
+        f"(wall; CPU {cpu_s:.3f} s, {static_cpu_s:.3f} s)")
     seconds, four_s = conical_scans(trials(2**17))
     figures.update(conical_2e17_s=seconds, four_beam_motion_2e17_s=four_s,
                    conical_over_four_beam=seconds / four_s)

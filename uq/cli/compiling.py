@@ -63,6 +63,9 @@ class CompileNotice:
         self.remove()
 
     def _start(self, item):
+        from uq.compileguard import active
+        if active():                    # refused, not compiled (uq.compileguard)
+            return
         depth = getattr(self._local, "depth", 0)
         self._local.depth = depth + 1
         if depth == 0:
@@ -75,6 +78,9 @@ class CompileNotice:
                       flush=True)
 
     def _end(self, item):
+        from uq.compileguard import active
+        if active():
+            return
         self._local.depth -= 1
         if self._local.depth == 0:
             elapsed = time.perf_counter() - self._local.started

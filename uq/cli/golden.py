@@ -27,11 +27,23 @@ def add_parser(commands):
 
 
 def command(args):
+    """Analyse (and first simulate, for a synthetic campaign) and write the folder. As
+    ``uq run --model auto``: a synthetic campaign whose lidar kernels numba's cache does
+    not hold is simulated with the numpy model while they compile in the background
+    (:mod:`uq.cli.firstrun`)."""
+    from uq.cli import firstrun
     from uq.golden.command import run_golden
+    from uq.golden.config import load_golden_config
     from uq.pipeline.shipped import scenario_path
     import io
     import sys
-    run_golden(scenario_path(args.config), args.output,
-               stream=io.StringIO() if args.quiet else sys.stdout,
-               overrides=parse_overrides(args.set))
+    path = scenario_path(args.config)
+    overrides = parse_overrides(args.set)
+    synthetic = load_golden_config(path, overrides).synthetic
+    lidars = [scenario.settings for scenario in synthetic["lidars"].values()] \
+        if synthetic else []
+    background = firstrun.Background(args, lidars)
+    run_golden(path, args.output, stream=io.StringIO() if args.quiet else sys.stdout,
+               overrides=overrides, model="auto" if firstrun.wanted(args) else "compiled",
+               kernels_missing=background.start)
     return EXIT_OK

@@ -22,13 +22,18 @@ def add_parser(commands):
     run.add_argument("--resume", action="store_true",
                      help="continue an interrupted run: reuse the finished chunks kept in "
                      "OUT.nc.partial/ and compute only the missing scenes")
-    run.add_argument("--model", choices=("compiled", "numpy"), default="compiled",
-                     help="the measurement model: 'compiled' (default; numba, wherever it "
-                     "applies, else numpy, said at -v) or 'numpy' (the reference model "
-                     "throughout; the same numbers to 1e-12 m/s, slower)")
+    run.add_argument("--model", choices=("auto", "compiled", "numpy"), default="auto",
+                     help="the measurement model and statistics: 'auto' (default) the "
+                     "compiled ones (numba) where numba's cache holds their kernels, else "
+                     "numpy while the kernels compile in a background process for later "
+                     "runs (first run after an install); 'compiled' compiles what is "
+                     "missing first; 'numpy' the reference model throughout. The same "
+                     "numbers to 1e-12 m/s")
     run.add_argument("--device", choices=("cpu", "gpu"), default="cpu",
                      help="where the turbulence boxes of record mode are made: 'cpu' "
-                     "(numpy, default) or 'gpu' (CuPy on a CUDA GPU; exits 2 without one)")
+                     "(default, the only one this version runs: numpy's FFTs and compiled "
+                     "kernels); 'gpu' is refused (exit 2): record mode's boxes are not "
+                     "made with CuPy yet")
     scale = run.add_mutually_exclusive_group()
     scale.add_argument("--workers", type=int, metavar="N",
                        help="run the sweep on a local dask cluster of N processes "
@@ -40,20 +45,17 @@ def add_parser(commands):
     return run
 
 
+#: Why ``--device gpu`` is refused (one line, exit 2).
+GPU_REFUSED = ("record mode makes its turbulence boxes on the CPU only in this version "
+               "(their generation and sampling with CuPy are not wired into the run and "
+               "have not been verified on a GPU)")
+
+
 def check_device(args, scenario):
-    """``--device gpu``: CuPy and a CUDA GPU must be there (else exit 2, one line, before
-    any work); this version's runs make no box (the Monte Carlo records are not wired
-    yet), which it says at once."""
-    if getattr(args, "device", "cpu") != "gpu":
-        return
-    from uq.physics.turbulencebox import array_namespace
-    try:
-        array_namespace("gpu")
-    except ValueError as error:
-        raise ScenarioError("--device", "gpu", f"{error}; allowed: --device cpu") from None
-    logging.getLogger(__name__).warning(
-        "--device gpu: this run makes no turbulence box (the Monte Carlo records are not "
-        "wired yet); it runs on the CPU as with --device cpu")
+    """``--device gpu`` is refused before any work (one line, exit 2): no run of this
+    version makes a box on a GPU, so the flag would not do what it says."""
+    if getattr(args, "device", "cpu") == "gpu":
+        raise ScenarioError("--device", "gpu", f"{GPU_REFUSED}; allowed: --device cpu")
 
 
 def command(args):
@@ -71,8 +73,12 @@ def command(args):
     check_target(output)                     # before any work: refused targets cost nothing
     check_scale_out(args)
     check_device(args, scenario)
+    from uq.cli import firstrun
     compiling = getattr(args, "compile_notice", None)
-    load_kernels(args, scenario)
+    if args.model == "auto" and not firstrun.wanted(args):
+        args.model = "compiled"              # compiles what it calls first (module doc)
+    background = firstrun.Background(args, [scenario.settings])
+    load_kernels(args, scenario, background)
     before_run = compiling.seconds if compiling else 0.0     # compiled before the run
     new_folders = missing_folders(output.parent)
     checkpoint = Checkpoint(checkpoint_directory(output), resume=args.resume,
@@ -85,7 +91,8 @@ def command(args):
     try:
         with dask_client(args) as client:
             dataset = run(scenario, progress=progress, client=client, checkpoint=checkpoint,
-                          model=args.model, kernels_ready=beside.wait if beside else None)
+                          model=args.model, kernels_ready=beside.wait if beside else None,
+                          kernels_missing=background.start)
         dataset.attrs["runtime_s"] += before_run  # the user's wait, compiles included
         write_netcdf(dataset, output)
         checkpoint.clear()                   # still locked: no other run can be in it
@@ -123,7 +130,7 @@ def _note(text):
     print(f"uq: {text}", file=sys.stderr, flush=True)
 
 
-def load_kernels(args, scenario):
+def load_kernels(args, scenario, background=None):
     """Load the compiled kernels the run surely uses before its progress bar starts: the
     statistics', and the static model's geometry (real arithmetic; the complex kernels
     load when a GUM grid of many scenes first calls them) or the time-resolved model's.
@@ -133,13 +140,30 @@ def load_kernels(args, scenario):
     records' boxes are drawn (:func:`uq.pipeline.records.draw_first_records`): numba
     keeps ~100-170 MB of what it compiles, which a box drawn after it would add to; on a
     cold cache a second process compiles them while the boxes are drawn
-    (:mod:`uq.cli.sidecompile`)."""
+    (:mod:`uq.cli.sidecompile`). With ``--model auto`` nothing compiles here: the
+    kernels are loaded where numba's cache holds them (a record-mode run's too: loading
+    keeps far less than compiling), else their compile starts in the background
+    (:mod:`uq.cli.firstrun`)."""
+    model = getattr(args, "model", "compiled")
+    if model == "numpy":
+        return                                    # no kernel is called
+    if model == "auto":                  # loaded where cached; else the compile starts
+        from uq.compileguard import KernelNotCached, cached_only
+        try:                             # (the run finds it missing too: numpy)
+            with cached_only():
+                _load_kernels(scenario)
+        except KernelNotCached as error:
+            background.start(error)
+        return
     if draws_records(scenario):          # every kernel when first called (or beside:
         return                           # :mod:`uq.cli.sidecompile`)
+    _load_kernels(scenario)
+
+
+def _load_kernels(scenario):
+    """Load (or compile) the kernels of :func:`load_kernels`."""
     from uq.pipeline import motionsection
     import uq.engine.statkernels  # noqa: F401  (numba compiles or loads on import)
-    if getattr(args, "model", "compiled") == "numpy":
-        return                                    # no model kernel is called
     if motionsection.is_time_resolved(scenario.settings):   # the static model unused
         import uq.physics.fusedmotionkernels  # noqa: F401
         return

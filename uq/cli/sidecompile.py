@@ -26,8 +26,6 @@ import sys
 import tempfile
 import time
 
-import yaml
-
 #: Trials per scene of the child's run: the kernels' types, not their work, matter.
 SIDE_COMPILE_TRIALS = 64
 #: Memory the machine must have free to start the child [MB]: its peak (~390-400 MB,
@@ -139,6 +137,7 @@ class SideCompile:
     """
 
     def __init__(self, settings, stream):
+        import yaml                          # (not on the command line's import path)
         handle, self.path = tempfile.mkstemp(prefix="uq-side-compile-", suffix=".yaml")
         with os.fdopen(handle, "w") as file:
             yaml.safe_dump(settings, file)

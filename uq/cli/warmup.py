@@ -61,8 +61,9 @@ def compile_for(scenario, overrides=()):
     without its turbulence records (the ``turbulence`` and ``record`` sections and their
     sweep keys), :data:`~uq.cli.sidecompile.SIDE_COMPILE_TRIALS` trials per scene, the
     results discarded: numba compiles (or loads) every kernel of its per-scan Monte
-    Carlo, the GUM's and the statistics'. A record-mode run's own records then call the
-    same kernels (:mod:`uq.cli.sidecompile`)."""
+    Carlo, the GUM's and the statistics' (those of runs of 2^17 trials or more too,
+    which a run of a few trials does not call). A record-mode run's own records then
+    call the same kernels (:mod:`uq.cli.sidecompile`)."""
     import copy
     import logging
     from uq.cli.common import parse_overrides
@@ -84,6 +85,7 @@ def compile_for(scenario, overrides=()):
         run(load_scenario(settings))
     finally:
         logging.disable(logging.NOTSET)
+    import uq.engine.passkernels  # noqa: F401  (long runs' statistics: compiled on import)
 
 
 #: The sections of record mode (:mod:`uq.pipeline.records`), left out by :func:`compile_for`.

@@ -100,6 +100,21 @@ class UniformCircle:
         return f"UniformCircle(radius={self.radius:g})"
 
 
+def moments(distribution):
+    """(mean, standard deviation) of a distribution (a frozen scipy one, or anything with
+    ``mean()`` and ``std()``), kept for the next run that uses the same object (the
+    scenario layer shares one frozen distribution per spec)."""
+    try:
+        return _kept_moments(distribution)
+    except TypeError:                        # unhashable: computed anew
+        return _kept_moments.__wrapped__(distribution)
+
+
+@functools.lru_cache(maxsize=1024)
+def _kept_moments(distribution):
+    return float(distribution.mean()), float(distribution.std())
+
+
 @dataclass(frozen=True)
 class InputSet:
     """Random inputs laid out as columns of a (samples, dimension) matrix.
@@ -130,9 +145,8 @@ class InputSet:
     @functools.cached_property
     def _moments(self):
         """(mean, standard deviation) of each input, computed once (scipy's frozen
-        mean() and std() cost ~50 us each)."""
-        return {name: (float(self.distributions[name].mean()),
-                       float(self.distributions[name].std())) for name in self.names}
+        mean() and std() cost ~50 us each; :func:`moments` keeps them across runs)."""
+        return {name: moments(self.distributions[name]) for name in self.names}
 
     def correlation_matrix(self):
         """Column correlation matrix, shape (dimension, dimension)."""

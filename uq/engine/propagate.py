@@ -37,7 +37,7 @@ log = logging.getLogger(__name__)
 def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
               correlation=None, circular=(), output_dims=None, interval="symmetric",
               chunk_size=None, control_variate=False, stopping="jcgm101", covariance=(),
-              stop_when_gum_valid=False, auxiliary=()):
+              stop_when_gum_valid=False, auxiliary=(), compiled=True):
     """Propagate input distributions through `model` by Monte Carlo and by the GUM.
 
     Parameters
@@ -96,6 +96,10 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
         batch as the others): they take no part in the GUM, the stopping rule, the
         coverage interval, the control variate or the validation. The model may leave
         them out of a call with complex inputs (the GUM's).
+    compiled : bool
+        The statistics' compiled loops (numba, :mod:`uq.engine.statkernels`; default),
+        or False: the same statistics in numpy (:mod:`uq.engine.statnumpy`, equal to
+        rounding), nothing compiled.
 
     Returns
     -------
@@ -148,7 +152,7 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
     references = {q: _circular_reference(gum_value[q]) if q in circular else None
                   for q in gum_value}
     runner = _Runner(wrapped, inputs_laid, method, seed, references, interval, chunk_size,
-                     covariance, auxiliary)
+                     covariance, auxiliary, compiled)
     if set(covariance) & circular:
         raise ValueError(f"no covariance of circular outputs: {sorted(set(covariance) & circular)}")
     if control_variate:
@@ -165,14 +169,16 @@ def propagate(model, inputs, *, n=None, digits=None, method="mc", seed=None,
                            q in circular) for q in gum_value}
         runner.run_adaptive(digits or DEFAULT_DIGITS, stopping, targets)
     validation_digits = digits or DEFAULT_DIGITS
-    dataset = _gum_dataset(gum_value, jacobian, inputs_laid, output_dims or {})
-    dataset = dataset.assign(_gum_covariances(jacobian, inputs_laid, dataset, covariance))
+    gum_results = _gum_variables(gum_value, jacobian, inputs_laid, output_dims or {})
+    data = {**gum_results, **_gum_covariances(jacobian, inputs_laid, gum_results, covariance)}
     if runner.stats is not None:
-        dataset = dataset.assign(_mc_variables(runner, dataset, circular, validation_digits))
-        dataset = dataset.assign(_mc_covariances(runner, dataset))
-        dataset = dataset.assign(_auxiliary_variables(runner, output_dims or {}))
+        data.update(_mc_variables(runner, gum_results, circular, validation_digits))
+        data.update(_mc_covariances(runner, gum_results))
+        data.update(_auxiliary_variables(runner, output_dims or {}))
     else:
-        dataset = dataset.assign(_not_validated(dataset))
+        data.update(_not_validated(gum_results))
+    # one Dataset of every variable (each assign of xarray's is a merge: ~1 ms)
+    dataset = xr.Dataset(data, coords={"input": list(inputs_laid.names)})
     dataset.attrs.update(n_samples=runner.n_done, seed=seed, sampling_method=method,
                          digits=validation_digits, interval=interval,
                          coverage_probability=COVERAGE_PROBABILITY, gum=gum_note,
@@ -269,7 +275,7 @@ class _Runner:
     """Draws blocks, evaluates the model chunk by chunk, accumulates statistics."""
 
     def __init__(self, model, inputs, method, seed, references, interval, chunk_size,
-                 covariance=(), auxiliary=()):
+                 covariance=(), auxiliary=(), compiled=True):
         self.model, self.inputs, self.method, self.seed = model, inputs, method, seed
         self.references, self.interval = references, interval
         blocks = DEFAULT_BLOCKS_PER_CHUNK if chunk_size is None else -(-int(chunk_size) // RNG_BLOCK_SIZE)
@@ -284,16 +290,17 @@ class _Runner:
         self.control, self.linear = None, {}
         self.covariance, self.comoments = tuple(covariance), {}
         self.auxiliary, self.moments = tuple(auxiliary), {}
+        self.compiled = compiled                     # the statistics' loops
 
     def _start(self, capacity, shapes, expected=None):
         self.moments = {q: Moments(shapes[q]) for q in self.auxiliary}
         shapes = {q: shape for q, shape in shapes.items() if q not in self.auxiliary}
         self.stats = {q: StreamingStatistics(shape, capacity, self.references[q],
-                                             expected=expected)
+                                             expected=expected, compiled=self.compiled)
                       for q, shape in shapes.items()}
         self.batches = {q: {key: [] for key in _BATCH_KEYS} for q in shapes}
         self.linear = {q: Moments(shape) for q, shape in shapes.items()}
-        self.comoments = {q: CoMoments(shapes[q]) for q in self.covariance}
+        self.comoments = {q: CoMoments(shapes[q], self.compiled) for q in self.covariance}
 
     def _pieces(self, first_block, n_blocks, n_samples, drawn=None):
         """Outputs (and linear deviations, with a control variate) of n_samples trials
@@ -414,17 +421,25 @@ class _Runner:
         chunks = [(first, min(self.blocks_per_chunk, total_blocks - first),
                    min(n - first * RNG_BLOCK_SIZE, self.blocks_per_chunk * RNG_BLOCK_SIZE))
                   for first in range(0, total_blocks, self.blocks_per_chunk)]
+        if len(chunks) == 1:                 # nothing to draw ahead: no second thread
+            self._fixed_chunk(chunks[0], n)
+            return
         with ThreadPoolExecutor(max_workers=1, thread_name_prefix="uq-draws") as drawer:
             pending = drawer.submit(self._drawn, *chunks[0])
             for index, chunk in enumerate(chunks):
                 drawn = pending.result()
                 if index + 1 < len(chunks):
                     pending = drawer.submit(self._drawn, *chunks[index + 1])
-                for outputs, linear in self._pieces(*chunk, drawn):
-                    if self.stats is None:
-                        self._start(tail_capacity(n, kind=self.interval) + 1,
-                                    {q: v.shape[1:] for q, v in outputs.items()}, expected=n)
-                    self._accumulate(outputs, linear)
+                self._fixed_chunk(chunk, n, drawn)
+
+    def _fixed_chunk(self, chunk, n, drawn=None):
+        """Evaluate and accumulate one chunk of a run of n trials (`drawn`: its inputs,
+        made ahead, else made here)."""
+        for outputs, linear in self._pieces(*chunk, drawn):
+            if self.stats is None:
+                self._start(tail_capacity(n, kind=self.interval) + 1,
+                            {q: v.shape[1:] for q, v in outputs.items()}, expected=n)
+            self._accumulate(outputs, linear)
 
     def run_adaptive(self, digits, stopping="jcgm101", gum_targets=None):
         """JCGM 101:2008, 7.9.4: batches of M >= 10^4 trials, one RNG block per step, until
@@ -485,8 +500,8 @@ class _Runner:
         return coverage_factor(h) * np.max(spread, axis=0)
 
 
-def _gum_dataset(gum_value, jacobian, inputs, output_dims):
-    """GUM value, u and budget of every output."""
+def _gum_variables(gum_value, jacobian, inputs, output_dims):
+    """GUM value, u and budget of every output: {name: (dims, values)}."""
     data = {}
     for q, value in gum_value.items():
         dims = tuple(output_dims.get(q, [f"{q}_dim{i}" for i in range(np.ndim(value))]))
@@ -495,15 +510,16 @@ def _gum_dataset(gum_value, jacobian, inputs, output_dims):
             f"{q}_gum_u": (dims, gum.combined_uncertainty(jacobian[q], inputs)),
             f"{q}_budget": (("input",) + dims, gum.variance_budget(jacobian[q], inputs)),
         })
-    return xr.Dataset(data, coords={"input": list(inputs.names)})
+    return data
 
 
 def _mc_variables(runner, gum_results, circular, digits):
-    """Monte Carlo statistics of every output, and the clause 8 validation of the GUM."""
+    """Monte Carlo statistics of every output, and the clause 8 validation of the GUM
+    (`gum_results`: :func:`_gum_variables`)."""
     data = {}
     for q, stats in runner.stats.items():
-        dims = gum_results[f"{q}_gum_u"].dims
-        value, u_gum = gum_results[f"{q}_gum_value"].values, gum_results[f"{q}_gum_u"].values
+        dims, u_gum = gum_results[f"{q}_gum_u"]
+        value = gum_results[f"{q}_gum_value"][1]
         result = runner.result(q)
         error = runner.numerical_error(q)
         delta = gum.numerical_tolerance(u_gum, digits)    # clause 8's delta (JCGM 101 8.2)
@@ -542,10 +558,9 @@ def _not_validated(gum_results):
     and ``q_gum_validation_conclusive`` are False (present, as every results file has
     them; there is no ``q_mc_u`` to validate against)."""
     data = {}
-    for name in gum_results.data_vars:
+    for name, (dims, values) in gum_results.items():
         if name.endswith("_gum_u"):
-            q, dims = name[:-len("_gum_u")], gum_results[name].dims
-            shape = gum_results[name].shape
+            q, shape = name[:-len("_gum_u")], np.shape(values)
             data[f"{q}_gum_valid"] = (dims, np.zeros(shape, dtype=bool))
             data[f"{q}_gum_validation_conclusive"] = (dims, np.zeros(shape, dtype=bool))
     return data
@@ -568,11 +583,11 @@ def _other(dims):
     return tuple(dims) + (f"{dims[-1]}_other",)
 
 
-def _gum_covariances(jacobian, inputs, dataset, names):
-    return {f"{q}_gum_covariance": (_other(dataset[f"{q}_gum_u"].dims),
+def _gum_covariances(jacobian, inputs, gum_results, names):
+    return {f"{q}_gum_covariance": (_other(gum_results[f"{q}_gum_u"][0]),
                                     gum.output_covariance(jacobian[q], inputs)) for q in names}
 
 
-def _mc_covariances(runner, dataset):
-    return {f"{q}_mc_covariance": (_other(dataset[f"{q}_gum_u"].dims), moments.covariance())
+def _mc_covariances(runner, gum_results):
+    return {f"{q}_mc_covariance": (_other(gum_results[f"{q}_gum_u"][0]), moments.covariance())
             for q, moments in runner.comoments.items()}

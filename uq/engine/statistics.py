@@ -39,11 +39,15 @@ from uq.engine.orderstats import order_statistics
 INTERVALS = ("symmetric", "shortest")
 
 
-def _kernels():
+def _kernels(compiled=True):
     """:mod:`uq.engine.statkernels`, imported when a statistic is first computed, not
     with this module: its kernels have explicit signatures, so numba compiles them
     (first run after an install, ~5 s) or loads them on import, which a command that
-    only reads a scenario (``uq fit``, ``uq check``) must not pay."""
+    only reads a scenario (``uq fit``, ``uq check``) must not pay. Not `compiled`: the
+    same loops in numpy (:mod:`uq.engine.statnumpy`), nothing compiled."""
+    if not compiled:
+        from uq.engine import statnumpy
+        return statnumpy
     from uq.engine import statkernels
     return statkernels
 
@@ -179,8 +183,9 @@ class CoMoments:
     when all g of its values are finite (complete cases).
     """
 
-    def __init__(self, shape):
+    def __init__(self, shape, compiled=True):
         self.shape = tuple(shape)
+        self.compiled = compiled
         self.count = np.zeros(shape[:-1], dtype=np.int64)
         self.mean = np.zeros(shape)
         self.comoment = np.zeros(self.shape + self.shape[-1:])
@@ -193,7 +198,7 @@ class CoMoments:
         rows = values.reshape(len(values), -1, g)
         count = np.empty(rows.shape[1], dtype=np.int64)
         mean, comoment = np.empty(rows.shape[1:]), np.empty(rows.shape[1:] + (g,))
-        _kernels().comoments(rows, count, mean, comoment)
+        _kernels(self.compiled).comoments(rows, count, mean, comoment)
         count = count.reshape(self.count.shape)
         mean = mean.reshape(self.shape)
         comoment = comoment.reshape(self.comoment.shape)
@@ -270,11 +275,15 @@ class StreamingStatistics:
         Values kept whole, over all elements.
     expected : int, optional
         Samples that will be added (the store is sized for them at once).
+    compiled : bool
+        The compiled loops (default); False: the same statistics in numpy
+        (:mod:`uq.engine.statnumpy`, equal to rounding), nothing compiled.
     """
 
     def __init__(self, shape, capacity, reference=None, stored_values=STORED_VALUES,
-                 expected=None):
+                 expected=None, compiled=True):
         self.shape = tuple(shape)
+        self.compiled = compiled
         self.capacity = int(capacity)
         self.reference = None if reference is None else \
             np.array(np.broadcast_to(reference, shape), dtype=float).reshape(-1)   # writeable
@@ -289,6 +298,11 @@ class StreamingStatistics:
         self._scratch = []                         # per part of the elements
         self._expected = int(expected) if expected else 0
         self._run = None                           # the run's brackets (_RunBrackets)
+
+    @property
+    def _loops(self):
+        """The statistics' loops: compiled, or numpy's (:func:`_kernels`)."""
+        return _kernels(self.compiled)
 
     @property
     def _stored(self):
@@ -310,7 +324,8 @@ class StreamingStatistics:
         values = np.asarray(values, dtype=float)
         m = len(values)
         flat = values.reshape(m, self.size)          # (a view where the layout allows)
-        if kind == "symmetric" and self._stored and self._expected >= ONE_PASS_MIN_TRIALS:
+        if kind == "symmetric" and self._stored and self._expected >= ONE_PASS_MIN_TRIALS \
+                and self.compiled:
             return self._add_in_one_pass(flat, batch_size, summarize,
                                          min(summary_size or batch_size, batch_size))
         if self._run is not None:
@@ -320,18 +335,18 @@ class StreamingStatistics:
         if not circular and flat.strides[0] == flat.itemsize:  # element-major (the
             columns[:, offset:offset + m] = flat.T      # compiled models'): row copies
         else:
-            _kernels().transpose(flat, self.reference if circular else _NO_REFERENCE,
+            self._loops.transpose(flat, self.reference if circular else _NO_REFERENCE,
                                   circular, columns, offset)
         summaries = []
         count, mean, m2 = (np.empty(self.size, dtype=np.int64), np.empty(self.size),
                            np.empty(self.size))
         for start in range(0, m, batch_size):
             stop = min(m, start + batch_size)
-            _kernels().moments(columns, offset + start, offset + stop, count, mean, m2)
+            self._loops.moments(columns, offset + start, offset + stop, count, mean, m2)
             self.moments.merge(count.reshape(self.shape), mean.reshape(self.shape),
                                m2.reshape(self.shape))
             if circular:
-                _kernels().resultant(columns, offset + start, offset + stop,
+                self._loops.resultant(columns, offset + start, offset + stop,
                                       self.reference, self._cos, self._sin)
             if summarize:
                 summaries.extend(self._summaries(columns, offset, start, stop, (count, mean, m2),
@@ -356,7 +371,7 @@ class StreamingStatistics:
         reference = self.reference if circular else _NO_REFERENCE
         copy = flat.strides[0] == flat.itemsize      # element-major: copied in the pass
         if not copy:                                 # trial-major: tiles of trials
-            _kernels().transpose(flat, reference, circular, columns, offset)
+            self._loops.transpose(flat, reference, circular, columns, offset)
         if self._run is None:
             # (the values stored at most: the room is a fraction of the store's)
             self._run = _RunBrackets(self.size, min(self._expected or m,
@@ -365,7 +380,7 @@ class StreamingStatistics:
         size = size if summarize else 0
         count, mean, m2 = (np.empty(self.size, dtype=np.int64), np.empty(self.size),
                            np.empty(self.size))
-        length = _kernels().scratch_length(size)
+        length = self._loops.scratch_length(size)
         if len(self._scratch) != 1 or self._scratch[0].shape[1] < length:
             self._scratch = [np.empty((2, length))]
         summaries = []
@@ -409,7 +424,7 @@ class StreamingStatistics:
         count, mean, m2 = (np.empty_like(m) for m in moments)
         out = []
         for first in range(start, stop - size + 1, size):
-            _kernels().moments(columns, offset + first, offset + first + size, count, mean,
+            self._loops.moments(columns, offset + first, offset + first + size, count, mean,
                                 m2)
             out.append((first, self._summary(columns, offset + first, offset + first + size,
                                              count, mean, m2, kind)))
@@ -445,12 +460,12 @@ class StreamingStatistics:
         if kind == "symmetric":
             ranks = _rank_pairs(count, probability)
             parts = element_parts(size)
-            length = _kernels().scratch_length(stop - start)
+            length = self._loops.scratch_length(stop - start)
             if len(self._scratch) != len(parts) or self._scratch[0].shape[1] < length:
                 self._scratch = [np.empty((2, length)) for _ in parts]
             count = np.ascontiguousarray(count, dtype=np.int64)
             low_rank, high_rank = ranks[:, 0].copy(), ranks[:, 1].copy()
-            in_parallel([(_kernels().select_pairs, columns[part], start, stop, count[part],
+            in_parallel([(self._loops.select_pairs, columns[part], start, stop, count[part],
                           low_rank[part], high_rank[part], low[part], high[part], scratch)
                          for part, scratch in zip(parts, self._scratch)])
             return low, high

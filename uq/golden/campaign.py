@@ -108,9 +108,10 @@ def site_difference(n, rng, settings):
             settings["direction_separation"] * rng.standard_normal(n))
 
 
-def lidar_records(scenario, mast, site, rng, settings):
+def lidar_records(scenario, mast, site, rng, settings, compiled=True):
     """One floating lidar's table over the mast's records, at the site whose wind differs
-    from the mast's by `site` (:func:`site_difference`); see the module docstring."""
+    from the mast's by `site` (:func:`site_difference`); see the module docstring
+    (`compiled`: the compiled model, else numpy's: the same numbers to 1e-12)."""
     n = len(mast)
     site_speed, site_turn = site
     shear = np.nan_to_num(mast["shear"].to_numpy(), nan=0.0)
@@ -119,7 +120,7 @@ def lidar_records(scenario, mast, site, rng, settings):
         speed, direction = lidar_at_height(
             scenario, height, mast[f"speed_{height:g}"].to_numpy() * site_speed,
             mast[f"direction_{height:g}"].to_numpy() + site_turn, shear, rng,
-            settings["scans_per_record"])
+            settings["scans_per_record"], compiled)
         table[f"speed_{height:g}"], table[f"direction_{height:g}"] = speed, direction
         table[f"ti_{height:g}"] = mast[f"ti_{height:g}"]
     lost = rng.random(n) < settings["outage"]
@@ -129,7 +130,7 @@ def lidar_records(scenario, mast, site, rng, settings):
     return table
 
 
-def lidar_at_height(scenario, height, speed, direction, shear, rng, scans):
+def lidar_at_height(scenario, height, speed, direction, shear, rng, scans, compiled=True):
     """10-min mean speed [m s-1] and direction [deg] of a lidar gate at `height` [m] for
     records of the site's `speed`, `direction` [deg] and `shear` (arrays, shape (n,))."""
     settings = scenario.settings
@@ -140,7 +141,7 @@ def lidar_at_height(scenario, height, speed, direction, shear, rng, scans):
     draws = {name: _draw(spec, (scans, len(speed)), rng, name)
              for name, spec in sorted(error_inputs(settings, scene.n_beams, 1).items())}
     out = measurement_model(scene, ("wind_speed", "wind_direction"), scene_draws=True,
-                            **draws)
+                            compiled=compiled, **draws)
     return (np.mean(out["wind_speed"][..., 0], axis=0),
             circular_mean_deg(out["wind_direction"][..., 0], axis=0) % FULL_CIRCLE_DEG)
 
@@ -157,9 +158,11 @@ def _draw(spec, leading, rng, name):
     return dist.ppf(rng.random(leading + shape))
 
 
-def generate_campaign(config, directory):
+def generate_campaign(config, directory, compiled=True):
     """Write the synthetic campaign's CSV files and its data configuration
-    (``campaign.yaml``) into `directory`; returns the configuration's path."""
+    (``campaign.yaml``) into `directory`; returns the configuration's path (`compiled`:
+    the lidars' compiled model, else numpy's; the same records to 1e-12, the same draws).
+    """
     settings = config.synthetic
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
@@ -174,10 +177,10 @@ def generate_campaign(config, directory):
             tables["mast"] = mast
             for role, name in (("golden", "flsb"), ("unit", "flsa")):
                 tables[name] = lidar_records(settings["lidars"][role], mast, site, rng,
-                                             settings)
+                                             settings, compiled)
         else:
             tables["smc"] = lidar_records(settings["lidars"]["unit"], mast, site, rng,
-                                          settings)
+                                          settings, compiled)
     for name, table in tables.items():
         table.to_csv(directory / f"{name}.csv", index_label="timestamp", float_format="%.5g")
     path = directory / "campaign.yaml"

@@ -38,10 +38,13 @@ KPI = ("speed_slope", "speed_r_squared", "speed_n_records", "speed_slope_verdict
        "availability_verdict", "coverage_verdict", "class_number")
 
 
-def run_golden(config_path, output=None, stream=None, overrides=None):
+def run_golden(config_path, output=None, stream=None, overrides=None, model="compiled",
+               kernels_missing=None):
     """Analyse the campaign of `config_path` and write the folder; returns its path.
     The summary goes to `stream` (default stdout), warnings to the log (stderr);
-    `overrides` are ``uq golden --set`` (:func:`uq.golden.config.load_golden_config`)."""
+    `overrides` are ``uq golden --set`` (:func:`uq.golden.config.load_golden_config`).
+    `model` and `kernels_missing`: the synthetic lidars' model, as :func:`uq.run`'s (the
+    campaign is generated again from its seed where ``auto`` finds a kernel missing)."""
     stream = stream or sys.stdout
     config = load_golden_config(config_path, overrides)
     folder = Path(output) if output else Path("results") / config.name
@@ -49,8 +52,11 @@ def run_golden(config_path, output=None, stream=None, overrides=None):
     partial = new_partial_folder(folder)
     try:
         if config.synthetic is not None:
+            from uq.pipeline.runner import ModelChoice
             from .campaign import generate_campaign
-            config = load_golden_config(generate_campaign(config, partial / "data"))
+            choice = ModelChoice(model, kernels_missing)
+            config = load_golden_config(choice.evaluate(
+                lambda compiled: generate_campaign(config, partial / "data", compiled)))
         ds = analyse(config)
         _write(ds, partial, config.name)
     except BaseException:

@@ -101,6 +101,16 @@ def correction_rotation(model, heading, pitch, roll, nominal_heading):
     return attitude_matrix(heading, pitch, roll)
 
 
+def believed_motion(model, navigation, nominal_heading=0.0):
+    """(rotation (..., k, 3, 3), ship velocity (..., k, 3)) that correction `model`
+    believes from the INS `navigation` (:func:`correction_rotation`,
+    :func:`correction_ship_velocity`)."""
+    nav = navigation
+    return (correction_rotation(model, nav["heading"], nav["pitch"], nav["roll"],
+                                nominal_heading),
+            correction_ship_velocity(model, nav["sog"], nav["cog"], nav["heave"]))
+
+
 def correction_ship_velocity(model, sog, cog, heave):
     """Ship velocity (north, east, up) [m s-1] the model removes; shape (..., 3)."""
     zero = 0 * sog
@@ -112,7 +122,7 @@ def correction_ship_velocity(model, sog, cog, heave):
 
 
 def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navigation,
-                     nominal_heading=0.0, horizontal_only=False):
+                     nominal_heading=0.0, horizontal_only=False, believed=None):
     """Earth-frame wind from radial velocities under a correction model.
 
     Parameters
@@ -134,6 +144,9 @@ def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navig
         Two beams of a nacelle lidar: w = 0 assumed, the horizontal wind from the earth-
         frame beams the model believes (:func:`uq.physics.nacelle.horizontal_least_squares`);
         `operator` is not used. ``tilt2d`` (Eq. 13 on a 3-D DBS wind) is refused.
+    believed : tuple, optional
+        ``(rotation, ship velocity)`` of :func:`believed_motion` for the same `model`,
+        `navigation` and `nominal_heading`, where the caller has them already.
 
     Returns
     -------
@@ -157,9 +170,7 @@ def reconstruct_wind(radial_velocity, model, lidar_unit_vectors, operator, navig
     array([-10.,   0.,   0.])
     """
     nav = navigation
-    rotation = correction_rotation(model, nav["heading"], nav["pitch"], nav["roll"],
-                                   nominal_heading)
-    ship = correction_ship_velocity(model, nav["sog"], nav["cog"], nav["heave"])
+    rotation, ship = believed or believed_motion(model, nav, nominal_heading)
     if horizontal_only:
         if model == "tilt2d":
             raise ValueError("tilt2d needs beams that determine the 3-D wind")

@@ -50,7 +50,7 @@ from uq import complexstep
 from uq.physics import probe as probe_volume
 from uq.physics import wind
 from uq.physics.beams import beam_unit_vectors, least_squares_operator, slant_distances
-from uq.physics.correction import correction_rotation, correction_ship_velocity, reconstruct_wind
+from uq.physics.correction import believed_motion, reconstruct_wind
 from uq.physics.rotation import attitude_matrix, rotate_vectors
 from uq.physics import modelinputs
 from uq.physics.modelinputs import STATIC, STATIC_COMPILED
@@ -188,10 +188,11 @@ def measurement_model(scene, outputs=OUTPUTS, scene_draws=False, compiled=True, 
     measured, navigation, beams_earth = _measure(scene, err, (n,) + scenes)
     unit_vectors = scene.nominal_unit_vectors()
     operator = None if scene.horizontal_only else least_squares_operator(unit_vectors)
+    believed = believed_motion(scene.correction, navigation, scene.field("heading", 1))
     wind_vector = reconstruct_wind(measured, scene.correction, unit_vectors, operator,
                                    navigation, scene.field("heading", 1),
-                                   horizontal_only=scene.horizontal_only)
-    result = _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors)
+                                   horizontal_only=scene.horizontal_only, believed=believed)
+    result = _outputs(scene, outputs, wind_vector, measured, believed, unit_vectors)
     if "gate_height" in outputs:
         result["gate_height"] = _gate_height(scene, beams_earth, err["lidar_height"])
     return _full_shape(result, (n,) + scene.shape, scene.n_beams)
@@ -263,12 +264,12 @@ def _ship_velocity(scene):
     return np.stack([sog * np.cos(cog), sog * np.sin(cog), heave], axis=-1)
 
 
-def _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors):
+def _outputs(scene, outputs, wind_vector, measured, believed, unit_vectors):
     nacelle_wanted = set(outputs) & set(NACELLE_OUTPUTS)
     pair = nacelle.level_pair(scene.azimuths) if scene.tilt != 0 and \
         not scene.horizontal_only else None
     if "radial_velocity" in outputs or nacelle_wanted or pair:
-        corrected, beams = _corrected_radial(scene, measured, navigation, unit_vectors)
+        corrected, beams = _corrected_radial(measured, believed, unit_vectors)
     if pair:                   # a nacelle lidar's hub-height wind: its level beams'
         wind_vector = nacelle.hub_height_wind(wind_vector, beams, corrected, pair)
     result = wind.wind_outputs(wind_vector, outputs)
@@ -284,13 +285,11 @@ def _outputs(scene, outputs, wind_vector, measured, navigation, unit_vectors):
     return result
 
 
-def _corrected_radial(scene, measured, navigation, unit_vectors):
+def _corrected_radial(measured, believed, unit_vectors):
     """Radial velocity freed of the believed ship motion, along the believed beam, and
-    the believed earth-frame beams (n, *S, b, 3)."""
-    nav = navigation
-    rotation = correction_rotation(scene.correction, nav["heading"], nav["pitch"],
-                                   nav["roll"], scene.field("heading", 1))
-    ship = correction_ship_velocity(scene.correction, nav["sog"], nav["cog"], nav["heave"])
+    the believed earth-frame beams (n, *S, b, 3); `believed`: the correction's rotation
+    and ship velocity (:func:`uq.physics.correction.believed_motion`)."""
+    rotation, ship = believed
     beams = (rotation @ unit_vectors[..., None])[..., 0]               # (n, *S, k|b, 3)
     corrected = measured + np.sum(beams * ship, axis=-1)[..., None]
     return corrected, np.broadcast_to(beams, corrected.shape[:-1] + (3,))

@@ -121,26 +121,49 @@ def degrees_of_freedom(motion, unit_phases, times):
     value, rate : dict
         dof -> ndarray of shape (n, *T) [rad or m, rad s-1 or m s-1] (0.0 for a degree
         of freedom no component moves).
+
+    Notes
+    -----
+    With the lag moved onto the unit phase (``sin(w t + psi) c1 + cos(w t + psi) c2 =
+    sin(w t) a + cos(w t) b``, a = c1 cos psi - c2 sin psi, b = c1 sin psi + c2 cos psi;
+    the rate ``w (cos(w t) a - sin(w t) b)``), each component's sine and cosine are
+    taken once for every degree of freedom, and only at the times given (once for all
+    trials where the times are common), and the sum over components is a product of
+    matrices.
     """
     c = np.asarray(unit_phases)
     n = c.shape[0]
-    times = _time_grid(times, n)
-    trailing = (1,) * (times.ndim - 1)
+    times = np.asarray(times)
     value = {d: 0.0 for d in DEGREES_OF_FREEDOM}
     rate = {d: 0.0 for d in DEGREES_OF_FREEDOM}
-    for k, component in enumerate(motion.components):
-        w = component.angular_frequency
-        c1 = c[:, k, 0].reshape((n,) + trailing)
-        c2 = c[:, k, 1].reshape((n,) + trailing)
-        for d, (amplitude, lag) in enumerate(zip(component.amplitudes, component.lags)):
-            if amplitude == 0:
-                continue
-            angle = w * times + lag
-            s, co = np.sin(angle), np.cos(angle)
-            name = DEGREES_OF_FREEDOM[d]
-            value[name] = value[name] + amplitude * (s * c1 + co * c2)
-            rate[name] = rate[name] + amplitude * w * (co * c1 - s * c2)
+    components = motion.components
+    if not components:
+        return value, rate
+    w = np.array([component.angular_frequency for component in components])    # (K,)
+    amplitudes = np.array([component.amplitudes for component in components])   # (K, 6)
+    lags = np.array([component.lags for component in components])               # (K, 6)
+    angle = np.moveaxis(w.reshape((-1,) + (1,) * times.ndim) * times, 0, 1)  # (n|1, K, *T)
+    sine, cosine = np.sin(angle), np.cos(angle)
+    shape = (n,) + times.shape[1:]
+    for d, name in enumerate(DEGREES_OF_FREEDOM):
+        amplitude = amplitudes[:, d]
+        if not np.any(amplitude):
+            continue
+        cos_lag, sin_lag = np.cos(lags[:, d]), np.sin(lags[:, d])
+        a = amplitude * (c[:, :, 0] * cos_lag - c[:, :, 1] * sin_lag)     # (n, K)
+        b = amplitude * (c[:, :, 0] * sin_lag + c[:, :, 1] * cos_lag)
+        value[name] = _over_components(a, sine, shape) + _over_components(b, cosine, shape)
+        rate[name] = _over_components(a * w, cosine, shape) - \
+            _over_components(b * w, sine, shape)
     return value, rate
+
+
+def _over_components(weights, basis, shape):
+    """sum_k weights[i, k] basis[i, k, ...] of weights (n, K) and basis (n or 1, K, *T),
+    shape (n, *T): one product of matrices where the basis is common to the trials."""
+    if basis.shape[0] == 1:
+        return (weights @ basis[0].reshape(basis.shape[1], -1)).reshape(shape)
+    return np.einsum("ik,ik...->i...", weights, basis)
 
 
 def platform_kinematics(scene, motion, unit_phases, times):

@@ -55,7 +55,7 @@ from uq.physics.rotation import (attitude_from_matrix_analytic, attitude_matrix,
                                  rotation_about_vertical)
 from uq.physics import modelinputs, nacelle
 from uq.physics.modelinputs import MOTION, MOTION_COMPILED
-from uq.physics.scene import NACELLE_OUTPUTS, sample_count, with_held
+from uq.physics.scene import NACELLE_OUTPUTS, SCENE_FIELDS, sample_count, with_held
 from uq.physics.timing import dwell_frequency
 
 #: The inputs a scan in motion adds to the static model's (:mod:`uq.physics.modelinputs`).
@@ -95,11 +95,14 @@ def measurement_model(scene, outputs, scene_draws=False, compiled=True, held=Non
     if not shape:
         return single_scene(scene, outputs, **errors)
     results = {}
+    # scenes that differ only in the wind (a sweep of its direction, say) share the same
+    # draws: their platform, beams and INS readings are computed once
+    platforms = None if scene_draws else {}
     for index in np.ndindex(*shape):
         one = _scene_at(scene, index)
         mine = {k: (v[(slice(None),) + index] if scene_draws and np.ndim(v) > 1 else v)
                 for k, v in errors.items()}
-        for q, value in single_scene(one, outputs, **mine).items():
+        for q, value in single_scene(one, outputs, platforms=platforms, **mine).items():
             results.setdefault(q, []).append(value)
     n = max(v[0].shape[0] for v in results.values())
     return {q: np.stack([np.broadcast_to(v, (n,) + v.shape[1:]) for v in values], axis=1)
@@ -108,32 +111,81 @@ def measurement_model(scene, outputs, scene_draws=False, compiled=True, held=Non
 
 def _scene_at(scene, index):
     import dataclasses
-    from uq.physics.scene import SCENE_FIELDS
     fields = {name: np.asarray(getattr(scene, name))[index] if np.ndim(getattr(scene, name))
               else getattr(scene, name) for name in SCENE_FIELDS}
     return dataclasses.replace(scene, **{k: float(np.real(v)) if np.isrealobj(v) else v
                                          for k, v in fields.items()})
 
 
-def single_scene(scene, outputs, **errors):
-    """The model for one scene (scalar fields); outputs of shape (n, g) or (n, b, g)."""
+#: The scene fields the wind alone depends on; the others fix the platform and the beams.
+WIND_FIELDS = ("wind_speed", "wind_direction", "vertical_wind", "shear", "reference_height")
+
+
+def single_scene(scene, outputs, *, platforms=None, **errors):
+    """The model for one scene (scalar fields); outputs of shape (n, g) or (n, b, g).
+    `platforms`: a dict in which the wind-free part of a scene (:func:`_platform`) is
+    kept for the next scene of the same draws that differs only in
+    :data:`WIND_FIELDS` (the same arrays, computed once)."""
     resolved = scene.time_resolved
     n = sample_count(errors)
     err = {name: np.asarray(errors.get(name, 0.0)) for name in set(errors) | set(modelinputs.names(MOTION))}
+    key = None if platforms is None else tuple(
+        getattr(scene, name) for name in SCENE_FIELDS if name not in WIND_FIELDS)
+    platform = None if key is None else platforms.get(key)
+    if platform is None:
+        platform = _platform(scene, resolved, err, n, outputs)
+        if key is not None:
+            platforms.clear()                # (scenes come grouped: keep the last one)
+            platforms[key] = platform
+    measured, heights = _measure(scene, platform, err)
+    unit_vectors = scene.nominal_unit_vectors()                        # configured, (b, 3)
+    horizontal = scene.horizontal_only
+    rotation, velocity = platform["rotation"], platform["velocity"]
+    believed, along = platform["believed"], platform["along"]
+    if scene.correction == "pointwise":
+        wind_vector = pointwise_wind(measured, unit_vectors, rotation, velocity, horizontal)
+    elif horizontal:
+        if scene.correction == "tilt2d":
+            raise ValueError("tilt2d needs beams that determine the 3-D wind")
+        wind_vector = pointwise_wind(measured, unit_vectors, rotation[:, None],
+                                     velocity[:, None], True)
+    else:
+        operator = least_squares_operator(unit_vectors)
+        wind_vector = scan_wind(measured, scene.correction, operator, rotation, velocity)
+    pair = nacelle.level_pair(scene.azimuths) if scene.tilt != 0 and not horizontal else None
+    if pair:                   # a nacelle lidar's hub-height wind: its level beams'
+        wind_vector = nacelle.hub_height_wind(wind_vector, believed, measured + along, pair)
+    result = _outputs(scene, outputs, wind_vector, measured + along, heights)
+    if set(outputs) & set(NACELLE_OUTPUTS):
+        slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
+                                scene.vertical_beam)                    # (b, g)
+        lidar = scene.lidar_height + np.asarray(platform["lidar_lift"])
+        believed_heights = nacelle.believed_heights(lidar, slant, believed)
+        extra = nacelle.nacelle_outputs(outputs, wind_vector, result, scene.heading,
+                                        believed, measured + along, believed_heights,
+                                        nacelle.upper_lower(scene.azimuths))
+        n = max(np.shape(v)[0] for v in result.values())
+        result.update({q: np.broadcast_to(v, (n,) + np.shape(v)[1:]) for q, v in extra.items()})
+    return result
+
+
+def _platform(scene, resolved, err, n, outputs):
+    """What a scene's model computes without the wind: the phases, the platform's
+    kinematics at the beams' times, the true beams and their gates' heights (:func:`
+    _geometry`), and the INS reading with the correction's rotation and velocity, the
+    believed beams and the velocity along them (``along``), and the lidar's lift."""
     # the motion and the INS timing vary over n_time trials (1 when none of their inputs
     # is random): the platform's kinematics are evaluated that many times, not n
     n_time = max([1] + [np.shape(err[k])[0] for k in TIME_RESOLVED_INPUTS if np.ndim(err[k])])
     phases = resolved.motion.unit_phases(_phases(err["motion_phases"], err["motion_window"],
                                                  resolved, n_time))
     phases = np.broadcast_to(phases, (n_time,) + phases.shape[1:])
-    measured, heights = _measure(scene, resolved, phases, err, n)
+    platform = _geometry(scene, resolved, phases, err)
     navigation = _navigation(scene, resolved, phases, err, n)
     unit_vectors = scene.nominal_unit_vectors()                        # configured, (b, 3)
-    horizontal = scene.horizontal_only
     lidar_lift = 0.0                    # the lidar's height above its static one, as read
     if scene.correction == "pointwise":
         rotation, velocity = _pointwise_reading(navigation, resolved)
-        wind_vector = pointwise_wind(measured, unit_vectors, rotation, velocity, horizontal)
         believed = (rotation @ unit_vectors[..., None])[..., 0]        # (n, b, 3)
         along = np.sum(believed * velocity, axis=-1)[..., None]
         if set(outputs) & set(NACELLE_OUTPUTS):
@@ -143,31 +195,11 @@ def single_scene(scene, outputs, **errors):
                                        navigation["pitch"][:, 0], navigation["roll"][:, 0],
                                        scene.heading)                  # (n, 3, 3)
         velocity = removed_velocity(scene.correction, navigation["velocity"][:, 0])
-        if horizontal:
-            if scene.correction == "tilt2d":
-                raise ValueError("tilt2d needs beams that determine the 3-D wind")
-            wind_vector = pointwise_wind(measured, unit_vectors, rotation[:, None],
-                                         velocity[:, None], True)
-        else:
-            operator = least_squares_operator(unit_vectors)
-            wind_vector = scan_wind(measured, scene.correction, operator, rotation, velocity)
         believed = (rotation[:, None] @ unit_vectors[..., None])[..., 0]   # (n, b, 3)
         along = np.sum(believed * velocity[:, None, :], axis=-1)[..., None]
-    pair = nacelle.level_pair(scene.azimuths) if scene.tilt != 0 and not horizontal else None
-    if pair:                   # a nacelle lidar's hub-height wind: its level beams'
-        wind_vector = nacelle.hub_height_wind(wind_vector, believed, measured + along, pair)
-    result = _outputs(scene, outputs, wind_vector, measured + along, heights)
-    if set(outputs) & set(NACELLE_OUTPUTS):
-        slant = slant_distances(scene.ranges, scene.half_cone, len(scene.azimuths),
-                                scene.vertical_beam)                    # (b, g)
-        lidar = scene.lidar_height + np.asarray(lidar_lift)
-        believed_heights = nacelle.believed_heights(lidar, slant, believed)
-        extra = nacelle.nacelle_outputs(outputs, wind_vector, result, scene.heading,
-                                        believed, measured + along, believed_heights,
-                                        nacelle.upper_lower(scene.azimuths))
-        n = max(np.shape(v)[0] for v in result.values())
-        result.update({q: np.broadcast_to(v, (n,) + np.shape(v)[1:]) for q, v in extra.items()})
-    return result
+    platform.update(rotation=rotation, velocity=velocity, believed=believed, along=along,
+                    lidar_lift=lidar_lift)
+    return platform
 
 
 def _lever_arm_lift(scene, resolved, rotation):
@@ -197,8 +229,11 @@ def _phases(phases, window, resolved, n):
     return np.concatenate([part(phases, k - k_window), part(window, k_window)], axis=-2)
 
 
-def _measure(scene, resolved, phases, err, n):
-    """True radial velocities plus noise, (n, b, g), and the gate heights (n, b, g)."""
+def _geometry(scene, resolved, phases, err):
+    """The wind-free part of :func:`_measure`: the platform's kinematics at the beams'
+    quadrature times, the true beams (n, b, q, 3), the gates' heights (n, b, q, g), the
+    beams' own velocity along them (n, b, q), the quadrature weights (q,) and the
+    slant distances (b, g)."""
     timing, motion = resolved.timing, resolved.motion
     n_beams = scene.n_beams
     fastest = dwell_frequency(motion.components)
@@ -216,17 +251,25 @@ def _measure(scene, resolved, phases, err, n):
     lidar_z = scene.lidar_height + np.reshape(err["lidar_height"], (-1, 1, 1)) \
         + kin["lidar_offset"][..., 2]                                   # (n, b, q)
     heights = lidar_z[..., None] + slant[:, None, :] * beams[..., 2:3]  # (n, b, q, g)
+    own = np.sum(beams * kin["lidar_velocity"], axis=-1)                # (n, b, q)
+    mean_height = np.einsum("...q,q->...", np.moveaxis(heights, -2, -1), weights)
+    return {"beams": beams, "heights": heights, "own": own, "weights": weights,
+            "slant": slant, "mean_height": mean_height}
+
+
+def _measure(scene, platform, err):
+    """True radial velocities plus noise, (n, b, g), and the gate heights (n, b, g), on
+    the scene's :func:`_platform`."""
+    beams, heights, weights = platform["beams"], platform["heights"], platform["weights"]
     speed = wind.power_law_speed(scene.wind_speed, heights, scene.reference_height,
                                  scene.shear) if scene.probe is None else \
-        _probe_speed(scene, heights, beams[..., 2:3], slant[:, None, :], err)
+        _probe_speed(scene, heights, beams[..., 2:3], platform["slant"][:, None, :], err)
     to_north, to_east = wind.wind_components(1.0, complexstep.degrees(scene.wind_direction))
     along_wind = beams[..., 0] * to_north + beams[..., 1] * to_east     # (n, b, q)
-    own = np.sum(beams * kin["lidar_velocity"], axis=-1)                # (n, b, q)
     radial = speed * along_wind[..., None] + (beams[..., 2] * scene.vertical_wind
-                                              - own)[..., None]
+                                              - platform["own"])[..., None]
     mean_radial = np.einsum("...q,q->...", np.moveaxis(radial, -2, -1), weights)  # (n, b, g)
-    mean_height = np.einsum("...q,q->...", np.moveaxis(heights, -2, -1), weights)
-    return mean_radial + err["lidar_radial_velocity"], mean_height
+    return mean_radial + err["lidar_radial_velocity"], platform["mean_height"]
 
 
 def _probe_speed(scene, heights, vertical, focus, err):

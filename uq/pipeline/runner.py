@@ -11,6 +11,8 @@ a number.
 import contextlib
 import dataclasses
 import logging
+import os
+import threading
 import time
 
 import numpy as np
@@ -18,7 +20,7 @@ import xarray as xr
 
 from uq._version import __version__
 from uq.pipeline.distributions import error_distribution
-from uq.engine.inputs import Input
+from uq.engine.inputs import Input, moments
 from uq.pipeline import probesection, records
 from uq.pipeline.checkpoint import encode_chunk
 from uq.pipeline.modelsetup import (MOTION_INPUTS, error_inputs, input_label, scene_from_settings,
@@ -43,11 +45,11 @@ from uq.pipeline.sweep import batch_scene, group_assignments, sweep_plan, vector
 log = logging.getLogger(__name__)
 
 #: The values of ``uq run --model`` (and of :func:`run`'s `model`).
-MODEL_CHOICES = ("compiled", "numpy")
+MODEL_CHOICES = ("compiled", "numpy", "auto")
 
 
 def run(scenario, progress=None, *, client=None, checkpoint=None, model="compiled",
-        kernels_ready=None):
+        kernels_ready=None, kernels_missing=None):
     """Run a scenario and return its results.
 
     Parameters
@@ -60,14 +62,24 @@ def run(scenario, progress=None, *, client=None, checkpoint=None, model="compile
         Compute the chunks on this dask cluster; the result is identical to a local run.
     checkpoint : uq.pipeline.checkpoint.Checkpoint, optional
         Keeps finished chunks on disk and reuses those it already has (``--resume``).
-    model : {"compiled", "numpy"}
+    model : {"compiled", "numpy", "auto"}
         ``compiled`` (default): the compiled model wherever it applies (else numpy, logged
-        at ``-v``); ``numpy``: the numpy reference model throughout. Both give the same
-        numbers to 1e-12 m/s (``tests/pipeline/test_model_switch.py``).
+        at ``-v``), compiling what numba's cache does not hold; ``numpy``: the numpy
+        reference model and statistics throughout, nothing compiled; ``auto``: each
+        chunk the compiled model where numba's cache holds every kernel it calls, else
+        the numpy model (nothing compiles in this process but a record's turbulence
+        kernels, :mod:`uq.compileguard`; on a cluster: ``compiled``). They give the
+        same numbers to 1e-12 m/s (``tests/pipeline/test_model_switch.py``).
     kernels_ready : callable, optional
         Called with no argument before a chunk's model first runs, after its turbulence
         records are drawn: ``uq run`` waits there for the kernels it has a second process
         compile beside the boxes (:mod:`uq.cli.sidecompile`). Not called on a cluster.
+    kernels_missing : callable, optional
+        With ``auto``: called once, with the :class:`~uq.compileguard.KernelNotCached`,
+        when a chunk finds a kernel missing from the cache; it may return a callable
+        that says, before each later chunk, whether to try the compiled model again
+        (``uq run``: once the kernels' compile in the background has ended,
+        :mod:`uq.cli.firstrun`).
 
     Returns
     -------
@@ -83,12 +95,15 @@ def run(scenario, progress=None, *, client=None, checkpoint=None, model="compile
         seed = scenario.sampling["seed"]
         if seed is None:             # a resumed run keeps the seed its chunks were drawn with
             seed = checkpoint.seed if checkpoint and checkpoint.seed is not None else new_seed()
-        if checkpoint:
-            checkpoint.start(scenario, seed, plan.chunks, model)
-        results = _compute(scenario, plan, seed, progress, client, checkpoint,
-                           model == "compiled", kernels_ready)
+        if checkpoint:          # (auto's numpy chunks are the compiled ones' to 1e-12)
+            checkpoint.start(scenario, seed, plan.chunks,
+                             "compiled" if model == "auto" else model)
+        choice = ModelChoice(model if client is None or model != "auto" else "compiled",
+                             kernels_missing)
+        results = _compute(scenario, plan, seed, progress, client, checkpoint, choice,
+                           kernels_ready)
     dataset = _assemble(scenario, plan, results)
-    dataset.attrs.update(_global_attributes(scenario, seed, dataset, started, model))
+    dataset.attrs.update(_global_attributes(scenario, seed, dataset, started, choice))
     said = {}                                 # one line for the outputs said alike
     for q, text in outside_domain(dataset, scenario.outputs):
         said.setdefault(text, []).append(q)
@@ -131,17 +146,63 @@ def outside_domain(dataset, outputs):
     return lines
 
 
-def _compute(scenario, plan, seed, progress, client, checkpoint, compiled,
+
+
+class ModelChoice:
+    """Which model each chunk runs (:func:`run`'s `model`): :meth:`evaluate` calls
+    ``work(compiled)`` with the model's flag; with ``auto``, inside
+    :func:`uq.compileguard.cached_only`, and again with False where a kernel is
+    missing from numba's cache (then `kernels_missing`, once; the compiled model is
+    tried again only where what it returned says so)."""
+
+    def __init__(self, model, kernels_missing=None):
+        self.model = model
+        self.kernels_missing = kernels_missing
+        self.retry = None                    # after a miss: whether to try again
+        self.numpy_chunks = 0                # chunks auto ran with the numpy model
+        self.chunks = 0
+        self.missing = None                  # the first kernel found missing
+        self._lock = threading.Lock()        # (numpy chunks may run on threads)
+
+    @property
+    def compiled(self):
+        """The flag of a chunk run without the guard (on a cluster, ``compiled`` for
+        ``auto``)."""
+        return self.model != "numpy"
+
+    def evaluate(self, work):
+        """``work(compiled)`` of one chunk with the model chosen for it."""
+        with self._lock:
+            self.chunks += 1
+        if self.model != "auto":
+            return work(self.model == "compiled")
+        if self.missing is None or (self.retry is not None and self.retry()):
+            from uq.compileguard import KernelNotCached, cached_only
+            try:
+                with cached_only():
+                    return work(True)
+            except KernelNotCached as error:
+                with self._lock:
+                    first = self.missing is None
+                    self.missing = self.missing or str(error)
+                    self.retry = None
+                if first and self.kernels_missing is not None:
+                    self.retry = self.kernels_missing(error)
+        with self._lock:
+            self.numpy_chunks += 1
+        return work(False)
+
+
+def _compute(scenario, plan, seed, progress, client, checkpoint, choice,
              kernels_ready=None):
     """Results of every chunk, by index: from the checkpoint, else computed."""
     results = checkpoint.load() if checkpoint else {}
     todo = [chunk for chunk in plan.chunks if chunk.index not in results]
     if checkpoint:
         checkpoint.resumed(len(results), len(plan.chunks))
-    finished = ((chunk.index, run_chunk(scenario, plan, chunk, seed, compiled,
-                                        kernels_ready), None)
-                for chunk in todo) if client is None else \
-        _distributed(client, scenario, plan, todo, seed, compiled,
+    finished = _local(scenario, plan, todo, seed, choice, kernels_ready) \
+        if client is None else \
+        _distributed(client, scenario, plan, todo, seed, choice.compiled,
                      checkpoint.digest if checkpoint else None)
     if progress and results:
         progress(len(results), len(plan.chunks))
@@ -153,6 +214,42 @@ def _compute(scenario, plan, seed, progress, client, checkpoint, compiled,
         if progress:
             progress(len(results), len(plan.chunks))
     return results
+
+
+#: Threads that evaluate ``auto``'s numpy chunks together (the cores this process may
+#: use, at most 4): the numpy model is 1-4x slower than the compiled one per core, and
+#: its ufuncs release the GIL; the background compile, at a low priority, waits.
+NUMPY_CHUNK_THREADS = min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                          else os.cpu_count() or 1)
+
+
+def _local(scenario, plan, chunks, seed, choice, kernels_ready=None):
+    """Chunks in this process, yielded in order as ``(index, dataset, None)``. Once
+    ``auto`` runs the numpy model (a kernel missing from numba's cache), the remaining
+    chunks of a run without records go to :data:`NUMPY_CHUNK_THREADS` threads (each chunk
+    is the same whichever thread computes it: its draws come from the seed alone)."""
+    chunks = list(chunks)
+    while chunks:
+        chunk = chunks.pop(0)
+        yield chunk.index, run_chunk(scenario, plan, chunk, seed, choice, kernels_ready), None
+        if (choice.missing and len(chunks) > 1 and NUMPY_CHUNK_THREADS > 1
+                and "turbulence" not in scenario.settings):
+            yield from _in_threads(scenario, plan, chunks, seed, choice)
+            return
+
+
+def _in_threads(scenario, plan, chunks, seed, choice):
+    """:func:`_local`'s numpy chunks on threads, yielded in order; at a stop (Ctrl-C) the
+    chunks not started are cancelled (those running end with their chunk)."""
+    from concurrent.futures import ThreadPoolExecutor
+    pool = ThreadPoolExecutor(NUMPY_CHUNK_THREADS, thread_name_prefix="uq-chunk")
+    try:
+        futures = [pool.submit(run_chunk, scenario, plan, chunk, seed, choice)
+                   for chunk in chunks]
+        for chunk, future in zip(chunks, futures):
+            yield chunk.index, future.result(), None
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
 
 
 def _distributed(client, scenario, plan, chunks, seed, compiled, digest):
@@ -182,8 +279,8 @@ def chunk_task(scenario, plan, chunk, seed, compiled=True, digest=None):
 
 def run_chunk(scenario, plan, chunk, seed, compiled=True, kernels_ready=None):
     """Results of one chunk of scenes: a Dataset with a ``scene`` dimension (`compiled`:
-    the compiled model where it applies, else the numpy model throughout;
-    `kernels_ready`: as :func:`run`'s)."""
+    the compiled model where it applies, else the numpy model throughout, or a
+    :class:`ModelChoice`; `kernels_ready`: as :func:`run`'s)."""
     spectra_of = scenario.settings             # (the file's scene: the records' spectra)
     if plan.group_keys:
         scenario = scenario.with_values(group_assignments(scenario, plan, chunk.group))
@@ -198,12 +295,17 @@ def run_chunk(scenario, plan, chunk, seed, compiled=True, kernels_ready=None):
         prepared = records.prepare_records(scenario, record_fields, seed, spectra_of)
     if kernels_ready is not None:
         kernels_ready()
-    dataset = run_scene(scenario, batch_scene(base, fields), seed, compiled)
-    if record_fields is not None and "wind_speed_true" in dataset:
-        # the records' variables of each scene
-        dataset = dataset.assign(records.record_variables(
-            scenario, record_fields, dataset, seed, compiled, spectra_of, prepared))
-    return dataset
+
+    def evaluate(compiled):
+        dataset = run_scene(scenario, batch_scene(base, fields), seed, compiled)
+        if record_fields is not None and "wind_speed_true" in dataset:
+            # the records' variables of each scene
+            dataset = dataset.assign(records.record_variables(
+                scenario, record_fields, dataset, seed, compiled, spectra_of, prepared))
+        return dataset
+    if isinstance(compiled, ModelChoice):
+        return compiled.evaluate(evaluate)
+    return evaluate(compiled)
 
 
 def run_scene(scenario, scene, seed, compiled=True):
@@ -278,7 +380,7 @@ def _mean_of(spec):
     distribution = spec.distribution if isinstance(spec, Input) else spec
     if isinstance(distribution, float):
         return distribution
-    return float(distribution.mean())
+    return moments(distribution)[0]
 
 
 def _propagate(scene, settings, outputs, inputs, seed, compiled, held=None):
@@ -304,7 +406,8 @@ def _propagate(scene, settings, outputs, inputs, seed, compiled, held=None):
                        stopping=sampling["stopping"],
                        stop_when_gum_valid=sampling["stop_when_gum_valid"],
                        covariance=profile_covariances(outputs, n_gates),
-                       auxiliary=(HELD_WIND_SPEED,) if held is not None else ())
+                       auxiliary=(HELD_WIND_SPEED,) if held is not None else (),
+                       compiled=compiled)
 
 
 def profile_covariances(outputs, n_gates):
@@ -345,7 +448,10 @@ def _scene_dataset(scene, settings, outputs, engine, compiled):
         coords["range_other"] = list(scene.ranges)
     if "beam" in engine.dims:
         coords.update(_beam_coordinates(scene))
-    return engine.assign(data).assign_coords(coords)      # one merge each (xarray's cost)
+    variables = {name: engine.variables[name] for name in engine.data_vars}
+    return xr.Dataset({**variables, **data},                # one construction, no merge
+                      coords={**{name: engine.variables[name] for name in engine.coords},
+                              **coords}, attrs=engine.attrs)
 
 
 #: Outputs whose systematic error from the probe volume is reported (``{q}_probe_bias``).
@@ -401,31 +507,50 @@ def _standard_uncertainty(spec):
     if spec is None:
         return 0.0
     dist = error_distribution(spec)
-    return 0.0 if isinstance(dist, float) else float(dist.std())
+    return 0.0 if isinstance(dist, float) else moments(dist)[1]
 
 
 def _assemble(scenario, plan, results):
-    """Chunks (flat scenes, group-major) -> the grid, sweep dimensions in file order."""
+    """Chunks (flat scenes, group-major) -> the grid, sweep dimensions in file order
+    first (each variable's other dimensions after them, in their order), a range of one
+    gate squeezed to a scalar coordinate. The variables are laid out in numpy and the
+    Dataset built once (xarray's transpose and squeeze rebuild it: ~1 ms each)."""
     first = results[plan.chunks[0].index]
     names = {key: key.replace(".", "_") for key, _ in scenario.sweep}
     grid_dims = tuple(names[k] for k in plan.group_keys + plan.vector_keys)
     grid_shape = plan.group_shape + plan.vector_shape
+    order = [names[key] for key, _ in scenario.sweep]
+    squeeze = first.sizes.get("range", 0) == 1
+    chunks = [results[c.index].variables for c in plan.chunks]
     data = {}
-    for var, template in first.data_vars.items():
+    for var in first.data_vars:
+        template = first.variables[var]
         axis = template.dims.index("scene")
-        values = np.concatenate([results[c.index][var].values for c in plan.chunks], axis=axis)
+        values = np.concatenate([chunk[var].values for chunk in chunks], axis=axis)
         shape = values.shape[:axis] + grid_shape + values.shape[axis + 1:]
-        data[var] = (template.dims[:axis] + grid_dims + template.dims[axis + 1:],
-                     values.reshape(shape))
+        data[var] = _laid_out(template.dims[:axis] + grid_dims + template.dims[axis + 1:],
+                              values.reshape(shape), template.attrs, order, squeeze)
     coords = {names[key]: list(values) for key, values in scenario.sweep}
-    coords.update({c: first[c] for c in first.coords})
+    coords.update({c: _laid_out(first.variables[c].dims, first.variables[c].values,
+                                first.variables[c].attrs, order, squeeze)
+                   for c in first.coords})
     coords.update({follower.replace(".", "_"): (names[leader], list(dict(scenario.sweep)[leader]))
                    for follower, leader in scenario.links})
-    dataset = xr.Dataset(data, coords=coords)
-    dataset = dataset.transpose(*[names[key] for key, _ in scenario.sweep], ...)
-    if dataset.sizes.get("range", 0) == 1:
-        dataset = dataset.squeeze("range")
-    return _annotate(dataset, scenario)
+    return _annotate(xr.Dataset(data, coords=coords), scenario)
+
+
+def _laid_out(dims, values, attrs, order, squeeze):
+    """A Variable of `values` with the dimensions of `order` first (as xarray's
+    ``transpose(*order, ...)``) and, with `squeeze`, without its ``range`` axis of one
+    (as ``squeeze("range")``)."""
+    dims = tuple(dims)
+    if squeeze and "range" in dims:
+        values = np.take(values, 0, axis=dims.index("range"))
+        dims = tuple(d for d in dims if d != "range")
+    laid = [d for d in order if d in dims] + [d for d in dims if d not in order]
+    if laid != list(dims):
+        values = np.transpose(values, [dims.index(d) for d in laid])
+    return xr.Variable(tuple(laid), values, attrs)
 
 
 #: Attributes of the derived outputs.
@@ -485,7 +610,20 @@ def _annotate(ds, scenario):
     return cf_encode(ds)
 
 
-def _global_attributes(scenario, seed, dataset, started, model):
+def _model_attribute(choice):
+    """The ``model`` attribute: said where the numpy model ran (none: compiled)."""
+    if choice.model == "numpy":
+        return {"model": "numpy: the numpy reference model throughout (uq run --model "
+                         "numpy)"}
+    if choice.numpy_chunks:
+        return {"model": f"numpy for {choice.numpy_chunks} of {choice.chunks} chunks: "
+                         "numba's cache did not hold the compiled model's kernels "
+                         f"({choice.missing}; uq run --model auto); the same numbers "
+                         "to 1e-12"}
+    return {}
+
+
+def _global_attributes(scenario, seed, dataset, started, choice):
     return {"title": f"uq results: {scenario.name}",
             "skipped": skipped_work(scenario.settings, scenario.outputs,
                                     dict(scenario.sweep).get("lidar.probe.kind", ())),
@@ -503,8 +641,7 @@ def _global_attributes(scenario, seed, dataset, started, model):
             "ins_correlation": _swept_or(scenario, "ins.correlation",
                                          scenario.settings["ins"]["correlation"]),
             "runtime_s": time.perf_counter() - started, **_probe_attributes(scenario),
-            **({"model": "numpy: the numpy reference model throughout (uq run --model "
-                         "numpy)"} if model == "numpy" else {})}
+            **_model_attribute(choice)}
 
 
 def _swept_or(scenario, key, value):
