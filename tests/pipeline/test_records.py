@@ -404,5 +404,5 @@ def test_a_nacelle_lidar_s_records_agree_with_its_spectral_path():
     assert abs(float(ds["turbulence_intensity_spectral_z"])) <= 3.3
     assert float(ds["turbulence_intensity_u_ratio"]) == pytest.approx(0.567, abs=0.01)
     upward = run({**raw, "lidar": {**raw["lidar"], "mount": {"tilt": 0}},
-                  "sampling": {"method": "none"}})
+                  "sampling": {"method": "none"}, "record": {"duration": 120}})
     assert float(upward["turbulence_intensity_u_ratio"]) > 2.0
