@@ -13,13 +13,13 @@ Monte Carlo records reaches the campaign here and nowhere else:
   and the autocovariance of the lidar's series between scans all follow from these
   (:mod:`uq.campaign.spectra`); summed with the record's high-pass they are the spectral
   path's own record variances (tested).
-* :func:`motion_response`: the first derivatives of one scan's horizontal speed Vh with
-  respect to the unit phase vector of a harmonic platform motion of unit amplitude, per
-  degree of freedom and frequency (the GUM's linearisation of the motion, Eq. 13 of JCGM
-  100 with the phase covariance I/2 of :mod:`uq.physics.motion`), by central differences
-  of the compiled time-resolved model.
-* :func:`motion_curvature`: the phase-averaged second-order change of Vh under a harmonic
-  motion, as a Hermitian form in the complex amplitudes (the motion's bias of the mean).
+* :func:`motion_jacobian`: the first derivatives of one scan's horizontal speed Vh with
+  respect to the unit phase vector of a harmonic platform motion of given frequency and
+  complex amplitude (the GUM's linearisation of the motion, Eq. 13 of JCGM 100 with the
+  phase covariance I/2 of :mod:`uq.physics.motion`), by central differences of the
+  compiled time-resolved model.
+* :func:`motion_shift`: the phase-averaged second-order change of Vh under such a
+  motion (the motion's bias of the mean speed).
 * :func:`scan_noise_variance`: the GUM variance of one scan's Vh from every error that is
   not the motion (INS readings, radial noise), drawn independently scan by scan as the
   records draw them.
@@ -47,11 +47,11 @@ import numpy as np
 
 from uq.physics.motion import DEGREES_OF_FREEDOM, Motion, MotionComponent
 
-#: Step of the central differences of :func:`motion_response` [unit phase]: the model is
+#: Step of the central differences of :func:`motion_jacobian` [unit phase]: the model is
 #: smooth in the phases, so the O(h^2) error is ~1e-8 of the derivative (measured
 #: against the numpy model's complex step: 2.5e-8 relative), far below any other error.
 RESPONSE_STEP = 1e-4
-#: Radius of the phase vectors of :func:`motion_curvature` [1]: the motion is scaled by
+#: Radius of the phase vectors of :func:`motion_shift` [1]: the motion is scaled by
 #: it, so the second-order change is resolved (1e-6 of U) while the fourth order stays
 #: 1e-6 of it.
 CURVATURE_SCALE = 1e-3
@@ -60,9 +60,10 @@ CURVATURE_SCALE = 1e-3
 #: (the oscillating part of the second order) exactly; the fourth order, O(scale^4), is
 #: what remains.
 CURVATURE_PHASES = 8
-#: Frequencies of one call of the compiled model in :func:`motion_curvature` (its
-#: trials are components x phases, each component active alone: memory ~ n^2).
-CURVATURE_CHUNK = 8
+#: Components of one call of the compiled model in :func:`motion_jacobian` and
+#: :func:`motion_shift`: every trial holds every component of the call (one moved, the
+#: others at rest), so a call costs ~ n^2; 64 keeps it at a few milliseconds.
+MOTION_CHUNK = 64
 #: The record of :func:`gate_settings` (the spectral path's record and the Monte Carlo
 #: records) holds this many records per scene: the campaign draws them itself.
 GATE_RECORDS = 2
@@ -316,7 +317,15 @@ def _mean_errors(settings, scene):
 def motion_jacobian(settings, frequency, amplitude):
     """``dVh/dc_1 + i dVh/dc_2`` [m s-1] of each component (frequencies [Hz] (K,),
     complex amplitudes (K, 6)) at rest (c = 0), shape (K,): central differences of the
-    compiled model, one component moved at a time."""
+    compiled model, one component moved at a time (:data:`MOTION_CHUNK` components a
+    call)."""
+    return np.concatenate([_jacobian(settings, frequency[i:i + MOTION_CHUNK],
+                                     amplitude[i:i + MOTION_CHUNK])
+                           for i in range(0, len(frequency), MOTION_CHUNK)]) \
+        if len(frequency) else np.zeros(0, complex)
+
+
+def _jacobian(settings, frequency, amplitude):
     components = components_of(frequency, amplitude)
     count = len(components)
     phases = np.zeros((4 * count, count, 2))
@@ -330,21 +339,19 @@ def motion_jacobian(settings, frequency, amplitude):
     return first + 1j * second
 
 
-def motion_response(settings, frequency):
-    """z_d(f) [m s-1 per unit amplitude] of every degree of freedom at each frequency
-    [Hz], shape (n_f, 6) (module docstring)."""
-    frequency = np.asarray(frequency, float)
-    unit = np.eye(len(DEGREES_OF_FREEDOM))
-    freq = np.repeat(frequency, len(unit))
-    amplitude = np.tile(unit, (frequency.size, 1))
-    return motion_jacobian(settings, freq, amplitude).reshape(frequency.size, len(unit))
-
-
 def motion_shift(settings, frequency, amplitude):
     """The phase-averaged second-order change of Vh [m s-1] under each component alone
     (frequencies [Hz] (K,), complex amplitudes (K, 6)): ``(mean over the phases of
     Vh(s c) - Vh(0)) / s^2`` with s = :data:`CURVATURE_SCALE`, :data:`CURVATURE_PHASES`
-    equally spaced phases (module constants), so ``a^H G a`` at unit scale."""
+    equally spaced phases (module constants): ``a^H G a`` at unit scale, G the Hermitian
+    form of the second derivatives averaged over the phase."""
+    return np.concatenate([_shift(settings, frequency[i:i + MOTION_CHUNK],
+                                  amplitude[i:i + MOTION_CHUNK])
+                           for i in range(0, len(frequency), MOTION_CHUNK)]) \
+        if len(frequency) else np.zeros(0)
+
+
+def _shift(settings, frequency, amplitude):
     components = components_of(frequency, amplitude)
     count, p = len(components), CURVATURE_PHASES
     angle = 2.0 * np.pi * np.arange(p) / p
@@ -355,37 +362,6 @@ def motion_shift(settings, frequency, amplitude):
     phases[rows, which, 1] = CURVATURE_SCALE * np.sin(angle[rows % p])
     speed = _speeds(settings, components, phases)           # last row: at rest
     return (speed[:-1].reshape(count, p).mean(axis=1) - speed[-1]) / CURVATURE_SCALE ** 2
-
-
-def motion_curvature(settings, frequency):
-    """The Hermitian G (n_f, 6, 6) [m s-1 per amplitude^2] with ``a^H G a`` the
-    phase-averaged second-order change of Vh under a component of complex amplitude a
-    at each frequency [Hz] (:func:`motion_shift`, by polarisation: ``G_dd = q(e_d)``,
-    ``2 Re G_dd' = q(e_d + e_d') - G_dd - G_d'd'``, ``-2 Im G_dd' = q(e_d + i e_d') -
-    G_dd - G_d'd'``)."""
-    frequency = np.asarray(frequency, float)
-    dofs = len(DEGREES_OF_FREEDOM)
-    pairs = [(d, e) for d in range(dofs) for e in range(d + 1, dofs)]
-    probes = [np.eye(dofs)[d] for d in range(dofs)]
-    probes += [np.eye(dofs)[d] + np.eye(dofs)[e] for d, e in pairs]
-    probes += [np.eye(dofs)[d] + 1j * np.eye(dofs)[e] for d, e in pairs]
-    probes = np.array(probes, complex)                       # (36, 6)
-    out = np.zeros((frequency.size, dofs, dofs), complex)
-    for start in range(0, frequency.size, CURVATURE_CHUNK):
-        part = frequency[start:start + CURVATURE_CHUNK]
-        q = motion_shift(settings, np.repeat(part, len(probes)),
-                         np.tile(probes, (part.size, 1))).reshape(part.size, len(probes))
-        diagonal = q[:, :dofs]
-        g = np.zeros((part.size, dofs, dofs), complex)
-        g[:, range(dofs), range(dofs)] = diagonal
-        for i, (d, e) in enumerate(pairs):
-            base = diagonal[:, d] + diagonal[:, e]
-            real = (q[:, dofs + i] - base) / 2.0
-            imaginary = -(q[:, dofs + len(pairs) + i] - base) / 2.0
-            g[:, d, e] = real + 1j * imaginary
-            g[:, e, d] = real - 1j * imaginary
-        out[start:start + part.size] = g
-    return out
 
 
 def scan_noise_variance(settings):

@@ -12,9 +12,9 @@ direction relative to the lidar's heading theta, and its motion. The tables
   every harmonic of theta: a four-beam scan's fourth is the largest, the beams' timing
   adds the odd ones; 13 nodes are exact to the sixth, and the seventh and eighth of a
   pulsed DBS at 40-80 m hold below 1e-3 of F);
-* the motion's response ``y_s(f) = r_s^H z(f)`` of each motion shape r_s
-  (:mod:`uq.campaign.motion`; z of :func:`uq.campaign.adapter.motion_response`), its
-  curvature ``g_s(f) = 2 r_s^H G(f) r_s`` (:func:`~uq.campaign.adapter.motion_curvature`)
+* the motion's response ``y_s(f)`` of each motion shape r_s (:mod:`uq.campaign.motion`;
+  :func:`uq.campaign.adapter.motion_jacobian` of the component of amplitude r_s), its
+  curvature ``g_s(f) = 2 r_s^H G(f) r_s`` (:func:`~uq.campaign.adapter.motion_shift`)
   and the per-scan noise variance, on :data:`MOTION_DIRECTIONS` directions, a uniform
   frequency grid and :data:`MOTION_SPEEDS` speeds. These are exact in U and theta by
   their form: the radial velocities are linear in the wind vector and in the platform's
@@ -43,7 +43,7 @@ from uq.campaign.interpolation import (lagrange_weights, log_lagrange_weights,
 from uq.constants import FULL_CIRCLE_DEG
 
 #: Directions of the spectral tables over the circle [1] (odd: no Nyquist harmonic).
-SPECTRAL_DIRECTIONS = 13
+SPECTRAL_DIRECTIONS = 11
 #: Directions of the motion tables [1]: nine hold harmonics up to 4, the highest the
 #: motion's terms have (module docstring).
 MOTION_DIRECTIONS = 9
@@ -52,7 +52,7 @@ RESPONSE_DEGREE, CURVATURE_DEGREE, NOISE_DEGREE = 2, 4, 4
 #: Speed nodes of the spectral tables [1] (log-spaced over the campaign's speeds): F
 #: changes with U only through the scan's timing and the record's high-pass, smoothly
 #: in log U; the check points measure the cubic's error.
-SPEED_NODES = 4
+SPEED_NODES = 3
 #: Speeds of the motion tables [1]: three fix the exact forms in U (module docstring).
 MOTION_SPEEDS = 3
 #: The motion tables' frequency grid [Hz]: step and highest frequency. The response
@@ -120,11 +120,19 @@ def motion_node(lidar, height, scale, turbulence, record_duration, speed, direct
     settings = adapter.gate_settings(lidar, [height], {**turbulence, "length_scale": scale},
                                      record_duration, speed, direction)
     shapes = np.asarray(shapes, complex)
-    response = adapter.motion_response(settings, frequency_grid(FREQUENCY_STEP))
-    curvature = adapter.motion_curvature(settings, frequency_grid(CURVATURE_STEP))
-    return (response @ np.conj(shapes).T,
-            2.0 * np.real(np.einsum("sd,fde,se->fs", np.conj(shapes), curvature, shapes)),
+    return (_per_shape(adapter.motion_jacobian, settings, frequency_grid(FREQUENCY_STEP),
+                       shapes),
+            2.0 * _per_shape(adapter.motion_shift, settings, frequency_grid(CURVATURE_STEP),
+                             shapes),
             adapter.scan_noise_variance(settings))
+
+
+def _per_shape(function, settings, frequency, shapes):
+    """`function` (:func:`uq.campaign.adapter.motion_jacobian` or ``motion_shift``) of
+    every shape at every frequency, shape (n_f, S): the component of amplitude r_s."""
+    count = len(shapes)
+    values = function(settings, np.repeat(frequency, count), np.tile(shapes, (len(frequency), 1)))
+    return values.reshape(len(frequency), count)
 
 
 def build_tables(lidar, heights, scales, turbulence, record_duration, speed_range, shapes,
@@ -237,3 +245,54 @@ def noise_at(tables, height_index, speed, direction):
     """Per-scan noise variance [m2 s-2] of records (n,)."""
     wu, wt = _motion_weights(tables, speed, direction, (0, 1, 2), NOISE_DEGREE)
     return np.einsum("num,nu,nm->n", tables.noise[np.asarray(height_index)], wu, wt)
+
+
+# --- the tables' error ------------------------------------------------------------------
+
+def check_points(tables):
+    """(speed [m s-1], direction [deg]) pairs between the spectral nodes: the geometric
+    middle of each speed interval at directions half-way between two table directions
+    (the worst places of both interpolants), alternating along the circle."""
+    middles = np.sqrt(tables.speeds[:-1] * tables.speeds[1:])
+    step = FULL_CIRCLE_DEG / SPECTRAL_DIRECTIONS
+    return [(float(u), tables.heading + step * (0.5 + 5 * i) % FULL_CIRCLE_DEG)
+            for i, u in enumerate(middles)]
+
+
+def spectral_errors(tables, lidar, scales, turbulence, submit=None):
+    """Largest relative error of the tables' F, as that of the TI it corrects (``|sqrt(F_
+    table / F_direct) - 1|``), and of the spread, over the check points and heights,
+    against the spectral path run there (:func:`spectral_node`)."""
+    run = _runner(submit)
+    points = check_points(tables)
+    direct = [run(spectral_node, lidar, list(tables.heights), scales, turbulence,
+                  tables.record_duration, u, d) for u, d in points]
+    ti, spread = 0.0, 0.0
+    for (u, d), task in zip(points, direct):
+        value = _result(task)
+        for i in range(len(tables.heights)):
+            f, s, _ = spectral_at(tables, np.array([i]), np.array([u]), np.array([d]))
+            ti = max(ti, abs(float(np.sqrt(f[0] / value[0, i])) - 1.0))
+            spread = max(spread, abs(float(s[0] / value[1, i]) - 1.0))
+    return ti, spread
+
+
+def motion_errors(tables, lidar, scales, turbulence, shapes):
+    """Largest error of the tables' motion response at frequencies half-way between
+    their nodes, at a check point, relative to the response's largest magnitude over the
+    frequencies (the motion variance's relative error is at most twice it), per
+    height: the largest."""
+    u, d = check_points(tables)[0]
+    middle = frequency_grid(FREQUENCY_STEP)[:-1] + FREQUENCY_STEP / 2.0
+    worst = 0.0
+    for i, (h, scale) in enumerate(zip(tables.heights, scales)):
+        settings = adapter.gate_settings(lidar, [h], {**turbulence, "length_scale": scale},
+                                         tables.record_duration, u, d)
+        direct = _per_shape(adapter.motion_jacobian, settings, middle, shapes)
+        count = len(shapes)
+        table = response_at(tables, np.full(middle.size, i), np.full(middle.size, u),
+                            np.full(middle.size, d), np.repeat(middle[:, None], count, 1),
+                            np.tile(np.arange(count), (middle.size, 1)))
+        scale_y = np.max(np.abs(direct), axis=0)
+        worst = max(worst, float(np.max(np.abs(table - direct) / np.where(scale_y > 0, scale_y, 1))))
+    return worst
