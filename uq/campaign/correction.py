@@ -18,10 +18,12 @@ its variance about its own mean ``s^2 = (1/N) sum (Vh_m - mean)^2`` has the expe
 * sigma^2 [m2 s-2]: every other error of a scan (INS readings, radial noise), drawn
   independently scan by scan.
 
-The estimate inverts (1): ``V = (s^2 - V_m - (N-1)/N sigma^2) / F``, ``TI = sqrt(V) /
-U_c``, with the mean speed ``U_c = Vh_mean - b`` freed of the motion's bias b (its
-second-order shift of Vh, :mod:`uq.campaign.motion`). A lidar that reports the sample
-standard deviation (``ddof`` 1) has its variance turned into (1) by ``(N - ddof) / N``.
+The estimate inverts (1): ``V = (s^2 - V_m - (N-1)/N sigma^2) / F``, with the mean
+speed ``U_c = Vh_mean - b`` freed of the motion's bias b (its second-order shift of Vh,
+:mod:`uq.campaign.motion`). The lidar reports its standard deviation over ``N - ddof``
+scans; its variance is turned into (1) by ``(N - ddof) / N``, and the corrected TI is
+given back on the lidar's own convention, ``TI = sqrt(V N / (N - ddof)) / U_c``, so that
+a record without motion, filtering or scan errors is unchanged (the identity).
 
 Interval. The turbulence's and the noise's part of s^2 is distributed as a scaled
 chi-square (:mod:`uq.campaign.spectra`: ``x = s^2 - V_m ~ E chi2_nu / nu`` with ``E = F V
@@ -59,8 +61,9 @@ INTERVAL_ITERATIONS = 60
 #: Relative change of an interval end taken as converged [1].
 INTERVAL_TOLERANCE = 1e-9
 #: Significant digits of the motion's u at which its clause-8 tolerance is read (JCGM
-#: 101 7.9.2; the project's default for ``sampling.digits``).
-CLAUSE8_DIGITS = 2
+#: 101 7.9.2 takes one or two): one, since a record's motion (a sea state and a flat
+#: response, or a ten-minute IMU spectrum) is known to no better than some 10 %.
+CLAUSE8_DIGITS = 1
 
 #: The records' flags (bit, name, meaning, whether the record's values are NaN).
 FLAGS = (
@@ -185,11 +188,14 @@ def correct(speed, std, filtering, spread, motion_variance, motion_bias, noise_v
         u_ti = u_variance / (2.0 * corrected_speed ** 2 * ti_floor)
         measured = std / speed
     nan = np.where(consistent, 1.0, np.nan)
+    convention = np.sqrt(float(n_scans) / (n_scans - ddof))       # the lidar's N - ddof
     return {"wind_speed_corrected": corrected_speed,
             "turbulence_intensity_measured": measured,
-            "turbulence_intensity_corrected": ti * nan,
-            "turbulence_intensity_corrected_u": u_ti * nan,
-            "turbulence_intensity_corrected_low": np.sqrt(low) / corrected_speed * nan,
-            "turbulence_intensity_corrected_high": np.sqrt(high) / corrected_speed * nan,
+            "turbulence_intensity_corrected": ti * convention * nan,
+            "turbulence_intensity_corrected_u": u_ti * convention * nan,
+            "turbulence_intensity_corrected_low": np.sqrt(low) / corrected_speed * convention
+            * nan,
+            "turbulence_intensity_corrected_high": np.sqrt(high) / corrected_speed * convention
+            * nan,
             "variance_corrected": variance * nan,
             "consistent": consistent}

@@ -86,9 +86,9 @@ class MotionSet:
 
 def no_motion(count):
     """A set of `count` records without motion (every record valid)."""
-    return MotionSet(np.zeros((1, len(DEGREES_OF_FREEDOM)), complex), np.zeros((count, 0)),
+    return MotionSet(np.zeros((0, len(DEGREES_OF_FREEDOM)), complex), np.zeros((count, 0)),
                      np.zeros((count, 0), int), np.zeros((count, 0)),
-                     np.ones(count, bool), ("none",))
+                     np.ones(count, bool), ())
 
 
 def response_shape(response):

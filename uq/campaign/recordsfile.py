@@ -212,16 +212,19 @@ def on_grid(table, times):
 
 
 def load_reference(spec, times, heights):
-    """The reference's TI [1] on the records' grid, shape (time, height) (NaN where it
-    has none), and the number of its rows off the grid."""
+    """The reference on the records' grid: its TI [1] and mean speed [m s-1] (NaN where
+    it gives none), each (time, height), and the number of its rows off the grid."""
     table, outside = on_grid(read_table(spec.table), times)
     source = str(spec.table.file)
-    columns = []
+    tis, speeds = [], []
+    nan = np.full(len(times), np.nan)
     for h in heights:
         if h not in spec.heights:
-            columns.append(np.full(len(times), np.nan))
+            tis.append(nan)
+            speeds.append(nan)
             continue
         names, key = spec.heights[h], f"{spec.table.key}.heights.{h:g}"
+        speed = nan
         if "ti" in names:
             ti, _ = numbers(table, names["ti"], source, f"{key}.ti",
                             FRACTION_UNITS[spec.units["ti"]])
@@ -229,6 +232,8 @@ def load_reference(spec, times, heights):
             factor = SPEED_UNITS[spec.units["speed"]]
             speed, _ = numbers(table, names["speed"], source, f"{key}.speed", factor)
             std, _ = numbers(table, names["std"], source, f"{key}.std", factor)
+            _check_column("speed", speed, source, f"{key}.speed (column {names['speed']!r})")
+            _check_column("std", std, source, f"{key}.std (column {names['std']!r})")
             with np.errstate(divide="ignore", invalid="ignore"):
                 ti = np.where(speed > 0, std / speed, np.nan)
         finite = ti[np.isfinite(ti)]
@@ -236,5 +241,6 @@ def load_reference(spec, times, heights):
             raise DataFileError(source, f"{key}.ti", f"TI median {np.median(finite):g}: "
                                 "a percentage read as a fraction? allowed: units.ti percent "
                                 "or fraction, values >= 0")
-        columns.append(ti)
-    return np.stack(columns, axis=-1), outside
+        tis.append(ti)
+        speeds.append(speed)
+    return np.stack(tis, axis=-1), np.stack(speeds, axis=-1), outside

@@ -52,7 +52,7 @@ RESPONSE_DEGREE, CURVATURE_DEGREE, NOISE_DEGREE = 2, 4, 4
 #: Speed nodes of the spectral tables [1] (log-spaced over the campaign's speeds): F
 #: changes with U only through the scan's timing and the record's high-pass, smoothly
 #: in log U; the check points measure the cubic's error.
-SPEED_NODES = 3
+SPEED_NODES = 4
 #: Speeds of the motion tables [1]: three fix the exact forms in U (module docstring).
 MOTION_SPEEDS = 3
 #: The motion tables' frequency grid [Hz]: step and highest frequency. The response
@@ -85,9 +85,19 @@ class Tables:
     response: np.ndarray               # y (n_h, 3, n_m, n_f, S) [m s-1 per amplitude]
     curvature: np.ndarray              # g (n_h, 3, n_m, n_g, S) [m s-1 per amplitude^2]
     noise: np.ndarray                  # per-scan noise variance (n_h, 3, n_m) [m2 s-2]
+    response_step: float               # [Hz]: the response's frequencies step, 2 step, ...
+    curvature_step: float              # [Hz]: the curvature's
     n_scans: int
     scan_period: float
     record_duration: float
+
+    @property
+    def spectral_directions(self):
+        return self.filtering.shape[2]
+
+    @property
+    def motion_directions(self):
+        return self.noise.shape[2]
 
 
 def speed_nodes(low, high, count=SPEED_NODES):
@@ -115,15 +125,13 @@ def spectral_node(lidar, heights, scales, turbulence, record_duration, speed, di
 
 
 def motion_node(lidar, height, scale, turbulence, record_duration, speed, direction,
-                shapes):
+                shapes, response_frequencies, curvature_frequencies):
     """(y (n_f, S), g (n_g, S), noise variance) of one height at one node."""
     settings = adapter.gate_settings(lidar, [height], {**turbulence, "length_scale": scale},
                                      record_duration, speed, direction)
     shapes = np.asarray(shapes, complex)
-    return (_per_shape(adapter.motion_jacobian, settings, frequency_grid(FREQUENCY_STEP),
-                       shapes),
-            2.0 * _per_shape(adapter.motion_shift, settings, frequency_grid(CURVATURE_STEP),
-                             shapes),
+    return (_per_shape(adapter.motion_jacobian, settings, response_frequencies, shapes),
+            2.0 * _per_shape(adapter.motion_shift, settings, curvature_frequencies, shapes),
             adapter.scan_noise_variance(settings))
 
 
@@ -150,8 +158,9 @@ def build_tables(lidar, heights, scales, turbulence, record_duration, speed_rang
     spectral = [[run(spectral_node, lidar, heights, scales, turbulence, record_duration, u,
                      heading + np.degrees(t)) for t in periodic_nodes(SPECTRAL_DIRECTIONS)]
                 for u in speeds]
+    grids = frequency_grid(FREQUENCY_STEP), frequency_grid(CURVATURE_STEP)
     motion = [[[run(motion_node, lidar, h, s, turbulence, record_duration, u,
-                    heading + np.degrees(t), shapes)
+                    heading + np.degrees(t), shapes, *grids)
                 for t in periodic_nodes(MOTION_DIRECTIONS)] for u in motion_speeds]
               for h, s in zip(heights, scales)]
     spectral = np.array([[_result(task) for task in row] for row in spectral])  # (u, t, 3, h)
@@ -168,6 +177,7 @@ def build_tables(lidar, heights, scales, turbulence, record_duration, speed_rang
         response=np.array([[[node[0] for node in row] for row in rows] for rows in motion]),
         curvature=np.array([[[node[1] for node in row] for row in rows] for rows in motion]),
         noise=np.array([[[node[2] for node in row] for row in rows] for rows in motion]),
+        response_step=FREQUENCY_STEP, curvature_step=CURVATURE_STEP,
         n_scans=adapter.scans_per_record(probe), scan_period=adapter.scan_period(probe),
         record_duration=float(record_duration))
 
@@ -194,7 +204,8 @@ def spectral_at(tables, height_index, speed, direction):
     [deg], each (n,)); speeds clamped into the table's range (the caller flags them)."""
     speed = np.clip(np.asarray(speed, float), tables.speeds[0], tables.speeds[-1])
     wu = log_lagrange_weights(speed, tables.speeds)                       # (n, u)
-    wt = periodic_weights(relative_angle(tables.heading, direction), SPECTRAL_DIRECTIONS)
+    wt = periodic_weights(relative_angle(tables.heading, direction),
+                          tables.spectral_directions)
     return tuple(np.einsum("nut,nu,nt->n", table[height_index], wu, wt)
                  for table in (tables.filtering, tables.spread, tables.point_fraction))
 
@@ -209,8 +220,8 @@ def speed_weights(nodes, speed, powers):
 
 def _motion_weights(tables, speed, direction, powers, degree):
     return (speed_weights(tables.motion_speeds, speed, powers),
-            periodic_weights(relative_angle(tables.heading, direction), MOTION_DIRECTIONS,
-                             degree))
+            periodic_weights(relative_angle(tables.heading, direction),
+                             tables.motion_directions, degree))
 
 
 def _at_components(table, step, height_index, wu, wt, frequency, shape):
@@ -230,14 +241,14 @@ def _at_components(table, step, height_index, wu, wt, frequency, shape):
 def response_at(tables, height_index, speed, direction, frequency, shape):
     """y (n, K) [m s-1 per amplitude] at the records' components."""
     wu, wt = _motion_weights(tables, speed, direction, (0, 1), RESPONSE_DEGREE)
-    return _at_components(tables.response, FREQUENCY_STEP, height_index, wu, wt,
+    return _at_components(tables.response, tables.response_step, height_index, wu, wt,
                           frequency, shape)
 
 
 def curvature_at(tables, height_index, speed, direction, frequency, shape):
     """g (n, K) [m s-1 per amplitude^2] at the records' components."""
     wu, wt = _motion_weights(tables, speed, direction, (-1, 0, 1), CURVATURE_DEGREE)
-    return _at_components(tables.curvature, CURVATURE_STEP, height_index, wu, wt,
+    return _at_components(tables.curvature, tables.curvature_step, height_index, wu, wt,
                           frequency, shape)
 
 
@@ -254,7 +265,7 @@ def check_points(tables):
     middle of each speed interval at directions half-way between two table directions
     (the worst places of both interpolants), alternating along the circle."""
     middles = np.sqrt(tables.speeds[:-1] * tables.speeds[1:])
-    step = FULL_CIRCLE_DEG / SPECTRAL_DIRECTIONS
+    step = FULL_CIRCLE_DEG / tables.spectral_directions
     return [(float(u), tables.heading + step * (0.5 + 5 * i) % FULL_CIRCLE_DEG)
             for i, u in enumerate(middles)]
 
@@ -283,7 +294,7 @@ def motion_errors(tables, lidar, scales, turbulence, shapes):
     frequencies (the motion variance's relative error is at most twice it), per
     height: the largest."""
     u, d = check_points(tables)[0]
-    middle = frequency_grid(FREQUENCY_STEP)[:-1] + FREQUENCY_STEP / 2.0
+    middle = frequency_grid(tables.response_step)[:-1] + tables.response_step / 2.0
     worst = 0.0
     for i, (h, scale) in enumerate(zip(tables.heights, scales)):
         settings = adapter.gate_settings(lidar, [h], {**turbulence, "length_scale": scale},

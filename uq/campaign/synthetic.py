@@ -5,8 +5,9 @@ made by uq's own Monte Carlo records.
 * **Truth**: a stretch of the brightwind demo mast (:func:`uq.data.brightwind_mast`, MIT
   licence): each record's mean speed, its standard deviation and direction at 40, 60 and
   80 m. The mast's TI (std / speed) is the record's true TI: the field of the record is a
-  Mann field (:data:`TURBULENCE`) whose expected ten-minute TI at the gate, ``sqrt(V) /
-  U`` (a point sampled once a scan, the record's high-pass), equals it.
+  Mann field (:data:`TURBULENCE`) whose expected ten-minute TI at the gate, ``sqrt(V N /
+  (N - 1)) / U`` (a point sampled once a scan, the record's high-pass, the variance over
+  N - 1 scans as the lidar's), equals it.
 * **Sea**: the significant wave height follows the wind at 80 m with a slowly wandering
   factor (an AR(1) process of the records, :data:`SEA`), the peak period the wave height
   (a wind sea's ``Tp ~ 3.3 sqrt(Hs) + 2`` with noise); both written as a wave sensor's
@@ -58,6 +59,9 @@ MADE = {"min_speed": 1.0, "max_ti": 0.45}
 LOSSES = {"absent": 0.03, "low": 0.03, "low_range": (40.0, 79.0)}
 #: The lidar logger's local time zone and stamp.
 LOCAL_ZONE, LOCAL_OFFSET = "+01:00", pd.Timedelta(hours=1)
+#: The lidar's standard deviation is over N - DDOF scans; the record's true TI is on the
+#: same convention (its expected variance over N - 1 scans: the square of the mast's TI).
+DDOF = 1
 #: Spawn keys of the random streams: the sea, the losses, the records.
 SEA_STREAM, LOSS_STREAM, RECORD_STREAM = 1, 2, 3
 
@@ -114,9 +118,11 @@ def record_settings(lidar, height, speed, direction, truth_ti, hs, tp):
     """Validated gate settings of one record: the record's wind, the field whose expected
     ten-minute TI at the gate is `truth_ti`, and its sea."""
     scan = adapter.scan_period(lidar)
+    n = int(np.floor(CAMPAIGN_RECORD_SECONDS / scan + 1e-9))
     point = adapter.point_record_variance(TURBULENCE["length_scale"],
                                           TURBULENCE["anisotropy"], 1.0, speed, scan,
                                           CAMPAIGN_RECORD_SECONDS) / speed ** 2
+    point *= n / (n - DDOF)                  # the lidar's convention: over N - 1 scans
     motion = {"spectrum": {"kind": "jonswap", "hs": float(hs), "tp": float(tp),
                            **SPECTRUM},
               "response": lidar["motion"]["response"]}
@@ -129,7 +135,7 @@ def lidar_record(lidar, height, speed, direction, truth_ti, hs, tp, rng):
     """(mean speed, its standard deviation (ddof 1)) [m s-1] of one Monte Carlo record."""
     settings = record_settings(lidar, height, speed, direction, truth_ti, hs, tp)
     vh, _ = adapter.monte_carlo_record(settings, rng)
-    return float(np.mean(vh)), float(np.std(vh, ddof=1))
+    return float(np.mean(vh)), float(np.std(vh, ddof=DDOF))
 
 
 def plan(stretch):

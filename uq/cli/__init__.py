@@ -1,6 +1,6 @@
 """Command line: ``uq run``, ``uq check``, ``uq list``, ``uq plot``, ``uq report``,
-``uq export``, ``uq bench``, ``uq fit``, ``uq golden``, ``uq warmup``, ``uq --version``; one module per
-subcommand.
+``uq export``, ``uq bench``, ``uq fit``, ``uq golden``, ``uq campaign``, ``uq warmup``,
+``uq --version``; one module per subcommand.
 
 The command line dispatches; it computes nothing. Each subcommand module adds its
 parser and imports what it needs only when it runs, so ``uq --help`` and ``uq --version``
@@ -14,16 +14,18 @@ import contextlib
 import sys
 
 from uq._version import __version__
-from uq.cli import bench, check, export, fit, golden, listing, plot, report, run, warmup
+from uq.cli import (bench, campaign, check, export, fit, golden, listing, plot, report, run,
+                    warmup)
 from uq.cli.common import (EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK,  # noqa: F401
                            EXIT_TERMINATED, Parser, add_common_options, configure_logging,
                            interrupted_status, parse_overrides)
 from uq.errors import InputError
 from uq.interrupts import raise_if_stopped, stopping_on_signals
 
-SUBCOMMANDS = (run, check, listing, plot, report, export, bench, fit, golden, warmup)
+SUBCOMMANDS = (run, check, listing, plot, report, export, bench, fit, golden, campaign,
+               warmup)
 #: Commands that may compile numba kernels: they say so on stderr (uq.cli.compiling).
-COMPILING = ("run", "plot", "report", "bench", "fit", "golden", "warmup")
+COMPILING = ("run", "plot", "report", "bench", "fit", "golden", "campaign", "warmup")
 
 
 def build_parser():
