@@ -35,6 +35,7 @@ References
    Technol. 28, 853-868.
 """
 import numpy as np
+from scipy import interpolate
 
 from uq.campaign.adapter import record_high_pass
 
@@ -45,6 +46,9 @@ from uq.campaign.adapter import record_high_pass
 FINE_CUT = 10.0
 #: Points of the fine grid per period of ``cos(k1 U tau)`` at the longest lag [1].
 FINE_POINTS_PER_PERIOD = 16
+#: Lags of one block of the covariance's cosine transform (memory: block x the fine
+#: grid's points, ~FINE_CUT x FINE_POINTS_PER_PERIOD x N / 2 pi: 12 MB at N = 600).
+LAG_BLOCK = 512
 
 
 def high_pass(terms):
@@ -78,11 +82,14 @@ def scan_covariance(terms, n_scans):
     of minutes (``U tau`` of kilometres): summed on them, R at large lags is noise of the
     size of the nodes' terms, and the spread of s^2 comes out ~20 % high (measured
     against a dense grid). So the one-sided density ``s = 2 term / weight`` (the weights
-    hold the factor 2 of the even integrand) is interpolated (linearly
-    in log s against log k1: exact for the power laws of the spectrum's ranges) onto a
+    hold the factor 2 of the even integrand) is interpolated (a monotone cubic of log s
+    against log k1, Fritsch and Carlson 1980: exact for the power laws of the spectrum's
+    ranges, smooth at its knee) onto a
     uniform grid of :data:`FINE_POINTS_PER_PERIOD` points per period of the longest lag's
-    cosine, up to ``k_c = FINE_CUT / (U T_s)``; the nodes above k_c add to R(0) alone
-    (their eddies pass a gate within a scan: uncorrelated between scans)."""
+    cosine, up to ``k_c = FINE_CUT / (U T_s)``, for the lags of one scan and more (the
+    wavenumbers above k_c turn the cosine by more than 10 rad between two scans: they
+    are uncorrelated from scan to scan); R(0) is the nodes' own sum, the spectral path's
+    variance."""
     lags = np.arange(n_scans) * terms.scan_period
     cut = FINE_CUT / (terms.speed * terms.scan_period)
     step = 2.0 * np.pi / (FINE_POINTS_PER_PERIOD * terms.speed * max(lags[-1], terms.scan_period))
@@ -90,13 +97,17 @@ def scan_covariance(terms, n_scans):
     lidar = np.asarray(terms.lidar, float)
     positive = lidar > 0
     density = np.zeros(fine.size)
-    if np.any(positive):
-        log_density = np.interp(np.log(fine), np.log(terms.k1[positive]),
-                                np.log(2.0 * lidar[positive] / terms.weight[positive]),
-                                left=-np.inf, right=-np.inf)
-        density = np.exp(log_density)
-    covariance = np.cos(np.multiply.outer(lags, fine * terms.speed)) @ (density * step)
-    covariance[0] += np.sum(lidar[terms.k1 > cut])
+    if np.count_nonzero(positive) > 1:
+        nodes = np.log(terms.k1[positive])
+        inside = (fine >= terms.k1[positive][0]) & (fine <= terms.k1[positive][-1])
+        curve = interpolate.PchipInterpolator(nodes, np.log(2.0 * lidar[positive]
+                                                            / terms.weight[positive]))
+        density[inside] = np.exp(curve(np.log(fine[inside])))
+    weights = density * step
+    covariance = np.concatenate([np.cos(np.multiply.outer(lags[i:i + LAG_BLOCK],
+                                                          fine * terms.speed)) @ weights
+                                 for i in range(0, lags.size, LAG_BLOCK)])
+    covariance[0] = np.sum(lidar)                  # the variance: the nodes' own sum
     return covariance
 
 
@@ -104,17 +115,22 @@ def variance_spread(terms, n_scans):
     """``tr((P C_t)^2) / (N <s^2>_t)^2`` [1] of the lidar's turbulence over a record of
     `n_scans` scans (module docstring): the squared coefficient of variation of s^2 is
     twice this."""
-    covariance = toeplitz(scan_covariance(terms, n_scans))
-    centred = covariance - covariance.mean(axis=0, keepdims=True)     # P C
-    trace = np.trace(centred)
-    return float(np.sum(centred * centred.T) / trace ** 2)
+    return toeplitz_spread(scan_covariance(terms, n_scans))
 
 
-def toeplitz(first):
-    """The symmetric Toeplitz matrix of its first row, shape (N, N)."""
+def toeplitz_spread(first):
+    """``tr((P C)^2) / tr(P C)^2`` of the symmetric Toeplitz C of first row `first`
+    (N,), in O(N): with the row sums ``r_i``, ``tr(PC) = N R_0 - sum r / N`` and
+    ``tr((PC)^2) = sum C_ij^2 - 2 sum r_i^2 / N + (sum r)^2 / N^2``, ``sum C_ij^2 = N R_0^2
+    + 2 sum_k (N - k) R_k^2``."""
     first = np.asarray(first, float)
-    index = np.abs(np.subtract.outer(np.arange(first.size), np.arange(first.size)))
-    return first[index]
+    n = first.size
+    cumulative = np.cumsum(first)
+    rows = cumulative + cumulative[::-1] - first[0]          # r_i (C symmetric Toeplitz)
+    squares = n * first[0] ** 2 + 2.0 * np.sum((n - np.arange(1, n)) * first[1:] ** 2)
+    total = rows.sum()
+    trace = n * first[0] - total / n
+    return float((squares - 2.0 * np.sum(rows ** 2) / n + total ** 2 / n ** 2) / trace ** 2)
 
 
 def variance_of_variance(lidar_variance, spread, noise_variance, n_scans):
