@@ -300,14 +300,19 @@ def _speeds(settings, components, phases):
                                      **fixed)["wind_speed"])[:, 0]
 
 
+#: The motion's own inputs: the phases the derivatives are taken in (every other input,
+#: the INS's sampling offset among them, is held at its mean, where the GUM linearises).
+PHASE_INPUTS = ("motion_phases", "motion_window")
+
+
 def _mean_errors(settings, scene):
-    """Every non-motion input of the scene at its mean (floats): the bias an error
-    declares, zero otherwise."""
-    from uq.pipeline.modelsetup import MOTION_INPUTS, error_inputs
+    """Every input of the scene but the phases at its mean (floats): the bias an error
+    declares, zero otherwise; the INS's sampling offset half its period."""
+    from uq.pipeline.modelsetup import error_inputs
     from uq.engine.inputs import Input
     out = {}
     for name, spec in error_inputs(settings, scene.n_beams, 1).items():
-        if name in MOTION_INPUTS:
+        if name in PHASE_INPUTS:
             continue
         dist = spec.distribution if isinstance(spec, Input) else spec
         out[name] = dist if isinstance(dist, float) else float(dist.mean())
