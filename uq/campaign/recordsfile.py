@@ -83,11 +83,8 @@ def utc_times(column, zone, source, key):
         warnings.simplefilter("ignore", UserWarning)
         try:
             parsed = pd.to_datetime(column, errors="coerce")
-        except (ValueError, TypeError):      # mixed zones
-            parsed = pd.to_datetime(column, errors="coerce", utc=True)
-            if parsed.isna().any():
-                _bad_stamp(column, parsed, source, key)
-            return parsed.dt.tz_convert(None)
+        except (ValueError, TypeError):      # a stamp unlike the first, or mixed zones
+            return _stamp_by_stamp(column, source, key)
     if parsed.isna().any():
         _bad_stamp(column, parsed, source, key)
     if parsed.dt.tz is not None:
@@ -100,6 +97,24 @@ def utc_times(column, zone, source, key):
                             f"not exist in {zone} (a daylight-saving change); allowed: "
                             "stamps in UTC or with their offset") from None
     return local.dt.tz_convert(None)
+
+
+def _stamp_by_stamp(column, source, key):
+    """Stamps of different forms parsed one by one: a stamp that is not a date is
+    refused; stamps that all carry a zone (offsets that change with daylight saving)
+    are converted; some with a zone and some without are refused."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        parsed = pd.to_datetime(column, errors="coerce", format="mixed", utc=True)
+    if parsed.isna().any():
+        _bad_stamp(column, parsed, source, key)
+    zoned = column.astype(str).str.contains(r"(?:Z|[+-]\d\d:?\d\d)\s*$", regex=True)
+    if not zoned.all():
+        row = int(np.flatnonzero(~zoned.to_numpy())[0])
+        raise DataFileError(source, key, f"stamp {column.iloc[row]!r} (row {row + 2}) has no "
+                            "time zone where others have one; allowed: all stamps with "
+                            "their zone, or none (the configuration's time_zone)")
+    return parsed.dt.tz_convert(None)
 
 
 def _bad_stamp(column, parsed, source, key):
