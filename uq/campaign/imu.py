@@ -16,7 +16,8 @@ Per record [start, start + 10 min):
 * the segments' shares are averaged weighted by their lengths (Welch's averaging over
   non-overlapping, unwindowed segments) and summed into the nearest bin of the motion
   tables' grid (:data:`uq.campaign.surrogate.FREQUENCY_STEP`): the record's matrix M_b
-  per bin, ``sum_b M_b`` its covariance;
+  per bin, ``sum_b M_b`` its covariance, at the bin's power-weighted mean frequency (a
+  line keeps its own frequency: the response changes by several per cent within a bin);
 * a record whose segments cover less than :data:`MIN_COVERAGE` of its ten minutes has no
   motion (NaN in the results, flagged ``no_motion_data``); power below the first bin's
   half-step or above the tables' top frequency is left out (its share reported).
@@ -96,11 +97,14 @@ def segments(times, rate):
 
 def record_spectra(times, values, starts, rate):
     """Per record (period starts [s since 1970 UTC] (n,)): the cross-spectral matrices on
-    the motion tables' bins (n, n_bins, m, m) [rad2, m2], the covered share of the
-    record (n,) and the share of its power outside the bins (n,)."""
+    the motion tables' bins (n, n_bins, m, m) [rad2, m2], each bin's frequency (the mean
+    of its Fourier frequencies weighted by their power, the bin's centre where it has
+    none) (n, n_bins) [Hz], the covered share of the record (n,) and the share of its
+    power outside the bins (n,)."""
     dofs = list(values)
     grid = surrogate.frequency_grid(surrogate.FREQUENCY_STEP)
     out = np.zeros((len(starts), grid.size, len(dofs), len(dofs)), complex)
+    moment = np.zeros((len(starts), grid.size))
     covered, outside = np.zeros(len(starts)), np.zeros(len(starts))
     data = np.stack([values[d] for d in dofs], axis=-1)                    # (samples, m)
     length = PERIOD.total_seconds()
@@ -112,22 +116,28 @@ def record_spectra(times, values, starts, rate):
             if last - first < 2 or (last - first) / rate < MIN_SEGMENT_SECONDS or \
                     not np.all(np.isfinite(part)):
                 continue
-            spectra, weight, left = _segment(part, dofs, rate, grid)
+            spectra, first, weight, left = _segment(part, dofs, rate, grid)
             out[i] += spectra * weight
+            moment[i] += first * weight
             outside[i] += left * weight
             total += weight
         covered[i] = total / length
         if total > 0:
             out[i] /= total
+            moment[i] /= total
             inside = np.real(np.trace(out[i], axis1=-2, axis2=-1)).sum()
             left = outside[i] / total
             outside[i] = left / (inside + left) if inside + left > 0 else 0.0
-    return out, covered, outside
+    power = np.real(np.trace(out, axis1=-2, axis2=-1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        frequency = np.where(power > 0, moment / power, grid[None])
+    return out, frequency, covered, outside
 
 
 def _segment(part, dofs, rate, grid):
-    """(the segment's cross-spectra on the bins (n_bins, m, m), its length [s], the
-    power (trace) left outside the bins)."""
+    """(the segment's cross-spectra on the bins (n_bins, m, m), the first moment of each
+    bin's power in frequency (n_bins,) [Hz x power], its length [s], the power (trace)
+    left outside the bins)."""
     part = part.copy()
     for j, dof in enumerate(dofs):
         if dof == "yaw":
@@ -145,8 +155,11 @@ def _segment(part, dofs, rate, grid):
     inside = (index >= 0) & (index < grid.size)
     out = np.zeros((grid.size, len(dofs), len(dofs)), complex)
     np.add.at(out, index[inside], shares[inside])
-    left = float(np.real(np.trace(shares[~inside], axis1=-2, axis2=-1)).sum())
-    return out, n / rate, left
+    trace = np.real(np.trace(shares, axis1=-2, axis2=-1))
+    first = np.zeros(grid.size)
+    np.add.at(first, index[inside], (trace * frequency)[inside])
+    left = float(trace[~inside].sum())
+    return out, first, n / rate, left
 
 
 def motion_set(spec, record_times):
@@ -154,16 +167,15 @@ def motion_set(spec, record_times):
     datetime64 (n,)) from an IMU log; the log's samples outside every record left out."""
     times, values = read_log(spec)
     starts = (pd.DatetimeIndex(record_times) - pd.Timestamp(0)).total_seconds().to_numpy()
-    spectra, covered, outside = record_spectra(times, values, starts, spec.rate)
+    spectra, frequency, covered, outside = record_spectra(times, values, starts, spec.rate)
     dofs = [DEGREES_OF_FREEDOM.index(d) for d in values]
     shapes, labels = motion.polarisation_shapes(dofs)
     local = list(range(len(dofs)))
     power = motion.polarisation_powers(spectra, local)                     # (n, b, S)
-    grid = surrogate.frequency_grid(surrogate.FREQUENCY_STEP)
     n, bins, count = power.shape
     valid = covered >= MIN_COVERAGE
     return motion.MotionSet(
-        shapes, np.broadcast_to(np.repeat(grid, count), (n, bins * count)).copy(),
+        shapes, np.repeat(frequency, count, axis=1),
         np.broadcast_to(np.tile(np.arange(count), bins), (n, bins * count)).copy(),
         np.where(valid[:, None], power.reshape(n, bins * count), 0.0), valid, labels), \
         outside
