@@ -103,8 +103,10 @@ def _input_flags(config, records, motions, outside):
     """Flags (time, height) of what the inputs say alone."""
     bits = correction.FLAG_BITS
     speed, std = records["speed"].values, records["std"].values
-    flags = np.where(~(np.isfinite(speed) & np.isfinite(std)), bits["missing"], 0)
-    flags |= np.where(records["availability"].values < config.records.minimum_availability,
+    present = np.isfinite(speed) & np.isfinite(std)
+    flags = np.where(~present, bits["missing"], 0)
+    flags |= np.where(present & (records["availability"].values
+                                 < config.records.minimum_availability),
                       bits["low_availability"], 0)
     with np.errstate(invalid="ignore"):
         flags |= np.where(speed < config.minimum_speed, bits["low_speed"], 0)
