@@ -156,3 +156,48 @@ def test_a_folder_uq_did_not_write_is_not_replaced(tmp_path, capsys):
     assert main(["campaign", str(path), "-o", str(tmp_path / "mine")]) == 2
     assert "was not written by uq" in capsys.readouterr().err
     assert (tmp_path / "mine" / "notes.txt").read_text() == "mine"
+
+
+def test_uq_golden_takes_the_campaigns_corrected_ti(small, tmp_path):
+    """A golden configuration whose unit is the campaign's results file: uq golden's TI
+    KPIs use the corrected TI (its bins' unit mean is the corrected TI's, in percent),
+    the speed the corrected speed, and the report says so."""
+    import yaml
+    _, folder, ds = small
+    reference = ds["turbulence_intensity_reference"]
+    mast = pd.DataFrame({"time": pd.DatetimeIndex(ds["time"].values).strftime(
+        "%Y-%m-%dT%H:%MZ")})
+    for h in ds["height"].values:
+        mast[f"ws{h:g}"] = ds["wind_speed_measured"].sel(height=h).values * 1.01
+        mast[f"wd{h:g}"] = ds["wind_direction"].sel(height=h).values
+        mast[f"ti{h:g}"] = 100 * reference.sel(height=h).values
+    mast.to_csv(tmp_path / "mast.csv", index=False)
+    config = {"golden": {
+        "name": "with_campaign",
+        "instruments": {
+            "buoy": {"campaign": str(folder / "mini.nc")},
+            "mast": {"file": "mast.csv", "calibration": {"absolute": 0.05},
+                     "class_number": 0.0,
+                     "heights": {float(h): {"speed": f"ws{h:g}", "direction": f"wd{h:g}",
+                                            "environment": {"turbulence_intensity": f"ti{h:g}"}}
+                                 for h in ds["height"].values}}},
+        "comparisons": [{"unit": "buoy", "reference": "mast"}],
+        "classification": {"route": "class_number"},
+        "bins": {"minimum_records": 1}}}
+    path = tmp_path / "golden.yaml"
+    path.write_text(yaml.safe_dump(config))
+    assert main(["golden", str(path), "-o", str(tmp_path / "golden"), "-q"]) == 0
+    golden = xr.open_dataset(tmp_path / "golden" / "with_campaign.nc")
+    from uq.golden import binning
+    h = float(ds["height"].values[-1])
+    corrected = ds["turbulence_intensity_corrected"].sel(height=h).values
+    speed = ds["wind_speed_measured"].sel(height=h).values * 1.01
+    keep = np.isfinite(corrected) & np.isfinite(reference.sel(height=h).values)
+    index = binning.bin_index(np.where(keep, speed, np.nan))
+    g = golden.sel(comparison="buoy-mast", height=h)
+    for k, b in enumerate(g["bin"].values):
+        chosen = index == int(round(b / 0.5))
+        if chosen.any():
+            assert float(g["ti_unit_mean"].values[k]) == pytest.approx(
+                100 * corrected[chosen].mean(), rel=1e-4)       # written with 5 digits
+    assert "is uq campaign's" in (tmp_path / "golden" / "report.md").read_text()
