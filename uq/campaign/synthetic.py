@@ -72,7 +72,7 @@ class Stretch:
     (excluded), UTC, and the seed of every random stream."""
 
     start: str = "2016-03-02"
-    stop: str = "2016-03-04"
+    stop: str = "2016-03-03"
     seed: int = 2016
 
 
@@ -162,16 +162,18 @@ def plan(stretch):
     return table
 
 
-def make_records(lidar, table, stretch, done=None, report=None):
+def make_records(lidar, table, stretch, done=None, report=None, part=(0, 1)):
     """Mean and std of every made record and height: a table (index of `table`) with
     columns ``mean_H``, ``std_H``; `done` (such a table) records already made (kept);
-    `report(index, total)` is called after each record."""
+    `report(index, total)` is called after each record; `part` (i, n): only the records
+    whose index is i modulo n (n processes share the work)."""
     out = done.copy() if done is not None else pd.DataFrame(index=table.index)
     for h in HEIGHTS:
         for name in (f"mean_{h:g}", f"std_{h:g}"):
             if name not in out:
                 out[name] = np.nan
-    jobs = [(i, j, h) for i in range(len(table)) for j, h in enumerate(HEIGHTS)
+    jobs = [(i, j, h) for i in range(part[0], len(table), part[1])
+            for j, h in enumerate(HEIGHTS)
             if table[f"made_{h:g}"].iloc[i] and not np.isfinite(out[f"mean_{h:g}"].iloc[i])]
     for count, (i, j, h) in enumerate(jobs):
         row = table.iloc[i]
