@@ -74,8 +74,9 @@ def analyse(config, client=None):
         ds["turbulence_intensity_reference"] = (("time", "height"), reference)
         ds["wind_speed_reference"] = (("time", "height"), reference_speed)
         ds.attrs["n_reference_off_grid"] = reference_off
-        ds["turbulence_intensity_measured_predicted"] = (("time", "height"),
-                                                         _predicted(config, ds, tables))
+        predicted, predicted_u = _predicted(config, ds, tables)
+        ds["turbulence_intensity_measured_predicted"] = (("time", "height"), predicted)
+        ds["turbulence_intensity_measured_predicted_u"] = (("time", "height"), predicted_u)
     ds = ds.assign(_bin_tables(config, ds))
     ds.attrs.update(errors)
     ds.attrs.update(_counts(flags, records, motion_off))
@@ -213,15 +214,17 @@ def _dataset(config, records, corrected, flags, tables):
 
 
 def _predicted(config, ds, tables):
-    """The measured TI the model predicts from the reference's TI: ``E[s_reported] /
-    U`` with ``s^2 ~ E chi2_nu / nu`` (:mod:`uq.campaign.spectra`), E from Eq. 1 of
-    :mod:`uq.campaign.correction` with ``V = (TI_ref U_c)^2``."""
+    """The measured TI the model predicts from the reference's TI, and its standard
+    deviation from record to record: ``E[s_reported] / U`` with ``s^2 ~ E chi2_nu / nu``
+    (:mod:`uq.campaign.spectra`), E from Eq. 1 of :mod:`uq.campaign.correction` with the
+    reference's variance on the lidar's convention, ``V = (TI_ref U_c)^2 (N - ddof) /
+    N``; the standard deviation ``sqrt(E[s^2] - E[s]^2) / U``."""
     from scipy import special
     from uq.campaign import spectra
     n, ddof = tables.n_scans, config.records.ddof
     u_c = ds["wind_speed_corrected"].values
     lidar = ds["lidar_filtering_factor"].values * (ds["turbulence_intensity_reference"].values
-                                                    * u_c) ** 2
+                                                    * u_c) ** 2 * (n - ddof) / n
     noise = ds["scan_noise_variance"].values
     mean = lidar + ds["motion_variance"].values + (n - 1.0) / n * noise
     var = spectra.variance_of_variance(lidar, ds["record_variance_spread"].values, noise, n)
@@ -229,7 +232,10 @@ def _predicted(config, ds, tables):
         dof = spectra.degrees_of_freedom(mean, var)
         root = np.sqrt(2.0 / dof) * np.exp(special.gammaln((dof + 1) / 2) - special.gammaln(dof / 2))
         root = np.where(np.isfinite(root), root, 1.0)
-        return np.sqrt(mean * n / (n - ddof)) * root / ds["wind_speed_measured"].values
+        reported = mean * n / (n - ddof)                     # E[s_reported^2]
+        speed = ds["wind_speed_measured"].values
+        return (np.sqrt(reported) * root / speed,
+                np.sqrt(np.maximum(reported * (1.0 - root ** 2), 0.0)) / speed)
 
 
 def _bin_tables(config, ds):
@@ -275,6 +281,9 @@ def _bin_tables(config, ds):
         put("ti_mean_bias_corrected_u", bins.bin_sums(np.where(
             both, d["turbulence_intensity_corrected_u"].values ** 2, np.nan), speed, centres,
             config.bin_width))
+        put("ti_mean_bias_measured_predicted_u", bins.bin_sums(np.where(
+            both, d["turbulence_intensity_measured_predicted_u"].values ** 2, np.nan), speed,
+            centres, config.bin_width))
     data = {name: (("bin", "height"), values) for name, values in out.items()}
     data["required"] = ("bin", binning.sufficient_bins(np.zeros(len(centres)), centres,
                                                        config.minimum_records,

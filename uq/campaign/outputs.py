@@ -34,6 +34,9 @@ METADATA = {
     "turbulence_intensity_measured_predicted": ("1", "expected measured turbulence "
                                                 "intensity of the model given the "
                                                 "reference's", None),
+    "turbulence_intensity_measured_predicted_u": ("1", "standard deviation of the measured "
+                                                  "turbulence intensity the model predicts "
+                                                  "from record to record", None),
     "wind_speed_reference": ("m s-1", "the reference's ten-minute mean wind speed",
                              "wind_speed"),
     "variance_corrected": ("m2 s-2", "the field's ten-minute u-variance at the gate, "
@@ -95,7 +98,9 @@ def bin_metadata(name):
              "ti_mean_bias_corrected_u": ("1", "stated standard uncertainty of the corrected "
                                           "mean bias error"),
              "ti_mean_bias_measured_predicted": ("1", "mean bias error of the measured "
-                                                 "turbulence intensity the model predicts")}
+                                                 "turbulence intensity the model predicts"),
+             "ti_mean_bias_measured_predicted_u": ("1", "standard uncertainty of the bin's "
+                                                   "measured mean bias about its prediction")}
     return fixed.get(name)
 
 
