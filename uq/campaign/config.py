@@ -80,7 +80,6 @@ MOTION_KINDS = ("sea_state", "statistics", "imu")
 MOTION_KEYS = TABLE_KEYS + ("kind", "columns", "spectrum", "response", "units", "rate",
                             "time_unit")
 SPECTRUM_KEYS = ("gamma", "components", "band")
-RESPONSE_KEYS = ("factor", "lag")
 STATISTIC_KEYS = ("std", "amplitude", "period")
 TIME_UNITS = ("unix", "timestamp")
 REFERENCE_KEYS = TABLE_KEYS + ("heights", "units")
@@ -371,21 +370,12 @@ def _spectrum(check, raw, key):
 
 
 def _response(check, raw, key):
-    check.mapping(raw, key)
-    check.keys(raw, key, DEGREES_OF_FREEDOM)
-    if not raw:
+    """The buoy's response (uq's ``motion.response`` validator): dof -> (factor, lag)."""
+    from uq.pipeline.motionsection import validate_response
+    if isinstance(raw, dict) and not raw:
         check.fail(key, "empty; allowed: the response of at least one degree of freedom")
-    out = {}
-    for dof, spec in raw.items():
-        where = f"{key}.{dof}"
-        check.mapping(spec, where)
-        check.keys(spec, where, RESPONSE_KEYS)
-        check.required(spec, where, ("factor",), "allowed: the amplitude per metre of wave "
-                       "amplitude (deg/m or m/m)")
-        out[dof] = (check.number(spec["factor"], f"{where}.factor", low=0.0),
-                    check.number(spec.get("lag", 0.0), f"{where}.lag", low=-360.0,
-                                 high=360.0))
-    return out
+    found = validate_response(check, raw, key)
+    return {dof: (spec["factor"], spec["lag"]) for dof, spec in found.items()}
 
 
 def _statistics(check, raw, key):
