@@ -8,10 +8,10 @@ made by uq's own Monte Carlo records.
   Mann field (:data:`TURBULENCE`) whose expected ten-minute TI at the gate, ``sqrt(V N /
   (N - 1)) / U`` (a point sampled once a scan, the record's high-pass, the variance over
   N - 1 scans as the lidar's), equals it.
-* **Sea**: the significant wave height follows the wind at 80 m with a slowly wandering
-  factor (an AR(1) process of the records, :data:`SEA`), the peak period the wave height
-  (a wind sea's ``Tp ~ 3.3 sqrt(Hs) + 2`` with noise); both written as a wave sensor's
-  table (UTC, stamps at the period's start).
+* **Sea**: the significant wave height follows the wind at 80 m (a swell and the fully
+  developed wind sea) with a slowly wandering factor (an AR(1) process of the records,
+  :data:`SEA`), the peak period the wave height (``Tp ~ 3.3 sqrt(Hs) + 2`` with noise);
+  both written as a wave sensor's table (UTC, stamps at the period's start).
 * **Lidar**: each record and height is one Monte Carlo record
   (:func:`uq.campaign.adapter.monte_carlo_record`) of the lidar's scenario
   (``campaign_buoy_lidar.yaml``: it does not correct its motion) at the gate, in the
@@ -43,9 +43,10 @@ MAST_COLUMNS = {40.0: ("Spd40mN", "Spd40mNStd", "Dir38mS"),
 #: configuration states it), IEC 61400-1's Gamma.
 TURBULENCE = {"model": "mann", "length_scale": 33.6, "anisotropy": 3.9}
 #: The sea: Hs = (base + coefficient U80^2) x factor, the factor's log an AR(1) of the
-#: records (correlation per record, standard deviation), clipped to [low, high] [m];
-#: Tp = a sqrt(Hs) + b + noise [s], clipped to [low, high].
-SEA = {"base": 0.3, "coefficient": 0.008, "correlation": 0.98, "spread": 0.3,
+#: records (correlation per record, standard deviation), clipped to [low, high] [m]: a
+#: swell of 0.5 m and the fully developed wind sea of Pierson and Moskowitz (1964), Hs
+#: = 0.21 U^2 / g = 0.0214 U^2; Tp = a sqrt(Hs) + b + noise [s], clipped to [low, high].
+SEA = {"base": 0.5, "coefficient": 0.0214, "correlation": 0.98, "spread": 0.3,
        "hs_range": (0.2, 4.0), "tp_a": 3.3, "tp_b": 2.0, "tp_noise": 0.4,
        "tp_range": (3.0, 14.0)}
 #: JONSWAP of the records (the lidar scenario's response moves the buoy).
