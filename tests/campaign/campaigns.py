@@ -4,10 +4,22 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 import yaml
 
 ROOT = Path(__file__).resolve().parents[2]
 LIDAR = ROOT / "scenarios" / "campaign_buoy_lidar.yaml"
+
+
+@pytest.fixture
+def coarse_tables(monkeypatch):
+    """Tables of few nodes (for the plumbing: their error is measured and large): the
+    spectral path at 2 speeds x 3 directions, the motion's curvature every 0.2 Hz (the
+    motion's response and noise keep their nine directions: exact in direction)."""
+    from uq.campaign import surrogate
+    monkeypatch.setattr(surrogate, "SPEED_NODES", 2)
+    monkeypatch.setattr(surrogate, "SPECTRAL_DIRECTIONS", 3)
+    monkeypatch.setattr(surrogate, "CURVATURE_STEP", 0.2)
 
 
 def lidar_records(count=24, heights=(40, 80), seed=3, start="2016-03-02 00:10"):

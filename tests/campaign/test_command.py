@@ -13,7 +13,7 @@ from uq.campaign import command
 from uq.cli import main
 from uq.pipeline.scenario import load_scenario
 
-from campaigns import LIDAR, lidar_records, write_campaign
+from campaigns import LIDAR, coarse_tables, lidar_records, write_campaign  # noqa: F401
 
 CONTRACT = ("turbulence_intensity_measured", "turbulence_intensity_corrected",
             "turbulence_intensity_corrected_u", "turbulence_intensity_corrected_low",
