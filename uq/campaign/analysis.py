@@ -27,7 +27,7 @@ from uq.campaign import bins, correction, model, motion, surrogate
 from uq.campaign.config import length_scales
 from uq.campaign.motioninput import load_motion
 from uq.campaign.recordsfile import load_records, load_reference
-from uq.constants import CAMPAIGN_CHUNK_RECORDS, FULL_CIRCLE_DEG
+from uq.constants import CAMPAIGN_CHUNK_RECORDS, CAMPAIGN_RECORD_SECONDS, FULL_CIRCLE_DEG
 from uq.golden import binning, kpi
 
 #: Margin of the tables' speed range beyond the records' fastest [1] (the tables'
@@ -42,6 +42,8 @@ def analyse(config, client=None):
     records = load_records(config.records)
     times, heights = records["time"].values, list(config.heights)
     motions, outside, motion_off = _motion(config, times)
+    reference = None if config.reference is None else \
+        load_reference(config.reference, times, heights)      # every file read first
     flags = _input_flags(config, records, motions, outside)
     usable = (flags & correction.INVALIDATING) == 0
     speed = records["speed"].values
@@ -49,45 +51,40 @@ def analyse(config, client=None):
         2.0 * config.minimum_speed
     scales = length_scales(config)
     turbulence = {"model": "mann", "anisotropy": config.anisotropy}
+    lidar = config.lidar.settings
     submit = None if client is None else client.submit
-    tables = surrogate.build_tables(config.lidar.settings, heights, scales, turbulence,
-                                    surrogate_duration(config),
+    tables = surrogate.build_tables(lidar, heights, scales, turbulence,
+                                    CAMPAIGN_RECORD_SECONDS,
                                     (config.minimum_speed, max(top * SPEED_MARGIN,
                                                                2 * config.minimum_speed)),
                                     motions.shapes, submit)
-    errors = {"surrogate_ti_error": surrogate.spectral_errors(
-        tables, config.lidar.settings, scales, turbulence, submit)}
-    errors["surrogate_spread_error"] = errors["surrogate_ti_error"][1]
-    errors["surrogate_ti_error"] = errors["surrogate_ti_error"][0]
-    errors["surrogate_motion_error"] = surrogate.motion_errors(
-        tables, config.lidar.settings, scales, turbulence, motions.shapes) \
-        if motions.frequency.shape[1] else 0.0
+    ti_error, spread_error = surrogate.spectral_errors(tables, lidar, scales, turbulence,
+                                                       submit)
+    motion_error = surrogate.motion_errors(tables, lidar, scales, turbulence,
+                                           motions.shapes) if motions.shapes.size else 0.0
     corrected = correct_records(config, records, motions, tables, usable, submit)
     flags |= np.where(usable & ~corrected.pop("consistent"),
                       correction.FLAG_BITS["variance_below_model"], 0)
     flags |= np.where(usable & (np.abs(corrected["wind_speed_motion_bias"]) > _tolerance(
         corrected["motion_u"])), correction.FLAG_BITS["motion_clause8"], 0)
     ds = _dataset(config, records, corrected, flags, tables)
-    if config.reference is not None:
-        reference, reference_speed, reference_off = load_reference(config.reference, times,
-                                                                   heights)
-        ds["turbulence_intensity_reference"] = (("time", "height"), reference)
-        ds["wind_speed_reference"] = (("time", "height"), reference_speed)
-        ds.attrs["n_reference_off_grid"] = reference_off
+    if reference is not None:
+        ds["turbulence_intensity_reference"] = (("time", "height"), reference[0])
+        ds["wind_speed_reference"] = (("time", "height"), reference[1])
+        ds.attrs["n_reference_off_grid"] = reference[2]
         predicted, predicted_u = _predicted(config, ds, tables)
         ds["turbulence_intensity_measured_predicted"] = (("time", "height"), predicted)
         ds["turbulence_intensity_measured_predicted_u"] = (("time", "height"), predicted_u)
     ds = ds.assign(_bin_tables(config, ds))
-    ds.attrs.update(errors)
+    ds.attrs.update(surrogate_ti_error=ti_error, surrogate_spread_error=spread_error,
+                    surrogate_motion_error=motion_error,
+                    surrogate_nodes=f"spectral path: {tables.speeds.size} speeds x "
+                    f"{tables.spectral_directions} directions; motion: "
+                    f"{tables.motion_speeds.size} speeds x {tables.motion_directions} "
+                    f"directions, frequencies every {tables.response_step:g} Hz")
     ds.attrs.update(_counts(flags, records, motion_off))
     ds.attrs["runtime_s"] = clock.perf_counter() - started
     return ds
-
-
-def surrogate_duration(config):
-    """The record duration [s] of the campaign (ten minutes)."""
-    from uq.constants import CAMPAIGN_RECORD_SECONDS
-    return CAMPAIGN_RECORD_SECONDS
 
 
 def _motion(config, times):
@@ -205,6 +202,7 @@ def _dataset(config, records, corrected, flags, tables):
                     coords={"time": records["time"].values,
                             "height": np.array(config.heights, float)})
     ds.attrs.update(name=config.name, description=config.description,
+                    configuration=config.text, lidar_scenario=config.lidar.text,
                     filtering=config.filtering, coverage=config.coverage,
                     n_scans=tables.n_scans, scan_period=tables.scan_period,
                     std_ddof=config.records.ddof, minimum_speed=config.minimum_speed,

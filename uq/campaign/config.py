@@ -55,6 +55,8 @@ import dataclasses
 import re
 from pathlib import Path
 
+import yaml
+
 from uq.constants import (CAMPAIGN_MIN_SPEED, COVERAGE_PROBABILITY, GOLDEN_BIN_WIDTH,
                           GOLDEN_MAX_BINS, GOLDEN_MAX_SPEED, GOLDEN_MIN_RECORDS,
                           GOLDEN_REQUIRED_RANGE, MANN_ANISOTROPY, MAX_ANISOTROPY,
@@ -151,6 +153,7 @@ class CampaignConfig:
     filtering_u: float = 0.0
     motion_u: float = 0.0
     minimum_speed: float = CAMPAIGN_MIN_SPEED
+    text: str = ""              # the configuration's YAML as read
 
     @property
     def heights(self):
@@ -168,7 +171,8 @@ def load_campaign_config(path):
         check.fail("campaign", "missing; allowed: a mapping under the top-level key "
                    "'campaign'")
     check.keys(raw, "", ("campaign",))
-    return validate_campaign(raw["campaign"], check, path.parent)
+    config = validate_campaign(raw["campaign"], check, path.parent)
+    return dataclasses.replace(config, text=yaml.safe_dump(raw, sort_keys=False))
 
 
 def validate_campaign(raw, check, base):

@@ -20,7 +20,9 @@ made by uq's own Monte Carlo records.
   Its mean speed and standard deviation (``ddof`` 1) of the scans are the record's. The
   lidar's table is written as a logger writes it: its own column names, local time
   (UTC+01:00) stamped at the period's end, an availability per height; some records
-  lost (rows absent) and some with a low availability.
+  lost (rows absent), some with a low availability, and those whose turbulence box would
+  exceed uq's limit of cells (a fast wind over a high sea: the motion widens the box)
+  left empty.
 
 Each record and height has its own random stream (:func:`record_stream`), so one record
 can be made again alone (the tests do, against the shipped table).
@@ -60,6 +62,11 @@ MADE = {"min_speed": 1.0, "max_ti": 0.45}
 LOSSES = {"absent": 0.03, "low": 0.03, "low_range": (40.0, 79.0)}
 #: The lidar logger's local time zone and stamp.
 LOCAL_ZONE, LOCAL_OFFSET = "+01:00", pd.Timedelta(hours=1)
+#: What :func:`make_records` keeps for a record whose turbulence box would be larger
+#: than uq allows (:data:`uq.constants.MAX_BOX_CELLS`: a fast wind over a high sea, whose
+#: motion widens the box): not made, its row left empty in the lidar's table (a record
+#: the logger lost).
+TOO_LARGE = -1.0
 #: The lidar's standard deviation is over N - DDOF scans; the record's true TI is on the
 #: same convention (its expected variance over N - 1 scans: the square of the mast's TI).
 DDOF = 1
@@ -178,9 +185,14 @@ def make_records(lidar, table, stretch, done=None, report=None, part=(0, 1)):
             if table[f"made_{h:g}"].iloc[i] and not np.isfinite(out[f"mean_{h:g}"].iloc[i])]
     for count, (i, j, h) in enumerate(jobs):
         row = table.iloc[i]
-        mean, std = lidar_record(lidar, h, row[f"speed_{h:g}"], row[f"direction_{h:g}"],
-                                 row[f"ti_{h:g}"], row["hs"], row["tp"],
-                                 record_stream(stretch.seed, i, j))
+        try:
+            mean, std = lidar_record(lidar, h, row[f"speed_{h:g}"], row[f"direction_{h:g}"],
+                                     row[f"ti_{h:g}"], row["hs"], row["tp"],
+                                     record_stream(stretch.seed, i, j))
+        except ValueError as error:
+            if "turbulence box" not in str(error):
+                raise
+            mean, std = TOO_LARGE, TOO_LARGE         # the box uq may not make: lost
         out.iloc[i, out.columns.get_loc(f"mean_{h:g}")] = mean
         out.iloc[i, out.columns.get_loc(f"std_{h:g}")] = std
         if report is not None:
@@ -202,7 +214,8 @@ def write_files(table, records, folder):
     lidar = pd.DataFrame(index=table.index)
     for h in HEIGHTS:
         name = f"{h:g}"
-        made = table[f"made_{name}"].to_numpy()
+        made = table[f"made_{name}"].to_numpy() & (records[f"mean_{name}"].to_numpy()
+                                                  != TOO_LARGE)
         lidar[LIDAR_COLUMNS["speed"].format(h=name)] = np.where(made, records[f"mean_{name}"], np.nan)
         lidar[LIDAR_COLUMNS["std"].format(h=name)] = np.where(made, records[f"std_{name}"], np.nan)
         lidar[LIDAR_COLUMNS["direction"].format(h=name)] = np.where(
