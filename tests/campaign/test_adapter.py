@@ -75,7 +75,7 @@ def test_the_shift_is_the_second_order_of_a_quadrature_over_the_phase():
     components = adapter.components_of(np.array([0.15]), 0.05 * shape[None])
     angle = 2 * np.pi * np.arange(64) / 64
     phases = np.stack([np.cos(angle), np.sin(angle)], axis=-1)[:, None, :]
-    speed = adapter._speeds(settings, components, np.concatenate([phases, np.zeros((1, 1, 2))]))
+    speed = adapter.scan_speeds(settings, components, np.concatenate([phases, np.zeros((1, 1, 2))]))
     assert (speed[:-1].mean() - speed[-1]) / 0.05 ** 2 == pytest.approx(q, rel=0.02)
     assert q != 0
 

@@ -290,7 +290,7 @@ def components_of(frequency, amplitude):
                  for f, a in zip(np.asarray(frequency, float), amplitude))
 
 
-def _speeds(settings, components, phases):
+def scan_speeds(settings, components, phases):
     """Vh [m s-1] of the gate's scan under `components` with the unit phase vectors
     `phases` (n, K, 2) (the compiled model), every other input at its mean."""
     from uq.physics.measurement import measurement_model
@@ -338,7 +338,7 @@ def _jacobian(settings, frequency, amplitude):
     for sign, offset in ((1.0, 0), (-1.0, 1)):
         phases[4 * index + offset, index, 0] = sign * RESPONSE_STEP
         phases[4 * index + 2 + offset, index, 1] = sign * RESPONSE_STEP
-    speed = _speeds(settings, components, phases)
+    speed = scan_speeds(settings, components, phases)
     first = (speed[0::4] - speed[1::4]) / (2 * RESPONSE_STEP)
     second = (speed[2::4] - speed[3::4]) / (2 * RESPONSE_STEP)
     return first + 1j * second
@@ -365,7 +365,7 @@ def _shift(settings, frequency, amplitude):
     which = rows // p
     phases[rows, which, 0] = CURVATURE_SCALE * np.cos(angle[rows % p])
     phases[rows, which, 1] = CURVATURE_SCALE * np.sin(angle[rows % p])
-    speed = _speeds(settings, components, phases)           # last row: at rest
+    speed = scan_speeds(settings, components, phases)           # last row: at rest
     return (speed[:-1].reshape(count, p).mean(axis=1) - speed[-1]) / CURVATURE_SCALE ** 2
 
 

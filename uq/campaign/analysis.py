@@ -41,10 +41,10 @@ def analyse(config, client=None):
     started = clock.perf_counter()
     records = load_records(config.records)
     times, heights = records["time"].values, list(config.heights)
-    motions, outside, motion_off = _motion(config, times)
+    motions, outside, motion_off = motion_of(config, times)
     reference = None if config.reference is None else \
         load_reference(config.reference, times, heights)      # every file read first
-    flags = _input_flags(config, records, motions, outside)
+    flags = input_flags(config, records, motions, outside)
     usable = (flags & correction.INVALIDATING) == 0
     speed = records["speed"].values
     top = float(np.nanmax(np.where(usable, speed, np.nan))) if usable.any() else \
@@ -87,7 +87,7 @@ def analyse(config, client=None):
     return ds
 
 
-def _motion(config, times):
+def motion_of(config, times):
     """(MotionSet within the tables' band, the share of each record's motion power
     outside it, the motion file's rows off the records' grid)."""
     if config.motion is None:
@@ -97,7 +97,7 @@ def _motion(config, times):
     return found, np.maximum(outside, left), off
 
 
-def _input_flags(config, records, motions, outside):
+def input_flags(config, records, motions, outside):
     """Flags (time, height) of what the inputs say alone."""
     bits = correction.FLAG_BITS
     speed, std = records["speed"].values, records["std"].values
@@ -137,7 +137,7 @@ def correct_records(config, records, motions, tables, usable, submit=None):
     rows, columns = np.nonzero(usable)
     direction = record_directions(config, records, tables)
     speed, std = records["speed"].values, records["std"].values
-    run = surrogate._runner(submit)
+    run = surrogate.runner(submit)
     tasks = []
     for start in range(0, rows.size, CAMPAIGN_CHUNK_RECORDS):
         r, c = rows[start:start + CAMPAIGN_CHUNK_RECORDS], columns[start:start + CAMPAIGN_CHUNK_RECORDS]
@@ -147,7 +147,7 @@ def correct_records(config, records, motions, tables, usable, submit=None):
                          config.motion_u))
     out = {}
     for start, task in zip(range(0, rows.size, CAMPAIGN_CHUNK_RECORDS), tasks):
-        part = surrogate._result(task)
+        part = surrogate.result(task)
         r, c = rows[start:start + CAMPAIGN_CHUNK_RECORDS], columns[start:start + CAMPAIGN_CHUNK_RECORDS]
         for name, values in part.items():
             if name not in out:

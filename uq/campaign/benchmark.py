@@ -83,8 +83,8 @@ def direct_against_fast(config_path, count=12, seed=0):
     config = load_campaign_config(config_path)
     from uq.campaign.recordsfile import load_records
     records = load_records(config.records)
-    motions, outside, _ = analysis._motion(config, records["time"].values)
-    flags = analysis._input_flags(config, records, motions, outside)
+    motions, outside, _ = analysis.motion_of(config, records["time"].values)
+    flags = analysis.input_flags(config, records, motions, outside)
     usable = (flags & correction.INVALIDATING) == 0
     rows, columns = np.nonzero(usable)
     pick = np.random.default_rng(seed).choice(rows.size, size=min(count, rows.size),

@@ -154,7 +154,7 @@ def build_tables(lidar, heights, scales, turbulence, record_duration, speed_rang
     heading = float(lidar["ship"]["heading"])
     speeds = speed_nodes(*speed_range)
     motion_speeds = speed_nodes(*speed_range, MOTION_SPEEDS)
-    run = _runner(submit)
+    run = runner(submit)
     spectral = [[run(spectral_node, lidar, heights, scales, turbulence, record_duration, u,
                      heading + np.degrees(t)) for t in periodic_nodes(SPECTRAL_DIRECTIONS)]
                 for u in speeds]
@@ -163,8 +163,8 @@ def build_tables(lidar, heights, scales, turbulence, record_duration, speed_rang
                     heading + np.degrees(t), shapes, *grids)
                 for t in periodic_nodes(MOTION_DIRECTIONS)] for u in motion_speeds]
               for h, s in zip(heights, scales)]
-    spectral = np.array([[_result(task) for task in row] for row in spectral])  # (u, t, 3, h)
-    motion = [[[_result(task) for task in row] for row in rows] for rows in motion]
+    spectral = np.array([[result(task) for task in row] for row in spectral])  # (u, t, 3, h)
+    motion = [[[result(task) for task in row] for row in rows] for rows in motion]
     probe = adapter.gate_settings(lidar, heights[:1], {**turbulence,
                                                        "length_scale": scales[0]},
                                   record_duration)
@@ -182,13 +182,15 @@ def build_tables(lidar, heights, scales, turbulence, record_duration, speed_rang
         record_duration=float(record_duration))
 
 
-def _runner(submit):
+def runner(submit):
+    """`(function, *args) -> task` of a dask client's `submit`, or of a call here."""
     if submit is None:
         return lambda function, *args: function(*args)
     return submit
 
 
-def _result(task):
+def result(task):
+    """A task's value (a dask future's result, or the value itself)."""
     return task.result() if hasattr(task, "result") else task
 
 
@@ -274,13 +276,13 @@ def spectral_errors(tables, lidar, scales, turbulence, submit=None):
     """Largest relative error of the tables' F, as that of the TI it corrects (``|sqrt(F_
     table / F_direct) - 1|``), and of the spread, over the check points and heights,
     against the spectral path run there (:func:`spectral_node`)."""
-    run = _runner(submit)
+    run = runner(submit)
     points = check_points(tables)
     direct = [run(spectral_node, lidar, list(tables.heights), scales, turbulence,
                   tables.record_duration, u, d) for u, d in points]
     ti, spread = 0.0, 0.0
     for (u, d), task in zip(points, direct):
-        value = _result(task)
+        value = result(task)
         for i in range(len(tables.heights)):
             f, s, _ = spectral_at(tables, np.array([i]), np.array([u]), np.array([d]))
             ti = max(ti, abs(float(np.sqrt(f[0] / value[0, i])) - 1.0))
