@@ -101,7 +101,7 @@ def input_flags(config, records, motions, outside):
     """Flags (time, height) of what the inputs say alone."""
     bits = correction.FLAG_BITS
     speed, std = records["speed"].values, records["std"].values
-    present = np.isfinite(speed) & np.isfinite(std)
+    present = np.isfinite(speed) & np.isfinite(std) & np.isfinite(records["direction"].values)
     flags = np.where(~present, bits["missing"], 0)
     flags |= np.where(present & (records["availability"].values
                                  < config.records.minimum_availability),

@@ -274,9 +274,9 @@ def _records(check, raw, base):
         value = check.number(height, where, low=0.0, low_open=True)
         check.mapping(columns, where)
         check.keys(columns, where, RECORD_COLUMNS)
-        check.required(columns, where, ("speed", "std"), "allowed: the columns of the mean "
-                       "speed and its standard deviation (direction and availability "
-                       "optional)")
+        check.required(columns, where, ("speed", "std", "direction"), "allowed: the columns "
+                       "of the mean speed, its standard deviation and the direction "
+                       "(availability optional)")
         heights[value] = {name: check.text(columns[name], f"{where}.{name}")
                           for name in RECORD_COLUMNS if columns.get(name) is not None}
     units = _units(check, raw.get("units") or {}, f"{key}.units",

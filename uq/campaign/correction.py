@@ -67,7 +67,8 @@ CLAUSE8_DIGITS = 1
 
 #: The records' flags (bit, name, meaning, whether the record's values are NaN).
 FLAGS = (
-    (1, "missing", "no record, or its speed or standard deviation missing", True),
+    (1, "missing", "no record, or its speed, standard deviation or direction missing",
+     True),
     (2, "low_availability", "availability below the configured minimum", True),
     (4, "low_speed", "mean speed below the configured minimum (no frozen-turbulence "
      "record)", True),

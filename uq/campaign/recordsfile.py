@@ -173,8 +173,8 @@ def load_records(spec):
         columns = []
         for h in heights:
             column = spec.heights[h].get(name)
-            if column is None:
-                columns.append(np.full(len(table), np.nan if name != "availability" else 1.0))
+            if column is None:                   # no availability given: every record's
+                columns.append(np.full(len(table), 1.0))
                 continue
             key = f"{spec.table.key}.heights.{h:g}.{name}"
             values, bad = numbers(table, column, source, key, factors[name])
