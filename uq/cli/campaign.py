@@ -5,7 +5,7 @@ from uq.cli.common import EXIT_OK
 def add_parser(commands):
     campaign = commands.add_parser(
         "campaign", help="correct a floating lidar's ten-minute records for the platform's "
-        "motion and the lidar's filtering: each record's TI with its uncertainty and 95 % "
+        "motion and the lidar's filtering: each record's TI with its uncertainty and 95 %% "
         "interval, the mean speed, per-bin errors against a reference, and a report")
     campaign.add_argument("config", help="campaign configuration (YAML with a 'campaign' "
                           "section), or the name of a shipped one, e.g. campaign_buoy")
