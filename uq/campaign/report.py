@@ -68,11 +68,12 @@ def _height_blocks(ds):
     for h in ds["height"].values:
         d = ds.sel(height=h)
         keep = np.isfinite(d["turbulence_intensity_corrected"].values)
-        mean = lambda name, scale=PERCENT: _cell(np.mean(d[name].values[keep])  # noqa: E731
-                                                 if keep.any() else np.nan, scale, 2)
+        def mean(name, scale=PERCENT, digits=2):
+            return _cell(np.mean(d[name].values[keep]) if keep.any() else np.nan, scale,
+                         digits)
         row = [f"{h:g}", int(keep.sum()), mean("turbulence_intensity_measured"),
                mean("turbulence_intensity_corrected"), mean("motion_turbulence_intensity"),
-               mean("lidar_filtering_factor", 1.0), mean("wind_speed_motion_bias", 1.0)]
+               mean("lidar_filtering_factor", 1.0), mean("wind_speed_motion_bias", 1.0, 3)]
         if "coverage_share" in ds:
             row += [f"{int(d['coverage_n_covered'])}/{int(d['coverage_n_records'])} = "
                     f"{_cell(d['coverage_share'], PERCENT, 1)} %",
