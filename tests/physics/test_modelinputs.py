@@ -228,7 +228,7 @@ def test_the_compiled_paths_fall_backs(model, kind, outputs, errors, reason, cap
 
 
 def test_adding_an_input_is_one_row_plus_its_physics(monkeypatch):
-    """The README's worked example: a radial-velocity bias of the lidar, one draw per
+    """The guide's worked example (docs/contributing.md): a radial-velocity bias of the lidar, one draw per
     scan. One row makes it a scenario key with its unit and budget label, an engine input
     the compiled model declines; the declaration-driven sensitivity check then fails until
     its physics is in the numpy model, and passes after."""

@@ -175,10 +175,10 @@ def test_lidar_height_error_budget_is_the_power_law_slope():
     assert float(budget) == pytest.approx((0.2 * speed / 120.0 * 0.5) ** 2, rel=1e-6)
 
 
-# --- README "Domain of validity": with `ins.correlation: beam`, is the paper's model the
-# physical GUM to first order? An independent GUM of the point-wise corrected physical
-# model (written out here from its definition; central differences, not complex step),
-# issue 16, bug 6.
+# --- the guide's "Domain of validity" (docs/use-cases/validate-gum.md): with
+# `ins.correlation: beam`, is the paper's model the physical GUM to first order? An
+# independent GUM of the point-wise corrected physical model (written out here from its
+# definition; central differences, not complex step), issue 16, bug 6.
 
 #: Step of the central differences [rad or m s-1]: truncation ~h^2 and rounding
 #: ~1e-16 / h relative both stay below 1e-9 (measured 1e-10 to 1e-9).
