@@ -20,9 +20,8 @@ made by uq's own Monte Carlo records.
   Its mean speed and standard deviation (``ddof`` 1) of the scans are the record's. The
   lidar's table is written as a logger writes it: its own column names, local time
   (UTC+01:00) stamped at the period's end, an availability per height; some records
-  lost (rows absent), some with a low availability, and those whose turbulence box would
-  exceed uq's limit of cells (a fast wind over a high sea: the motion widens the box)
-  left empty.
+  lost (rows absent), some with a low availability, and those uq's Monte Carlo records
+  may not make left empty (:data:`NOT_MADE`).
 
 Each record and height has its own random stream (:func:`record_stream`), so one record
 can be made again alone (the tests do, against the shipped table).
@@ -62,11 +61,13 @@ MADE = {"min_speed": 1.0, "max_ti": 0.45}
 LOSSES = {"absent": 0.03, "low": 0.03, "low_range": (40.0, 79.0)}
 #: The lidar logger's local time zone and stamp.
 LOCAL_ZONE, LOCAL_OFFSET = "+01:00", pd.Timedelta(hours=1)
-#: What :func:`make_records` keeps for a record whose turbulence box would be larger
-#: than uq allows (:data:`uq.constants.MAX_BOX_CELLS`: a fast wind over a high sea, whose
-#: motion widens the box): not made, its row left empty in the lidar's table (a record
-#: the logger lost).
-TOO_LARGE = -1.0
+#: What :func:`make_records` keeps for a record uq's Monte Carlo records may not make:
+#: a turbulence box larger than uq allows (:data:`uq.constants.MAX_BOX_CELLS`: a fast
+#: wind over a high sea, whose motion widens the box) or a field more turbulent than its
+#: limit (:data:`uq.constants.MAX_TURBULENCE_INTENSITY`: a gusty record at a low speed,
+#: whose ten-minute high-pass leaves a small share of the field's variance). Not made,
+#: its row is left empty in the lidar's table (a record the logger lost).
+NOT_MADE = -1.0
 #: The lidar's standard deviation is over N - DDOF scans; the record's true TI is on the
 #: same convention (its expected variance over N - 1 scans: the square of the mast's TI).
 DDOF = 1
@@ -189,10 +190,10 @@ def make_records(lidar, table, stretch, done=None, report=None, part=(0, 1)):
             mean, std = lidar_record(lidar, h, row[f"speed_{h:g}"], row[f"direction_{h:g}"],
                                      row[f"ti_{h:g}"], row["hs"], row["tp"],
                                      record_stream(stretch.seed, i, j))
-        except ValueError as error:
-            if "turbulence box" not in str(error):
+        except ValueError as error:       # ScenarioError is one: the field's intensity
+            if "turbulence box" not in str(error) and "turbulence.intensity" not in str(error):
                 raise
-            mean, std = TOO_LARGE, TOO_LARGE         # the box uq may not make: lost
+            mean, std = NOT_MADE, NOT_MADE           # beyond what uq may make: lost
         out.iloc[i, out.columns.get_loc(f"mean_{h:g}")] = mean
         out.iloc[i, out.columns.get_loc(f"std_{h:g}")] = std
         if report is not None:
@@ -215,7 +216,7 @@ def write_files(table, records, folder):
     for h in HEIGHTS:
         name = f"{h:g}"
         made = table[f"made_{name}"].to_numpy() & (records[f"mean_{name}"].to_numpy()
-                                                  != TOO_LARGE)
+                                                  != NOT_MADE)
         lidar[LIDAR_COLUMNS["speed"].format(h=name)] = np.where(made, records[f"mean_{name}"], np.nan)
         lidar[LIDAR_COLUMNS["std"].format(h=name)] = np.where(made, records[f"std_{name}"], np.nan)
         lidar[LIDAR_COLUMNS["direction"].format(h=name)] = np.where(
