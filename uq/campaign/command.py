@@ -68,7 +68,8 @@ def write_folder(ds, folder, config):
                       "with 2u, the measured's as predicted) and RMSE")]
     top = float(ds["height"].max())
     drawings.append(("time_series", lambda d: figures.plot_time_series(d, top),
-                     f"Turbulence intensity at {top:g} m over the campaign"))
+                     f"Turbulence intensity at {top:g} m over the campaign (the "
+                     "reference at the records corrected)"))
     shown = {}
     for stem, draw, caption in drawings:
         fig = draw(ds)

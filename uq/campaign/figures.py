@@ -94,7 +94,7 @@ def plot_bins(ds):
 
 def plot_time_series(ds, height):
     """TI at `height` over the campaign: measured, corrected with its interval, the
-    reference, and the motion's TI increment."""
+    reference (at the records corrected), and the motion's TI increment."""
     import matplotlib.pyplot as plt
     d = ds.sel(height=height)
     fig, ax = plt.subplots(figsize=(11, 3.8), constrained_layout=True)
@@ -106,9 +106,10 @@ def plot_time_series(ds, height):
             lw=0.8, label="measured")
     ax.plot(time, d["turbulence_intensity_corrected"].values * PERCENT, "-", color=CORRECTED,
             lw=0.9, label="corrected")
-    if "turbulence_intensity_reference" in d:
-        ax.plot(time, d["turbulence_intensity_reference"].values * PERCENT, "-",
-                color=REFERENCE, lw=0.8, label="reference")
+    if "turbulence_intensity_reference" in d:             # where the lidar's is corrected
+        corrected = np.isfinite(d["turbulence_intensity_corrected"].values)
+        ax.plot(time, np.where(corrected, d["turbulence_intensity_reference"].values, np.nan)
+                * PERCENT, "-", color=REFERENCE, lw=0.8, label="reference")
     ax.plot(time, d["motion_turbulence_intensity"].values * PERCENT, "-", color=PREDICTED,
             lw=0.8, label="motion's TI increment")
     ax.set(xlabel="time (UTC)", ylabel="TI [%]", title=f"Turbulence intensity at {height:g} m",
