@@ -165,7 +165,8 @@ RESULT_NAMES = ("wind_speed_corrected", "turbulence_intensity_measured",
                 "turbulence_intensity_corrected", "turbulence_intensity_corrected_u",
                 "turbulence_intensity_corrected_low", "turbulence_intensity_corrected_high",
                 "variance_corrected", "lidar_filtering_factor", "record_variance_spread",
-                "motion_variance", "motion_u", "wind_speed_motion_bias", "scan_noise_variance")
+                "motion_variance", "motion_u", "motion_cross", "wind_speed_motion_bias",
+                "scan_noise_variance")
 
 
 def correct_chunk(tables, height_index, speed, std, direction, motions, filtering, ddof,
@@ -175,9 +176,10 @@ def correct_chunk(tables, height_index, speed, std, direction, motions, filterin
     out = correction.correct(speed, std, terms["filtering"], terms["spread"],
                              terms["motion_variance"], terms["motion_bias"],
                              terms["noise_variance"], tables.n_scans, ddof, coverage,
-                             filtering_u, motion_u)
+                             filtering_u, motion_u, terms["motion_cross"])
     out.update(lidar_filtering_factor=terms["filtering"], record_variance_spread=terms["spread"],
                motion_variance=terms["motion_variance"], motion_u=terms["motion_u"],
+               motion_cross=terms["motion_cross"],
                wind_speed_motion_bias=terms["motion_bias"],
                scan_noise_variance=terms["noise_variance"])
     return out
@@ -225,7 +227,8 @@ def _predicted(config, ds, tables):
                                                     * u_c) ** 2 * (n - ddof) / n
     noise = ds["scan_noise_variance"].values
     mean = lidar + ds["motion_variance"].values + (n - 1.0) / n * noise
-    var = spectra.variance_of_variance(lidar, ds["record_variance_spread"].values, noise, n)
+    var = spectra.variance_of_variance(lidar, ds["record_variance_spread"].values, noise, n,
+                                       ds["motion_cross"].values, ds["motion_variance"].values)
     with np.errstate(invalid="ignore", divide="ignore"):
         dof = spectra.degrees_of_freedom(mean, var)
         root = np.sqrt(2.0 / dof) * np.exp(special.gammaln((dof + 1) / 2) - special.gammaln(dof / 2))

@@ -27,7 +27,8 @@ a record without motion, filtering or scan errors is unchanged (the identity).
 
 Interval. The turbulence's and the noise's part of s^2 is distributed as a scaled
 chi-square (:mod:`uq.campaign.spectra`: ``x = s^2 - V_m ~ E chi2_nu / nu`` with ``E = F V
-+ (N-1)/N sigma^2`` and nu from E and ``var(s^2)``, which both depend on V). The interval
++ (N-1)/N sigma^2`` and nu from E and ``var(s^2)``, which both depend on V; the variance
+holds the motion's cross terms with the turbulence and the scan errors). The interval
 of V holds every V under which the observed x lies within the central ``p`` of its
 distribution (Neyman's construction: it covers the true V with probability p, as far
 as the chi-square holds), found by a fixed-point iteration on each end; the relative
@@ -102,25 +103,29 @@ def chi_square_quantile(probability, dof):
     return 2.0 * special.gammaincinv(np.asarray(dof, float) / 2.0, probability) / dof
 
 
-def _distribution(lidar_variance, noise_part, spread, noise_variance, n_scans):
-    """(E, nu) of x under the lidar variance F V (arrays)."""
+def _distribution(lidar_variance, noise_part, spread, noise_variance, n_scans, motion=(0, 0)):
+    """(E, nu) of x under the lidar variance F V (arrays); `motion`: (the motion's cross
+    term sum V_k q_k, its record variance) [m2 s-2]."""
     mean = lidar_variance + noise_part
-    var = spectra.variance_of_variance(lidar_variance, spread, noise_variance, n_scans)
+    var = spectra.variance_of_variance(lidar_variance, spread, noise_variance, n_scans,
+                                       *motion)
     with np.errstate(divide="ignore", invalid="ignore"):
         dof = np.where(var > 0, spectra.degrees_of_freedom(mean, var), np.inf)
     return mean, dof
 
 
-def interval_end(x, noise_part, spread, noise_variance, n_scans, probability):
+def interval_end(x, noise_part, spread, noise_variance, n_scans, probability, motion=(0, 0)):
     """The lidar variance F V [m2 s-2] under which x is the `probability` quantile of
     its distribution (fixed point of ``FV = x / q(nu(FV)) - noise``), NaN where there
-    is none above 0 (x below that quantile at F V = 0)."""
+    is none above 0 (x below that quantile at F V = 0); `motion` as
+    :func:`_distribution`'s."""
     x = np.asarray(x, float)
-    zero_mean, zero_dof = _distribution(0.0 * x, noise_part, spread, noise_variance, n_scans)
+    zero_mean, zero_dof = _distribution(0.0 * x, noise_part, spread, noise_variance, n_scans,
+                                        motion)
     below = x < zero_mean * _quantile(probability, zero_dof)
     value = np.maximum(x - noise_part, 0.0)
     for _ in range(INTERVAL_ITERATIONS):
-        _, dof = _distribution(value, noise_part, spread, noise_variance, n_scans)
+        _, dof = _distribution(value, noise_part, spread, noise_variance, n_scans, motion)
         new = np.maximum(x / _quantile(probability, dof) - noise_part, 0.0)
         done = np.all(np.abs(new - value) <= INTERVAL_TOLERANCE * np.maximum(new, 1e-300))
         value = new
@@ -139,7 +144,8 @@ def _quantile(probability, dof):
 
 
 def correct(speed, std, filtering, spread, motion_variance, motion_bias, noise_variance,
-            n_scans, ddof=1, coverage=COVERAGE_PROBABILITY, filtering_u=0.0, motion_u=0.0):
+            n_scans, ddof=1, coverage=COVERAGE_PROBABILITY, filtering_u=0.0, motion_u=0.0,
+            motion_cross=0.0):
     """Correct records (arrays (n,), module docstring).
 
     Parameters
@@ -157,6 +163,9 @@ def correct(speed, std, filtering, spread, motion_variance, motion_bias, noise_v
         p of the interval.
     filtering_u, motion_u : float
         Relative standard uncertainties of F and of V_m [1].
+    motion_cross : ndarray
+        The motion's cross term with the turbulence ``sum_k V_k q(f_k)`` [m2 s-2]
+        (:mod:`uq.campaign.spectra`).
 
     Returns
     -------
@@ -171,8 +180,10 @@ def correct(speed, std, filtering, spread, motion_variance, motion_bias, noise_v
     lidar = x - noise_part
     variance = lidar / filtering
     tail = (1.0 - coverage) / 2.0
-    high = interval_end(x, noise_part, spread, noise_variance, n_scans, tail) / filtering
-    low = interval_end(x, noise_part, spread, noise_variance, n_scans, 1.0 - tail)
+    motion = (motion_cross, motion_variance)
+    high = interval_end(x, noise_part, spread, noise_variance, n_scans, tail, motion) / \
+        filtering
+    low = interval_end(x, noise_part, spread, noise_variance, n_scans, 1.0 - tail, motion)
     low = np.where(np.isnan(low) & np.isfinite(high), 0.0, low) / filtering
     estimate = np.maximum(variance, 0.0)
     k = special.ndtri(1.0 - tail)
@@ -180,7 +191,7 @@ def correct(speed, std, filtering, spread, motion_variance, motion_bias, noise_v
     low = np.maximum(estimate - np.hypot(estimate - np.minimum(low, estimate), k * extra), 0.0)
     high = estimate + np.hypot(np.maximum(high, estimate) - estimate, k * extra)
     spread_var = spectra.variance_of_variance(np.maximum(lidar, 0.0), spread, noise_variance,
-                                              n_scans)
+                                              n_scans, motion_cross, motion_variance)
     u_variance = np.sqrt(spread_var / filtering ** 2 + extra ** 2)
     consistent = np.isfinite(high)
     with np.errstate(invalid="ignore", divide="ignore"):

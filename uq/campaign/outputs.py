@@ -50,6 +50,9 @@ METADATA = {
                         "horizontal speed (GUM, the record's high-pass)", None),
     "motion_u": ("m s-1", "the platform motion's standard uncertainty of one scan's "
                  "horizontal speed (GUM)", None),
+    "motion_cross": ("m2 s-2", "the motion's cross term with the turbulence in the "
+                     "spread of the record's variance, sum of its harmonics' variances "
+                     "times the turbulence's cross response", None),
     "motion_turbulence_intensity": ("1", "the motion's turbulence-intensity increment, "
                                     "sqrt(motion variance) over the corrected mean speed",
                                     None),

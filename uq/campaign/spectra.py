@@ -21,6 +21,15 @@ mean ``s^2 = (1/N) sum (u_m - mean)^2`` (Eq. 3 of :mod:`uq.physics.lidarspectral
   the dimensionless ``spread = tr((P C_t)^2) / (N <s^2>_t)^2`` of the turbulence alone
   (its ``2 spread`` is the squared coefficient of variation of s^2; it does not depend
   on the intensity).
+* the platform's motion adds to each scan an error b independent of the turbulence,
+  harmonics of random phase of covariance ``C_b = sum_k V_k cos(w_k (m - n) T_s)`` (V_k
+  a harmonic's variance in one scan). The cross terms of ``s^2`` are exact whatever b's
+  distribution: ``var(2 a^T P b / N) = 4 tr(P C_t P C_b) / N^2 = (4 / N) <s^2>_t sum_k
+  V_k q(f_k)`` with the turbulence's *cross response* ``q(f) = sum_mn (P C_t P)_mn cos(2
+  pi f (m - n) T_s) / tr(P C_t)`` (:func:`cross_response`; 1 for white turbulence), and
+  ``4 sigma^2 V_m / N`` with the scan errors. The motion's own ``b^T P b`` is left out:
+  harmonics of random phase a few hundredths of a hertz apart keep their sample variance
+  over ten minutes (Gaussian motion would add ``2 tr((P C_b)^2) / N^2``).
 
 The distribution of s^2 (a weighted sum of chi-square variables) is taken as a scaled
 chi-square with the same mean and variance (Satterthwaite 1946; Box 1954):
@@ -133,14 +142,47 @@ def toeplitz_spread(first):
     return float((squares - 2.0 * np.sum(rows ** 2) / n + total ** 2 / n ** 2) / trace ** 2)
 
 
-def variance_of_variance(lidar_variance, spread, noise_variance, n_scans):
+def variance_of_variance(lidar_variance, spread, noise_variance, n_scans, motion_cross=0.0,
+                         motion_variance=0.0):
     """``var(s^2)`` [m4 s-4] of a record whose turbulence has the expected s^2
     `lidar_variance` and the :func:`variance_spread` `spread`, with white per-scan errors
-    of variance `noise_variance` (module docstring); arrays broadcast."""
+    of variance `noise_variance`, and the motion's cross terms (module docstring):
+    `motion_cross` ``sum_k V_k q(f_k)`` [m2 s-2], `motion_variance` its record variance
+    [m2 s-2]; arrays broadcast."""
     n = np.asarray(n_scans, float)
     t1 = n * lidar_variance                                  # tr(P C_t) = N <s^2>_t
     t2 = spread * t1 ** 2
-    return 2.0 / n ** 2 * (t2 + 2.0 * noise_variance * t1 + (n - 1.0) * noise_variance ** 2)
+    return (2.0 / n ** 2 * (t2 + 2.0 * noise_variance * t1 + (n - 1.0) * noise_variance ** 2)
+            + 4.0 / n * (lidar_variance * motion_cross + noise_variance * motion_variance))
+
+
+def cross_response(covariance, scan_period, frequency):
+    """The cross response q(f) [1] (module docstring) of the Toeplitz C of first row
+    `covariance` (N,) [m2 s-2] at `frequency` [Hz] (any shape), in O(N) a frequency:
+    ``sum_mn (PCP)_mn cos(w (m - n)) = sum C cos - (2 / N) Re(conj(E) sum_m r_m e^(i w m))
+    + S |E|^2 / N^2``, E = sum_m e^(i w m), r the row sums, S their sum."""
+    first = np.asarray(covariance, float)
+    n = first.size
+    lags = np.arange(n)
+    cumulative = np.cumsum(first)
+    rows = cumulative + cumulative[::-1] - first[0]
+    total = rows.sum()
+    trace = n * first[0] - total / n
+    omega = 2.0 * np.pi * np.asarray(frequency, float)[..., None] * scan_period
+    phase = np.exp(1j * omega * lags)                               # (..., N)
+    toeplitz_sum = n * first[0] + 2.0 * np.sum((n - lags[1:]) * first[1:]
+                                               * np.cos(omega * lags[1:]), axis=-1)
+    sums = phase.sum(axis=-1)
+    mixed = np.real(np.conj(sums) * (phase @ rows))
+    return (toeplitz_sum - 2.0 * mixed / n + total * np.abs(sums) ** 2 / n ** 2) / trace
+
+
+def folded(frequency, scan_period):
+    """`frequency` [Hz] folded into [0, 1 / (2 T_s)]: the cross response is even and
+    periodic with the scan rate (scans sample the motion once a scan)."""
+    rate = 1.0 / scan_period
+    f = np.mod(np.asarray(frequency, float), rate)
+    return np.minimum(f, rate - f)
 
 
 def degrees_of_freedom(mean, variance):

@@ -81,10 +81,12 @@ class Tables:
     filtering: np.ndarray              # F (n_h, n_u, n_theta) [1]
     spread: np.ndarray                 # (n_h, n_u, n_theta) [1]
     point_fraction: np.ndarray         # (n_h, n_u, n_theta) [1]
+    cross: np.ndarray                  # cross response q (n_h, n_u, n_theta, n_q) [1]
     motion_speeds: np.ndarray          # (3,) [m s-1]
     response: np.ndarray               # y (n_h, 3, n_m, n_f, S) [m s-1 per amplitude]
     curvature: np.ndarray              # g (n_h, 3, n_m, n_g, S) [m s-1 per amplitude^2]
     noise: np.ndarray                  # per-scan noise variance (n_h, 3, n_m) [m2 s-2]
+    cross_step: float                  # [Hz]: q's frequencies 0, step, ... 1 / (2 T_s)
     response_step: float               # [Hz]: the response's frequencies step, 2 step, ...
     curvature_step: float              # [Hz]: the curvature's
     n_scans: int
@@ -105,11 +107,18 @@ def speed_nodes(low, high, count=SPEED_NODES):
     return np.geomspace(low, high, count)
 
 
+def cross_frequencies(scan_period, n_scans):
+    """The cross response's frequencies [Hz]: 0 to half the scan rate, four a 1 / T (the
+    response is smooth on the scale of the record's resolution 1 / T)."""
+    return np.linspace(0.0, 0.5 / scan_period, 2 * n_scans + 1)
+
+
 def spectral_node(lidar, heights, scales, turbulence, record_duration, speed, direction):
-    """F, spread and point fraction of each height, shape (3, n_h), at one node; the
+    """(F, spread and point fraction of each height, shape (3, n_h); the cross response
+    of each height on :func:`cross_frequencies`, shape (n_h, n_q)) at one node; the
     heights grouped by their length scale `scales` [m] (one spectral path per group: the
     field is homogeneous, so a gate's variances do not depend on the reference point)."""
-    out = np.zeros((3, len(heights)))
+    out, cross = np.zeros((3, len(heights))), None
     for scale in sorted(set(scales)):
         group = [i for i, s in enumerate(scales) if s == scale]
         settings = adapter.gate_settings(lidar, [heights[i] for i in group],
@@ -117,11 +126,15 @@ def spectral_node(lidar, heights, scales, turbulence, record_duration, speed, di
                                          record_duration, speed, direction)
         terms = adapter.spectral_terms(settings)
         n = adapter.scans_per_record(settings)
+        grid = cross_frequencies(terms.scan_period, n)
+        cross = np.zeros((len(heights), grid.size)) if cross is None else cross
         for column, i in enumerate(group):
             gate = terms.gate(column)
-            out[:, i] = (spectra.filtering_factor(gate), spectra.variance_spread(gate, n),
+            covariance = spectra.scan_covariance(gate, n)
+            out[:, i] = (spectra.filtering_factor(gate), spectra.toeplitz_spread(covariance),
                          spectra.point_fraction(gate))
-    return out
+            cross[i] = spectra.cross_response(covariance, terms.scan_period, grid)
+    return out, cross
 
 
 def motion_node(lidar, height, scale, turbulence, record_duration, speed, direction,
@@ -163,7 +176,9 @@ def build_tables(lidar, heights, scales, turbulence, record_duration, speed_rang
                     heading + np.degrees(t), shapes, *grids)
                 for t in periodic_nodes(MOTION_DIRECTIONS)] for u in motion_speeds]
               for h, s in zip(heights, scales)]
-    spectral = np.array([[result(task) for task in row] for row in spectral])  # (u, t, 3, h)
+    spectral = [[result(task) for task in row] for row in spectral]
+    cross = np.array([[node[1] for node in row] for row in spectral])       # (u, t, h, q)
+    spectral = np.array([[node[0] for node in row] for row in spectral])    # (u, t, 3, h)
     motion = [[[result(task) for task in row] for row in rows] for rows in motion]
     probe = adapter.gate_settings(lidar, heights[:1], {**turbulence,
                                                        "length_scale": scales[0]},
@@ -173,6 +188,8 @@ def build_tables(lidar, heights, scales, turbulence, record_duration, speed_rang
         filtering=np.moveaxis(spectral[:, :, 0], -1, 0),
         spread=np.moveaxis(spectral[:, :, 1], -1, 0),
         point_fraction=np.moveaxis(spectral[:, :, 2], -1, 0),
+        cross=np.moveaxis(cross, 2, 0),
+        cross_step=0.5 / adapter.scan_period(probe) / (cross.shape[-1] - 1),
         motion_speeds=motion_speeds,
         response=np.array([[[node[0] for node in row] for row in rows] for rows in motion]),
         curvature=np.array([[[node[1] for node in row] for row in rows] for rows in motion]),
@@ -254,6 +271,24 @@ def curvature_at(tables, height_index, speed, direction, frequency, shape):
                           frequency, shape)
 
 
+def cross_at(tables, height_index, speed, direction, frequency):
+    """The cross response q (n, K) [1] at the records' components (frequencies (n, K)
+    [Hz], folded into the scan's band), linear in frequency."""
+    speed = np.clip(np.asarray(speed, float), tables.speeds[0], tables.speeds[-1])
+    wu = log_lagrange_weights(speed, tables.speeds)                       # (n, u)
+    wt = periodic_weights(relative_angle(tables.heading, direction),
+                          tables.spectral_directions)                     # (n, t)
+    f = spectra.folded(frequency, tables.scan_period) / tables.cross_step
+    lower = np.clip(np.floor(f).astype(int), 0, tables.cross.shape[-1] - 2)
+    weight = f - lower
+    rows = np.asarray(height_index)[:, None]
+    out = 0.0
+    for index, w in ((lower, 1.0 - weight), (lower + 1, weight)):
+        picked = tables.cross[rows, :, :, index]                          # (n, K, u, t)
+        out = out + np.einsum("nkut,nu,nt->nk", picked, wu, wt) * w
+    return out
+
+
 def noise_at(tables, height_index, speed, direction):
     """Per-scan noise variance [m2 s-2] of records (n,)."""
     wu, wt = _motion_weights(tables, speed, direction, (0, 1, 2), NOISE_DEGREE)
@@ -282,7 +317,7 @@ def spectral_errors(tables, lidar, scales, turbulence, submit=None):
                   tables.record_duration, u, d) for u, d in points]
     ti, spread = 0.0, 0.0
     for (u, d), task in zip(points, direct):
-        value = result(task)
+        value = result(task)[0]
         for i in range(len(tables.heights)):
             f, s, _ = spectral_at(tables, np.array([i]), np.array([u]), np.array([d]))
             ti = max(ti, abs(float(np.sqrt(f[0] / value[0, i])) - 1.0))
