@@ -165,8 +165,8 @@ RESULT_NAMES = ("wind_speed_corrected", "turbulence_intensity_measured",
                 "turbulence_intensity_corrected", "turbulence_intensity_corrected_u",
                 "turbulence_intensity_corrected_low", "turbulence_intensity_corrected_high",
                 "variance_corrected", "lidar_filtering_factor", "record_variance_spread",
-                "motion_variance", "motion_u", "motion_cross", "wind_speed_motion_bias",
-                "scan_noise_variance")
+                "motion_variance", "motion_u", "motion_cross", "motion_phase",
+                "wind_speed_motion_bias", "scan_noise_variance")
 
 
 def correct_chunk(tables, height_index, speed, std, direction, motions, filtering, ddof,
@@ -176,10 +176,11 @@ def correct_chunk(tables, height_index, speed, std, direction, motions, filterin
     out = correction.correct(speed, std, terms["filtering"], terms["spread"],
                              terms["motion_variance"], terms["motion_bias"],
                              terms["noise_variance"], tables.n_scans, ddof, coverage,
-                             filtering_u, motion_u, terms["motion_cross"])
+                             filtering_u, motion_u, terms["motion_cross"],
+                             terms["motion_phase"])
     out.update(lidar_filtering_factor=terms["filtering"], record_variance_spread=terms["spread"],
                motion_variance=terms["motion_variance"], motion_u=terms["motion_u"],
-               motion_cross=terms["motion_cross"],
+               motion_cross=terms["motion_cross"], motion_phase=terms["motion_phase"],
                wind_speed_motion_bias=terms["motion_bias"],
                scan_noise_variance=terms["noise_variance"])
     return out
@@ -215,28 +216,15 @@ def _dataset(config, records, corrected, flags, tables):
 
 def _predicted(config, ds, tables):
     """The measured TI the model predicts from the reference's TI, and its standard
-    deviation from record to record: ``E[s_reported] / U`` with ``s^2 ~ E chi2_nu / nu``
-    (:mod:`uq.campaign.spectra`), E from Eq. 1 of :mod:`uq.campaign.correction` with the
-    reference's variance on the lidar's convention, ``V = (TI_ref U_c)^2 (N - ddof) /
-    N``; the standard deviation ``sqrt(E[s^2] - E[s]^2) / U``."""
-    from scipy import special
-    from uq.campaign import spectra
-    n, ddof = tables.n_scans, config.records.ddof
-    u_c = ds["wind_speed_corrected"].values
-    lidar = ds["lidar_filtering_factor"].values * (ds["turbulence_intensity_reference"].values
-                                                    * u_c) ** 2 * (n - ddof) / n
-    noise = ds["scan_noise_variance"].values
-    mean = lidar + ds["motion_variance"].values + (n - 1.0) / n * noise
-    var = spectra.variance_of_variance(lidar, ds["record_variance_spread"].values, noise, n,
-                                       ds["motion_cross"].values, ds["motion_variance"].values)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        dof = spectra.degrees_of_freedom(mean, var)
-        root = np.sqrt(2.0 / dof) * np.exp(special.gammaln((dof + 1) / 2) - special.gammaln(dof / 2))
-        root = np.where(np.isfinite(root), root, 1.0)
-        reported = mean * n / (n - ddof)                     # E[s_reported^2]
-        speed = ds["wind_speed_measured"].values
-        return (np.sqrt(reported) * root / speed,
-                np.sqrt(np.maximum(reported * (1.0 - root ** 2), 0.0)) / speed)
+    deviation from record to record (:func:`uq.campaign.correction.predicted_measured`,
+    at the corrected mean speed over the measured one)."""
+    mean, spread = correction.predicted_measured(
+        ds["turbulence_intensity_reference"].values, ds["wind_speed_corrected"].values,
+        ds["lidar_filtering_factor"].values, ds["record_variance_spread"].values,
+        ds["motion_variance"].values, ds["scan_noise_variance"].values, tables.n_scans,
+        config.records.ddof, ds["motion_cross"].values, ds["motion_phase"].values)
+    ratio = ds["wind_speed_corrected"].values / ds["wind_speed_measured"].values
+    return mean * ratio, spread * ratio
 
 
 def _bin_tables(config, ds):

@@ -115,7 +115,8 @@ def direct_against_fast(config_path, count=12, seed=0):
     ti = [correction.correct(speed[rows, columns], records["std"].values[rows, columns],
                              terms["filtering"], terms["spread"], terms["motion_variance"],
                              terms["motion_bias"], terms["noise_variance"], tables.n_scans,
-                             config.records.ddof, motion_cross=terms["motion_cross"]
+                             config.records.ddof, motion_cross=terms["motion_cross"],
+                             motion_phase=terms["motion_phase"]
                              )["turbulence_intensity_corrected"]
           for terms in (fast, direct)]
     both = np.isfinite(ti[0]) & np.isfinite(ti[1])

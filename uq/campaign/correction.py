@@ -25,13 +25,17 @@ scans; its variance is turned into (1) by ``(N - ddof) / N``, and the corrected 
 given back on the lidar's own convention, ``TI = sqrt(V N / (N - ddof)) / U_c``, so that
 a record without motion, filtering or scan errors is unchanged (the identity).
 
-Interval. The turbulence's and the noise's part of s^2 is distributed as a scaled
-chi-square (:mod:`uq.campaign.spectra`: ``x = s^2 - V_m ~ E chi2_nu / nu`` with ``E = F V
-+ (N-1)/N sigma^2`` and nu from E and ``var(s^2)``, which both depend on V; the variance
-holds the motion's cross terms with the turbulence and the scan errors). The interval
-of V holds every V under which the observed x lies within the central ``p`` of its
+Interval. ``x = s^2 - V_m`` has the mean ``E = F V + (N-1)/N sigma^2`` and the variance
+``var(s^2)`` of :mod:`uq.campaign.spectra` (the turbulence's and the scan errors', the
+motion's cross terms with them, the spread of the motion's own sample variance where its
+phases are unknown), both depending on V. The turbulence and the scan errors are a
+scaled chi-square (a Gaussian quadratic form, Satterthwaite's approximation), the
+motion's terms symmetric about zero; x is taken as the Pearson type III distribution of
+their sum's mean, variance and skewness (:func:`quantile`: the scaled chi-square where
+there is no motion, near the normal where the motion's terms dominate). The interval of
+V holds every V under which the observed x lies within the central ``p`` of its
 distribution (Neyman's construction: it covers the true V with probability p, as far
-as the chi-square holds), found by a fixed-point iteration on each end; the relative
+as that distribution holds), each end found by bisection; the relative
 standard uncertainties of F and of V_m that the configuration states widen each side
 in quadrature (at ``k = Phi^-1((1+p)/2)``). ``TI_low, TI_high = sqrt(V_low, V_high) / U_c``.
 A record whose x lies below the lower ``(1-p)/2`` quantile even at V = 0 (the motion
@@ -44,7 +48,9 @@ estimate, and ``u(TI) = u(V) / (2 U_c^2 TI_*)`` with ``TI_* = sqrt(max(V, u(V)))
 References
 ----------
 .. [1] Neyman, J. (1937). Outline of a theory of statistical estimation based on the
-   classical theory of probability. Phil. Trans. R. Soc. A 236, 333-380.
+   classical theory of probability. Phil. Trans. R. Soc. A 236, 333-380; Johnson, N. L.,
+   Kotz, S. and Balakrishnan, N. (1994). Continuous Univariate Distributions, vol. 1,
+   Wiley, Ch. 17 (the gamma distribution shifted and scaled: Pearson type III).
 .. [2] Sathe, A., Mann, J., Gottschall, J. and Courtney, M. S. (2011). J. Atmos. Oceanic
    Technol. 28, 853-868.
 .. [3] JCGM 101:2008, 7.9.2 (numerical tolerance) and clause 8.
@@ -55,11 +61,10 @@ from scipy import special
 from uq.campaign import spectra
 from uq.constants import COVERAGE_PROBABILITY
 
-#: Fixed-point iterations of each interval end [1]: nu changes slowly with V, so the
-#: iteration contracts quickly (1e-10 relative in ~10 steps on the tests' cases); the
-#: remaining step is checked against :data:`INTERVAL_TOLERANCE`.
+#: Steps of each interval end's bracketing and bisection [1] (60 halvings: 1e-18 of the
+#: bracket; the bisection stops at :data:`INTERVAL_TOLERANCE`).
 INTERVAL_ITERATIONS = 60
-#: Relative change of an interval end taken as converged [1].
+#: Relative width of an interval end's bracket taken as converged [1].
 INTERVAL_TOLERANCE = 1e-9
 #: Significant digits of the motion's u at which its clause-8 tolerance is read (JCGM
 #: 101 7.9.2 takes one or two): one, since a record's motion (a sea state and a flat
@@ -103,49 +108,91 @@ def chi_square_quantile(probability, dof):
     return 2.0 * special.gammaincinv(np.asarray(dof, float) / 2.0, probability) / dof
 
 
-def _distribution(lidar_variance, noise_part, spread, noise_variance, n_scans, motion=(0, 0)):
-    """(E, nu) of x under the lidar variance F V (arrays); `motion`: (the motion's cross
-    term sum V_k q_k, its record variance) [m2 s-2]."""
+def moments(lidar_variance, noise_part, spread, noise_variance, n_scans, motion=(0, 0, 0)):
+    """(mean, variance, skewness) of x under the lidar variance F V [m2 s-2] (arrays):
+    the turbulence and the scan errors a scaled chi-square (third cumulant ``2 var_t^2 /
+    E``), the motion's terms symmetric about zero; `motion`: (its cross term sum V_k
+    q_k [m2 s-2], its record variance [m2 s-2], the spread of its sample variance [m4
+    s-4]) (:mod:`uq.campaign.spectra`)."""
     mean = lidar_variance + noise_part
-    var = spectra.variance_of_variance(lidar_variance, spread, noise_variance, n_scans,
-                                       *motion)
+    alone = spectra.variance_of_variance(lidar_variance, spread, noise_variance, n_scans)
+    total = spectra.variance_of_variance(lidar_variance, spread, noise_variance, n_scans,
+                                         *motion)
     with np.errstate(divide="ignore", invalid="ignore"):
-        dof = np.where(var > 0, spectra.degrees_of_freedom(mean, var), np.inf)
-    return mean, dof
+        skew = np.where((total > 0) & (mean > 0), 2.0 * alone ** 2 / (mean * total ** 1.5),
+                        0.0)
+    return mean, total, skew
 
 
-def interval_end(x, noise_part, spread, noise_variance, n_scans, probability, motion=(0, 0)):
+#: Skewness below which :func:`quantile` takes the normal's [1] (a chi-square of 8e8
+#: degrees of freedom: its quantiles are the normal's to 1e-4 of sigma).
+SKEW_FLOOR = 1e-4
+
+
+def quantile(probability, mean, variance, skew):
+    """The `probability` quantile of the Pearson type III distribution of the given mean,
+    variance and skewness (a shifted, scaled chi-square of ``k = 8 / skew^2`` degrees of
+    freedom: ``mean + (sigma skew / 4) (chi2_k(p) - k)``); the normal's where the
+    skewness vanishes, the scaled chi-square's where the motion's terms do."""
+    sigma = np.sqrt(np.maximum(variance, 0.0))
+    normal = mean + sigma * special.ndtri(probability)
+    big = skew > SKEW_FLOOR
+    k = 8.0 / np.where(big, skew, 1.0) ** 2
+    with np.errstate(invalid="ignore", over="ignore"):
+        gamma = mean + sigma * np.where(big, skew, 0.0) / 4.0 * (
+            2.0 * special.gammaincinv(k / 2.0, probability) - k)
+    return np.where(big, gamma, normal)
+
+
+def interval_end(x, noise_part, spread, noise_variance, n_scans, probability,
+                 motion=(0, 0, 0)):
     """The lidar variance F V [m2 s-2] under which x is the `probability` quantile of
-    its distribution (fixed point of ``FV = x / q(nu(FV)) - noise``), NaN where there
-    is none above 0 (x below that quantile at F V = 0); `motion` as
-    :func:`_distribution`'s."""
+    its distribution (:func:`moments`, :func:`quantile`; the quantile grows with F V:
+    bisection), NaN where there is none at or above 0 (x below that quantile at F V =
+    0)."""
     x = np.asarray(x, float)
-    zero_mean, zero_dof = _distribution(0.0 * x, noise_part, spread, noise_variance, n_scans,
-                                        motion)
-    below = x < zero_mean * _quantile(probability, zero_dof)
-    value = np.maximum(x - noise_part, 0.0)
-    for _ in range(INTERVAL_ITERATIONS):
-        _, dof = _distribution(value, noise_part, spread, noise_variance, n_scans, motion)
-        new = np.maximum(x / _quantile(probability, dof) - noise_part, 0.0)
-        done = np.all(np.abs(new - value) <= INTERVAL_TOLERANCE * np.maximum(new, 1e-300))
-        value = new
-        if done:
+
+    def gap(value):
+        return quantile(probability, *moments(value, noise_part, spread, noise_variance,
+                                              n_scans, motion)) - x
+    below = gap(np.zeros_like(x)) > 0
+    low, high = np.zeros_like(x), np.maximum(np.abs(x), noise_part) + 1e-12
+    for _ in range(INTERVAL_ITERATIONS):           # bracket the root: double the upper end
+        short = ~below & (gap(high) < 0)
+        if not short.any():
             break
-    return np.where(below, np.nan, value)
+        high = np.where(short, 2.0 * high, high)
+    for _ in range(INTERVAL_ITERATIONS):
+        middle = (low + high) / 2.0
+        up = gap(middle) < 0
+        low, high = np.where(up, middle, low), np.where(up, high, middle)
+        if np.all(high - low <= INTERVAL_TOLERANCE * np.maximum(high, 1e-300)):
+            break
+    return np.where(below, np.nan, (low + high) / 2.0)
 
 
-def _quantile(probability, dof):
-    """chi2_nu(p) / nu, 1 for an infinite nu (no spread)."""
-    dof = np.asarray(dof, float)
-    finite = np.isfinite(dof) & (dof > 0)
+def predicted_measured(truth, speed, filtering, spread, motion_variance, noise_variance,
+                       n_scans, ddof=1, motion_cross=0.0, motion_phase=0.0):
+    """(mean, standard deviation) from record to record of the TI the lidar reports
+    (its standard deviation over N - ddof scans over its mean speed `speed`) for a field
+    of true TI `truth` (on the lidar's convention) at the corrected speed: s^2's mean and
+    variance from Eq. 1 and :mod:`uq.campaign.spectra`, and ``E[sqrt(X)] = sqrt(mu) (1 -
+    var / (8 mu^2))``, ``sd = sqrt(var) / (2 sqrt(mu))`` (the second-order delta method)."""
+    n = float(n_scans)
+    convention = n / (n - ddof)
+    lidar = filtering * (np.asarray(truth, float) * speed) ** 2 / convention
+    mean = lidar + motion_variance + (n - 1.0) / n * noise_variance
+    var = spectra.variance_of_variance(lidar, spread, noise_variance, n_scans, motion_cross,
+                                       motion_variance, motion_phase)
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(finite, chi_square_quantile(probability, np.where(finite, dof, 1.0)),
-                        1.0)
+        root = np.sqrt(mean * convention) * (1.0 - var / (8.0 * mean ** 2))
+        spread_of_root = np.sqrt(var * convention) / (2.0 * np.sqrt(mean))
+    return root / speed, spread_of_root / speed
 
 
 def correct(speed, std, filtering, spread, motion_variance, motion_bias, noise_variance,
             n_scans, ddof=1, coverage=COVERAGE_PROBABILITY, filtering_u=0.0, motion_u=0.0,
-            motion_cross=0.0):
+            motion_cross=0.0, motion_phase=0.0):
     """Correct records (arrays (n,), module docstring).
 
     Parameters
@@ -163,9 +210,9 @@ def correct(speed, std, filtering, spread, motion_variance, motion_bias, noise_v
         p of the interval.
     filtering_u, motion_u : float
         Relative standard uncertainties of F and of V_m [1].
-    motion_cross : ndarray
-        The motion's cross term with the turbulence ``sum_k V_k q(f_k)`` [m2 s-2]
-        (:mod:`uq.campaign.spectra`).
+    motion_cross, motion_phase : ndarray
+        The motion's cross term with the turbulence ``sum_k V_k q(f_k)`` [m2 s-2] and the
+        spread of its own sample variance [m4 s-4] (:mod:`uq.campaign.spectra`).
 
     Returns
     -------
@@ -180,7 +227,7 @@ def correct(speed, std, filtering, spread, motion_variance, motion_bias, noise_v
     lidar = x - noise_part
     variance = lidar / filtering
     tail = (1.0 - coverage) / 2.0
-    motion = (motion_cross, motion_variance)
+    motion = (motion_cross, motion_variance, motion_phase)
     high = interval_end(x, noise_part, spread, noise_variance, n_scans, tail, motion) / \
         filtering
     low = interval_end(x, noise_part, spread, noise_variance, n_scans, 1.0 - tail, motion)
@@ -191,7 +238,7 @@ def correct(speed, std, filtering, spread, motion_variance, motion_bias, noise_v
     low = np.maximum(estimate - np.hypot(estimate - np.minimum(low, estimate), k * extra), 0.0)
     high = estimate + np.hypot(np.maximum(high, estimate) - estimate, k * extra)
     spread_var = spectra.variance_of_variance(np.maximum(lidar, 0.0), spread, noise_variance,
-                                              n_scans, motion_cross, motion_variance)
+                                              n_scans, *motion)
     u_variance = np.sqrt(spread_var / filtering ** 2 + extra ** 2)
     consistent = np.isfinite(high)
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -177,5 +177,5 @@ def motion_set(spec, record_times):
     return motion.MotionSet(
         shapes, np.repeat(frequency, count, axis=1),
         np.broadcast_to(np.tile(np.arange(count), bins), (n, bins * count)).copy(),
-        np.where(valid[:, None], power.reshape(n, bins * count), 0.0), valid, labels), \
-        outside
+        np.where(valid[:, None], power.reshape(n, bins * count), 0.0), valid, labels,
+        random_phases=False), outside

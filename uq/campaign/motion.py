@@ -52,6 +52,10 @@ class MotionSet:
         Records whose motion is known (the others are NaN in the results).
     labels : tuple of str
         A name of each shape, for the report.
+    random_phases : bool
+        Whether the components' phases are unknown and independent (a sea state,
+        statistics): the record's sample variance of the motion then spreads
+        (:func:`uq.campaign.spectra.phase_variance`); an IMU log's are what they were.
     """
 
     shapes: np.ndarray
@@ -60,6 +64,7 @@ class MotionSet:
     power: np.ndarray
     valid: np.ndarray
     labels: tuple
+    random_phases: bool = True
 
     @property
     def count(self):

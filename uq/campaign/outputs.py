@@ -53,6 +53,8 @@ METADATA = {
     "motion_cross": ("m2 s-2", "the motion's cross term with the turbulence in the "
                      "spread of the record's variance, sum of its harmonics' variances "
                      "times the turbulence's cross response", None),
+    "motion_phase": ("m4 s-4", "variance of the motion's own sample variance over a record "
+                     "(its harmonics' phases unknown)", None),
     "motion_turbulence_intensity": ("1", "the motion's turbulence-intensity increment, "
                                     "sqrt(motion variance) over the corrected mean speed",
                                     None),
