@@ -13,6 +13,8 @@ import shutil
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from uq.files import (check_folder_target, new_partial_folder, replace_folder, save_figure,
                       write_netcdf, write_text)
 from .analysis import analyse
@@ -66,10 +68,12 @@ def write_folder(ds, folder, config):
                      ("bin_errors", figures.plot_bin_errors, "Errors of the measured and "
                       "corrected TI per bin against the reference: mean bias (the corrected "
                       "with 2u, the measured's as predicted) and RMSE")]
-    top = float(ds["height"].max())
-    drawings.append(("time_series", lambda d: figures.plot_time_series(d, top),
-                     f"Turbulence intensity at {top:g} m over the campaign (the "
-                     "reference at the records corrected)"))
+    counts = ds["turbulence_intensity_corrected"].notnull().sum("time").values
+    fullest = float(ds["height"].values[int(np.argmax(counts))])      # the most corrected
+    drawings.append(("time_series", lambda d: figures.plot_time_series(d, fullest),
+                     f"Turbulence intensity at {fullest:g} m (the height with the most "
+                     "corrected records) over the campaign (the reference at the records "
+                     "corrected)"))
     shown = {}
     for stem, draw, caption in drawings:
         fig = draw(ds)
