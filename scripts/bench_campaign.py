@@ -20,12 +20,14 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--records", type=int, default=100_000)
     parser.add_argument("--workers", type=int, default=None)
-    parser.add_argument("--direct", type=int, default=12)
+    parser.add_argument("--direct", type=int, default=12,
+                        help="record-heights corrected by both paths (0: none)")
     args = parser.parse_args(argv)
     root = Path(__file__).resolve().parents[1]
     config = root / "scenarios" / "campaign_buoy.yaml"
     out = {"load_average": os.getloadavg(), "cpus": os.cpu_count()}
-    out.update(benchmark.direct_against_fast(config, args.direct))
+    if args.direct:
+        out.update(benchmark.direct_against_fast(config, args.direct))
     with tempfile.TemporaryDirectory() as folder:
         scaled = benchmark.scaled_campaign(config, Path(folder) / "in", args.records)
         client = None
@@ -34,11 +36,14 @@ def main(argv=None):
             cluster = local_cluster(args.workers, host="127.0.0.1")
             client = cluster.__enter__()
         try:
-            wall, count, attrs = benchmark.time_command(scaled, Path(folder) / "out", client)
+            wall, cpu, count, attrs = benchmark.time_command(scaled, Path(folder) / "out",
+                                                             client)
         finally:
             if client is not None:
                 cluster.__exit__(None, None, None)
-    out.update(command_seconds=wall, record_heights=count,
+    out.update(command_seconds=wall, command_cpu_seconds_driver=cpu, record_heights=count,
+               record_heights_corrected=attrs["n_corrected"],
+               command_runtime_s=attrs["runtime_s"],
                record_heights_per_second=count / wall, workers=args.workers or 1,
                surrogate_ti_error=attrs["surrogate_ti_error"],
                load_average_after=os.getloadavg())

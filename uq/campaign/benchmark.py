@@ -58,22 +58,24 @@ def scaled_campaign(config_path, folder, record_heights):
 
 
 def _span_days(records, spec):
+    """Whole days the records span (their last period's end included)."""
     stamps = pd.to_datetime(records[spec.get("time", "time")], format="mixed")
-    return int(np.ceil((stamps.max() - stamps.min()) / pd.Timedelta(days=1))) + 1
+    return int(np.ceil((stamps.max() - stamps.min() + pd.Timedelta(minutes=10))
+                       / pd.Timedelta(days=1)))
 
 
 def time_command(config_path, folder, client=None):
-    """(wall seconds of ``uq campaign`` on `config_path` into `folder`, record-heights,
-    the results' Dataset attributes)."""
+    """(wall seconds of ``uq campaign`` on `config_path` into `folder`, the CPU seconds
+    of this process in it, record-heights, the results' Dataset attributes)."""
     import io
     import xarray as xr
     from uq.campaign.command import run_campaign
-    started = time.perf_counter()
+    started, cpu = time.perf_counter(), time.process_time()
     out = run_campaign(config_path, folder, stream=io.StringIO(), client=client)
-    wall = time.perf_counter() - started
+    wall, cpu = time.perf_counter() - started, time.process_time() - cpu
     name = load_campaign_config(config_path).name
     with xr.open_dataset(out / f"{name}.nc") as ds:
-        return wall, int(ds.attrs["n_record_heights"]), dict(ds.attrs)
+        return wall, cpu, int(ds.attrs["n_record_heights"]), dict(ds.attrs)
 
 
 def direct_against_fast(config_path, count=12, seed=0):
