@@ -9,7 +9,7 @@
 
 
 Each scenario runs as shipped (``uq run``'s code path, ``uq golden`` for golden
-configurations); the digest is a SHA-256 of every variable's and coordinate's bytes and
+configurations, ``uq campaign`` for campaign configurations); the digest is a SHA-256 of every variable's and coordinate's bytes and
 of the attributes that are not timings. Bit-identical results give identical digests.
 
 ``--values-only`` digests each variable's values alone (as float64 where numeric, so a
@@ -72,12 +72,14 @@ def shipped(digest=digest, model="compiled"):
     results = {}
     for path in sorted(SCENARIOS.glob("*.yaml")):
         text = path.read_text()
-        if "golden:" in text:
-            if "synthetic" not in text and "comparisons" not in text:
+        command = "golden" if "golden:" in text else "campaign" if "\ncampaign:" in text \
+            else None
+        if command is not None:
+            if command == "golden" and "synthetic" not in text and "comparisons" not in text:
                 continue
             with tempfile.TemporaryDirectory() as folder:
                 with contextlib.redirect_stdout(io.StringIO()):
-                    main(["golden", str(path), "-o", str(Path(folder) / "g")])
+                    main([command, str(path), "-o", str(Path(folder) / "g")])
                 nc = next((Path(folder) / "g").glob("*.nc"))
                 with xr.open_dataset(nc) as ds:
                     results[path.stem] = digest(ds.load())
@@ -130,7 +132,8 @@ def agreement(model="numpy"):
     import uq
     worst = {}
     for path in sorted(SCENARIOS.glob("*.yaml")):
-        if "golden:" in path.read_text():
+        text = path.read_text()
+        if "golden:" in text or "\ncampaign:" in text:
             continue
         print(f"running {path.name} twice", file=sys.stderr)
         one, two = uq.run(str(path)), uq.run(str(path), model=model)

@@ -6,7 +6,9 @@ Rules (issue 15):
   shipped, numbacache) import no other layer;
 * physics and engine are independent of each other and import only base modules;
 * the pipeline imports base, physics and engine; outputs import those and the pipeline;
-* a wing (fit, golden, bench) imports the layers below it, never another wing;
+* a wing (fit, golden, campaign, bench) imports the layers below it, never another wing
+  but one: the campaign builds on uq golden's bins, KPIs and report renderer (golden
+  never imports the campaign: it reads a campaign's results file, no code);
 * the command line may import anything but the package face;
 * nothing imports the package face ``uq/__init__`` (``import uq``, ``uq.run``, ...);
 * no import cycles between modules.
@@ -29,8 +31,10 @@ ALLOWED = {"base": set(), "physics": set(), "engine": set(),
            "outputs": {"physics", "engine", "pipeline"},
            "fit": {"physics", "engine", "pipeline", "outputs"},
            "golden": {"physics", "engine", "pipeline", "outputs"},
+           "campaign": {"physics", "engine", "pipeline", "outputs", "golden"},
            "bench": {"physics", "engine", "pipeline", "outputs"},
-           "cli": {"physics", "engine", "pipeline", "outputs", "fit", "golden", "bench"}}
+           "cli": {"physics", "engine", "pipeline", "outputs", "fit", "golden", "campaign",
+                   "bench"}}
 
 
 def module_name(path):
@@ -133,6 +137,8 @@ def test_the_layers_are_folders():
     ({"uq.engine.gum": {"uq.physics.rotation"}}, "(engine) imports uq.physics.rotation"),
     ({"uq.pipeline.sweep": {"uq.outputs.figures"}}, "(pipeline) imports uq.outputs.figures"),
     ({"uq.golden.plots": {"uq.fit.plots"}}, "(golden) imports uq.fit.plots (fit)"),
+    ({"uq.golden.analysis": {"uq.campaign.correction"}},
+     "(golden) imports uq.campaign.correction (campaign)"),
     ({"uq.outputs.report": {"uq"}}, "imports the package face"),
     ({"uq.physics.scene": {"uq.physics.measurement"}}, "import cycle: "),
 ])

@@ -616,3 +616,16 @@ REPRESENTATIVE_TI_QUANTILE = 1.28
 #: 1024 points and the ~750 wavenumbers of a ten-minute record cost ~3e11 flops, about a
 #: minute on two cores; a 5-beam DBS at 100 m at the default spacing needs ~720.
 MAX_KAIMAL_POINTS = 1024
+
+#: Campaign records (uq campaign). Lowest mean speed of a record the correction takes
+#: [m s-1]: below it the ten-minute record is no frozen field advected past the lidar
+#: (Taylor's hypothesis needs sigma_u << U; at 2 m/s a TI of 0.25 is sigma_u = 0.5 m/s)
+#: and ``Vh = |u_h|`` is no longer linear in the fluctuations; IEC 61400-12-1's power
+#: curves and the OWA roadmap's TI bins start above it. Configurable
+#: (``campaign.minimum_speed``).
+CAMPAIGN_MIN_SPEED = 2.0
+#: A record is 10 min (the campaign's grid of records) [s].
+CAMPAIGN_RECORD_SECONDS = 600.0
+#: Records of one chunk of the correction (the fast path's arrays: ~50 MB at 24 motion
+#: components; a dask task each).
+CAMPAIGN_CHUNK_RECORDS = 4096

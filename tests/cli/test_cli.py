@@ -139,6 +139,19 @@ def test_version_and_help(tmp_path):
     assert uq("run", "--help", cwd=tmp_path).returncode == 0
 
 
+def test_every_help_prints(capsys):
+    """uq --help and every command's --help: argparse formats each help text with %, so
+    a bare % in one (a '95 % interval') breaks every help that lists it."""
+    from uq.cli import SUBCOMMANDS, main
+    names = [module.__name__.rsplit(".", 1)[1] for module in SUBCOMMANDS]
+    names = ["list" if name == "listing" else name for name in names]
+    for argv in [["--help"]] + [[name, "--help"] for name in names]:
+        with pytest.raises(SystemExit) as raised:
+            main(argv)
+        assert raised.value.code == 0, argv
+        assert "usage: uq" in capsys.readouterr().out
+
+
 def test_run_writes_default_path_and_set_overrides(tmp_path):
     path = write(tmp_path, GOOD, "good.yaml")
     result = uq("run", str(path), "--set", "wind.speed=7.5", "--set", "sampling.n=3000",

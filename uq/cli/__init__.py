@@ -1,6 +1,6 @@
 """Command line: ``uq run``, ``uq check``, ``uq list``, ``uq plot``, ``uq report``,
-``uq export``, ``uq bench``, ``uq fit``, ``uq golden``, ``uq warmup``, ``uq --version``; one module per
-subcommand.
+``uq export``, ``uq bench``, ``uq fit``, ``uq golden``, ``uq campaign``, ``uq warmup``,
+``uq --version``; one module per subcommand.
 
 The command line dispatches; it computes nothing. Each subcommand module adds its
 parser and imports what it needs only when it runs, so ``uq --help`` and ``uq --version``
@@ -30,9 +30,9 @@ from uq.interrupts import raise_if_stopped, stopping_on_signals
 
 #: The subcommand modules of :mod:`uq.cli`, in the order of ``uq --help``.
 SUBCOMMANDS = ("run", "check", "listing", "plot", "report", "export", "bench", "fit",
-               "golden", "warmup")
+               "golden", "campaign", "warmup")
 #: Commands that may compile numba kernels: they say so on stderr (uq.cli.compiling).
-COMPILING = ("run", "plot", "report", "bench", "fit", "golden", "warmup")
+COMPILING = ("run", "plot", "report", "bench", "fit", "golden", "campaign", "warmup")
 
 
 def build_parser():

@@ -100,7 +100,7 @@ class _Formatter(logging.Formatter):
         return f"{prefix}: {record.levelname.lower()}: {one_line(record.getMessage())}"
 
 
-WINGS = ("golden", "fit", "bench")
+WINGS = ("golden", "fit", "bench", "campaign")
 
 
 def add_common_options(parser):

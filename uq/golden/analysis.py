@@ -55,7 +55,10 @@ def analyse(config):
                     significance=config.significance, route=config.route,
                     bin_width=config.bin_width, required_low=config.required[0],
                     required_high=config.required[1], minimum_records=config.minimum_records,
-                    n_invalid=sum(int(r.attrs["n_invalid"]) for r in records.values()))
+                    n_invalid=sum(int(r.attrs["n_invalid"]) for r in records.values()),
+                    campaign_instruments=" ".join(
+                        f"{name}:{r.attrs['campaign_motion']}" for name, r in records.items()
+                        if "campaign_motion" in r.attrs))
     return ds
 
 

@@ -22,7 +22,10 @@ from .overrides import SCENARIO_SEPARATOR, load_lidar_scenario, split_overrides
 TOP_KEYS = ("name", "description", "instruments", "comparisons", "smc", "classification",
             "bins", "kpi", "synthetic")
 INSTRUMENT_KEYS = ("file", "time", "heights", "environment", "calibration", "class_number",
-                   "scenario")
+                   "scenario", "campaign")
+#: The keys a ``campaign`` instrument takes: its records are those of a ``uq campaign``
+#: results file (its heights, speeds and the TI corrected for the platform's motion).
+CAMPAIGN_INSTRUMENT_KEYS = ("campaign", "calibration", "class_number")
 TURBULENCE_KEYS = ("variable", "bands")
 HEIGHT_KEYS = ("speed", "direction", "environment")
 CLASSIFICATION_KEYS = ("variables", "significance", "ranges", "route")
@@ -37,7 +40,8 @@ class Instrument:
 
     ``heights`` maps a height [m] to ``{"speed": column, "direction": column or None,
     "environment": {variable: column}}``; ``environment`` holds the columns common to
-    all heights (a height's own entry wins). ``calibration`` (absolute [m s-1], relative
+    all heights (a height's own entry wins). With ``campaign`` the file is a ``uq
+    campaign`` results file, which gives the heights and variables itself. ``calibration`` (absolute [m s-1], relative
     [1]) and ``class_number`` [%] are given for a reference that is not itself verified
     in this configuration (a mast)."""
 
@@ -49,6 +53,7 @@ class Instrument:
     calibration: tuple = None
     class_number: float = None
     scenario: object = None
+    campaign: bool = False
 
 
 @dataclass(frozen=True)
@@ -169,6 +174,8 @@ def validate_golden(raw, check, base, scenarios=None):
 def _instrument(check, spec, key, name, base, scenarios=None):
     check.mapping(spec, key)
     check.keys(spec, key, INSTRUMENT_KEYS)
+    if "campaign" in spec:
+        return _campaign_instrument(check, spec, key, name, base)
     for needed in ("file", "heights"):
         if needed not in spec:
             check.fail(f"{key}.{needed}", "missing")
@@ -209,6 +216,30 @@ def _instrument(check, spec, key, name, base, scenarios=None):
                       environment=_columns(check, spec.get("environment") or {},
                                            f"{key}.environment"),
                       calibration=calibration, class_number=class_number)
+
+
+def _campaign_instrument(check, spec, key, name, base):
+    """An instrument whose records are a ``uq campaign`` results file (``<name>.nc``):
+    its heights, its speeds and directions, and as its TI the campaign's TI corrected for
+    the platform's motion and the lidar's filtering (:func:`uq.golden.records.
+    load_campaign_records`)."""
+    for other in spec:
+        if other not in CAMPAIGN_INSTRUMENT_KEYS:
+            check.fail(f"{key}.{other}", "not allowed with campaign (the campaign's file "
+                       f"gives the records); allowed: {', '.join(CAMPAIGN_INSTRUMENT_KEYS)}")
+    calibration = None
+    if "calibration" in spec:
+        cal = spec["calibration"]
+        check.mapping(cal, f"{key}.calibration")
+        check.keys(cal, f"{key}.calibration", ("absolute", "relative"))
+        calibration = tuple(check.number(cal.get(part, 0.0), f"{key}.calibration.{part}",
+                                         low=0.0) for part in ("absolute", "relative"))
+    class_number = spec.get("class_number")
+    return Instrument(name=name, file=base / check.text(spec["campaign"], f"{key}.campaign"),
+                      time="time", heights={}, environment={}, calibration=calibration,
+                      class_number=None if class_number is None else check.number(
+                          class_number, f"{key}.class_number", low=0.0),
+                      campaign=True)
 
 
 def _columns(check, value, key):

@@ -102,8 +102,18 @@ def _read(path, source, name):
                             "netCDF file of 10-min records") from None
 
 
+#: The variables of a ``uq campaign`` results file an instrument takes
+#: (:func:`load_campaign_records`): its name -> the campaign's, and the factor to the
+#: units here (TI in percent).
+CAMPAIGN_VARIABLES = {"speed": ("wind_speed_corrected", 1.0),
+                      "direction": ("wind_direction", 1.0),
+                      "turbulence_intensity": ("turbulence_intensity_corrected", 100.0)}
+
+
 def load_records(instrument):
     """The instrument's records as a Dataset (see the module docstring)."""
+    if instrument.campaign:
+        return load_campaign_records(instrument)
     table = read_table(instrument)
     source, prefix = str(instrument.file), f"instruments.{instrument.name}.heights"
     heights = sorted(instrument.heights)
@@ -127,6 +137,36 @@ def load_records(instrument):
     ds.attrs.update(instrument=instrument.name, file=source, n_invalid=invalid,
                     zoned=table.attrs["zoned"])
     return ds
+
+
+def load_campaign_records(instrument):
+    """The records of a ``uq campaign`` results file as an instrument's Dataset: the
+    corrected mean speed [m s-1], the direction [deg] and, as ``turbulence_intensity``
+    [%], the TI corrected for the platform's motion and the lidar's filtering (NaN where
+    the campaign could not correct a record). Its time stamps are the periods' starts in
+    UTC (a zone: the other instrument's stamps need one too)."""
+    source, key = str(instrument.file), f"instruments.{instrument.name}.campaign"
+    check_regular(instrument.file, MAX_RECORD_BYTES, "a uq campaign results file",
+                  DataFileError, key)
+    try:
+        with xr.open_dataset(instrument.file) as ds:
+            ds = ds.load()
+    except (OSError, ValueError) as error:
+        reason = str(error).splitlines()[0][:120] if str(error) else type(error).__name__
+        raise DataFileError(source, key, f"cannot read it as netCDF ({reason}); allowed: "
+                            "the <name>.nc of a uq campaign results folder") from None
+    missing = [name for name, _ in CAMPAIGN_VARIABLES.values() if name not in ds]
+    if missing or not str(ds.attrs.get("title", "")).startswith("uq campaign"):
+        raise DataFileError(source, key, f"not a uq campaign results file (no "
+                            f"{', '.join(missing) or 'uq campaign title'}); allowed: the "
+                            "<name>.nc that 'uq campaign' writes")
+    out = xr.Dataset({name: (("time", "height"), ds[variable].values * factor)
+                      for name, (variable, factor) in CAMPAIGN_VARIABLES.items()},
+                     coords={"time": ds["time"].values, "height": ds["height"].values})
+    out.attrs.update(instrument=instrument.name, file=source, n_invalid=0, zoned=1,
+                     campaign_motion=ds.attrs.get("motion", "none"),
+                     campaign_filtering=ds.attrs.get("filtering", ""))
+    return out
 
 
 def align(unit, reference):

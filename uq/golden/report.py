@@ -245,6 +245,7 @@ def _turbulence_blocks(ds, height):
                "TI the unit's lidar reads of the reference's TI by uq's spectral path (probe "
                "volume, beam separation, scan timing; fixed lidar, IEC Mann field), blank "
                "when the unit names no scenario.")]
+    blocks += _campaign_ti_blocks(ds)
     for k in ds["comparison"].values:
         c = ds.sel(comparison=k, height=height).isel(bin=bins)
         ratio = float(c["ti_predicted_ratio"])
@@ -260,6 +261,17 @@ def _turbulence_blocks(ds, height):
         blocks += [("h3", f"{k}: {note}"),
                    ("table", ["bin [m/s]"] + [h for _, h in TI_COLUMNS] + ["verdicts"], rows)]
     return blocks
+
+
+def _campaign_ti_blocks(ds):
+    """A paragraph naming the instruments whose TI is a ``uq campaign``'s corrected TI."""
+    named = [item.split(":") for item in ds.attrs.get("campaign_instruments", "").split()]
+    if not named:
+        return []
+    text = "; ".join(f"{name} (motion: {motion})" for name, motion in named)
+    return [("p", f"The TI of {text} is uq campaign's: each record's TI corrected for the "
+                  "platform's motion and the lidar's filtering (its results file's "
+                  "turbulence_intensity_corrected), so the KPIs above use the corrected TI.")]
 
 
 def _cell(value):

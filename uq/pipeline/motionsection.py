@@ -106,7 +106,7 @@ def validate_motion(check, value):
                    "both motion.spectrum and motion.response, or neither")
     if "spectrum" in value:
         out["spectrum"] = _spectrum(check, value["spectrum"])
-        out["response"] = _response(check, value["response"])
+        out["response"] = validate_response(check, value["response"])
     if "series" in value:
         out["series"] = _series(check, value["series"])
     return out
@@ -250,12 +250,15 @@ def _spectrum(check, value):
     return out
 
 
-def _response(check, value):
-    check.mapping(value, "motion.response")
-    check.keys(value, "motion.response", DEGREES_OF_FREEDOM)
+def validate_response(check, value, prefix="motion.response"):
+    """A platform's response to the waves (``motion.response``, or `prefix` in another
+    configuration): per degree of freedom its ``factor`` per metre of wave amplitude
+    [deg m-1 or m m-1] and its phase ``lag`` [deg]."""
+    check.mapping(value, prefix)
+    check.keys(value, prefix, DEGREES_OF_FREEDOM)
     out = {}
     for dof, spec in value.items():
-        key = f"motion.response.{dof}"
+        key = f"{prefix}.{dof}"
         check.mapping(spec, key)
         check.keys(spec, key, RESPONSE_KEYS)
         check.required(spec, key, ("factor",), "allowed: the amplitude per metre of wave "

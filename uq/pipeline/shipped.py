@@ -101,11 +101,12 @@ def results_path(argument):
 
 
 def describe(path):
-    """One line about the scenario at `path`: its ``description`` (or the golden
-    section's), white space collapsed; '' when it has none."""
+    """One line about the scenario at `path`: its ``description`` (or the golden or
+    campaign section's), white space collapsed; '' when it has none."""
     from uq.pipeline.yamlfile import read_yaml
     raw = read_yaml(path)
     if not isinstance(raw, dict):
         return ""
-    text = raw.get("description") or (raw.get("golden") or {}).get("description") or ""
+    text = raw.get("description") or (raw.get("golden") or {}).get("description") or \
+        (raw.get("campaign") or {}).get("description") or ""
     return " ".join(str(text).split())

@@ -1,0 +1,415 @@
+"""The campaign's one door to the physics it stands on.
+
+Everything :mod:`uq.campaign` takes from uq's physics passes through this module, so
+that a change of the spectral path, of the time-resolved measurement model or of the
+Monte Carlo records reaches the campaign here and nowhere else:
+
+* :func:`gate_settings`: the lidar's scenario reduced to one range gate at a campaign
+  height, in a given mean wind and turbulence model (validated settings).
+* :func:`spectral_terms`: the spectral path of that gate
+  (:func:`uq.physics.lidarspectral.mann_lidar_variances`), one k1 node of its wavenumber
+  grid at a time and without the record's high-pass: the contribution of each k1 to the
+  lidar's u-variance and to the point's. The record's variances, the filtering factor
+  and the autocovariance of the lidar's series between scans all follow from these
+  (:mod:`uq.campaign.spectra`); summed with the record's high-pass they are the spectral
+  path's own record variances (tested).
+* :func:`motion_jacobian`: the first derivatives of one scan's horizontal speed Vh with
+  respect to the unit phase vector of a harmonic platform motion of given frequency and
+  complex amplitude (the GUM's linearisation of the motion, Eq. 13 of JCGM 100 with the
+  phase covariance I/2 of :mod:`uq.physics.motion`), by central differences of the
+  compiled time-resolved model.
+* :func:`motion_shift`: the phase-averaged second-order change of Vh under such a
+  motion (the motion's bias of the mean speed).
+* :func:`scan_noise_variance`: the GUM variance of one scan's Vh from every error that is
+  not the motion (INS readings, radial noise), drawn independently scan by scan as the
+  records draw them.
+* :func:`monte_carlo_record`: one Monte Carlo record of the lidar
+  (:func:`uq.pipeline.records.monte_carlo_record`): the turbulence box, the motion, the
+  probe and the errors.
+
+Conventions
+-----------
+A harmonic motion of frequency f [Hz] moves degree of freedom d
+(:data:`uq.physics.motion.DEGREES_OF_FREEDOM`: roll, pitch, yaw [rad]; surge, sway, heave
+[m]) as ``x_d(t) = A_d sin(w t + psi_d + phi)``; its *complex amplitude* is ``a_d = A_d
+exp(i psi_d)``, and the phase phi of the whole component is uniform (the unit phase vector
+``c = (cos phi, sin phi)`` of :mod:`uq.physics.motion`). Times run from the start of the
+scan's first beam. The response of degree of freedom d at f is ``z_d = dVh/dc_1 + i
+dVh/dc_2`` for ``a = e_d`` (unit amplitude, lag 0); for any a the two derivatives are
+``dVh/dc_1 + i dVh/dc_2 = sum_d z_d conj(a_d)`` (linearity), so the component adds the
+variance ``|sum_d z_d conj(a_d)|^2 / 2 = z^H M z`` with ``M = a a^H / 2``.
+"""
+import copy
+import dataclasses
+import math
+
+import numpy as np
+
+from uq.physics.motion import DEGREES_OF_FREEDOM, Motion, MotionComponent
+
+#: Step of the central differences of :func:`motion_jacobian` [unit phase]: the model is
+#: smooth in the phases, so the O(h^2) error is ~1e-8 of the derivative (measured
+#: against the numpy model's complex step: 2.5e-8 relative), far below any other error.
+RESPONSE_STEP = 1e-4
+#: Radius of the phase vectors of :func:`motion_shift` [1]: the motion is scaled by
+#: it, so the second-order change is resolved (1e-6 of U) while the fourth order stays
+#: 1e-6 of it.
+CURVATURE_SCALE = 1e-3
+#: Phases of the quadrature over a component's uniform phase [1]: equally spaced, they
+#: average the first and third harmonics in the phase (odd orders) and the second
+#: (the oscillating part of the second order) exactly; the fourth order, O(scale^4), is
+#: what remains.
+CURVATURE_PHASES = 8
+#: Components of one call of the compiled model in :func:`motion_jacobian` and
+#: :func:`motion_shift`: every trial holds every component of the call (one moved, the
+#: others at rest), so a call costs ~ n^2; 64 keeps it at a few milliseconds.
+MOTION_CHUNK = 64
+#: The record of :func:`gate_settings` (the spectral path's record and the Monte Carlo
+#: records) holds this many records per scene: the campaign draws them itself.
+GATE_RECORDS = 2
+
+
+def gate_settings(lidar, heights, turbulence, record_duration, speed=10.0, direction=0.0,
+                  intensity=0.1, motion=None):
+    """Validated settings of the campaign lidar's gates at `heights` [m] above sea level.
+
+    Parameters
+    ----------
+    lidar : dict
+        Validated settings of the lidar's scenario (:class:`uq.pipeline.scenario.Scenario`
+        ``.settings``): its geometry, probe, scan timing, INS, errors and correction;
+        its ``motion`` and ``sweep`` are left out, its ``wind.shear`` kept.
+    heights : sequence of float
+        Gate heights [m]; a gate's range is ``height - lidar.height`` (an upward lidar).
+        The first is the reference height of the wind (its speed and direction); the
+        spectral path of each gate does not depend on it (a homogeneous field), the
+        measurement model's wind does (the power law): give one height for that.
+    turbulence : dict
+        ``{model, length_scale, anisotropy}`` of the field (Mann).
+    record_duration : float
+        [s].
+    speed, direction : float
+        Mean wind at the gate [m s-1], "from" [deg].
+    intensity : float
+        The field's sigma_u / U [1] (the spectral path is linear in its square).
+    motion : dict, optional
+        A scenario ``motion`` section (the Monte Carlo records' sea state).
+    """
+    from uq.pipeline.scenario import load_scenario
+    raw = copy.deepcopy(lidar)
+    for key in ("motion", "sweep", "turbulence", "record"):
+        raw.pop(key, None)
+    heights = [float(h) for h in heights]
+    raw["name"] = f"{lidar.get('name', 'lidar')}_at_{heights[0]:g}"
+    raw["wind"] = {**raw["wind"], "speed": float(speed), "direction": float(direction) % 360.0,
+                   "reference_height": heights[0]}
+    raw["lidar"] = {**raw["lidar"], "ranges": [h - lidar["lidar"]["height"] for h in heights]}
+    raw["turbulence"] = {**turbulence, "intensity": float(intensity)}
+    raw["record"] = {"duration": float(record_duration), "count": GATE_RECORDS}
+    raw["outputs"] = ["wind_speed"]
+    if motion:
+        raw["motion"] = motion
+    return _quiet(load_scenario, raw).settings
+
+
+def _quiet(function, *args):
+    """`function(*args)` without the scenario's warnings about keys that have no effect
+    in this reduced scene (an INS rate without motion: the campaign gives the motion)."""
+    import logging
+    logger = logging.getLogger("uq.pipeline.scenario")
+    level = logger.level
+    logger.setLevel(logging.ERROR)
+    try:
+        return function(*args)
+    finally:
+        logger.setLevel(level)
+
+
+def default_length_scale(height):
+    """IEC 61400-1's Mann length scale at `height` [m]: 0.8 Lambda_1 [m]
+    (:func:`uq.pipeline.turbulencesection.default_length_scale`)."""
+    from uq.pipeline.turbulencesection import default_length_scale as default
+    return default("mann", height)
+
+
+def with_wind(settings, speed, direction):
+    """`settings` (validated) with another mean wind [m s-1, deg "from"] (a copy)."""
+    out = dict(settings)
+    out["wind"] = {**settings["wind"], "speed": float(speed),
+                   "direction": float(direction) % 360.0}
+    return out
+
+
+# --- the spectral path -----------------------------------------------------------------
+
+@dataclasses.dataclass(frozen=True)
+class SpectralTerms:
+    """The spectral path of one gate, per k1 node, without the record's high-pass.
+
+    Attributes
+    ----------
+    k1 : ndarray, shape (n,)
+        Along-wind wavenumbers [rad m-1] (the grid's nodes, k1 > 0).
+    lidar : ndarray, shape (n,) or (n, n_gates)
+        Each node's contribution to the lidar's reconstructed u-variance [m2 s-2]
+        (quadrature weight, the factor 2 of the even integrand and the tensor's cross
+        section included), per gate.
+    point : ndarray, shape (n,)
+        The same for u at the reference point [m2 s-2].
+    weight : ndarray, shape (n,)
+        The nodes' quadrature weights in k1 [rad m-1], the factor 2 of the even
+        integrand included (a term over its weight is the integrand at k1 > 0, half the
+        one-sided density).
+    speed : float
+        Mean speed [m s-1]; ``f = k1 U / (2 pi)``.
+    scan_period, record_duration : float
+        [s].
+    """
+
+    k1: np.ndarray
+    lidar: np.ndarray
+    point: np.ndarray
+    weight: np.ndarray
+    speed: float
+    scan_period: float
+    record_duration: float
+
+    @property
+    def frequency(self):
+        """Frequencies of the nodes [Hz] (Taylor)."""
+        return self.k1 * self.speed / (2.0 * np.pi)
+
+    def gate(self, index):
+        """The terms of one gate (``lidar`` of shape (n,))."""
+        return dataclasses.replace(self, lidar=np.asarray(self.lidar)[:, index])
+
+
+@dataclasses.dataclass(frozen=True)
+class _Nodes:
+    """A :class:`~uq.physics.spectraltensor.WavenumberGrid` restricted to some of its k1
+    nodes (their weights unchanged): the spectral path over those nodes alone."""
+
+    grid: object
+    nodes: tuple
+
+    @property
+    def length_scale(self):
+        return self.grid.length_scale
+
+    def k1(self):
+        k1, weights = self.grid.k1()
+        return k1[list(self.nodes)], weights[list(self.nodes)]
+
+    def cross_section(self, k1):
+        return self.grid.cross_section(k1)
+
+
+def spectral_terms(settings):
+    """:class:`SpectralTerms` of validated gate `settings` (:func:`gate_settings`).
+
+    The probe's own transfer function at the gate's focus, the Mann tensor of the
+    settings' turbulence, the scan geometry of the pipeline (:func:`uq.pipeline.
+    turbulencesection.scan_geometry`); each k1 node is one call of the spectral path
+    with an infinite record (no high-pass), so that the node's terms are the integrand
+    itself."""
+    from uq.physics.lidarspectral import mann_lidar_variances, probe_transfer_for
+    from uq.physics.spectraltensor import WavenumberGrid
+    from uq.pipeline import probesection
+    from uq.pipeline.records import turbulence_model
+    from uq.pipeline.turbulencesection import scan_geometry
+    geometry = scan_geometry(settings)
+    lidar = settings["lidar"]
+    focus = np.asarray(lidar["ranges"], float) / math.cos(math.radians(lidar["half_cone"]))
+    transfer = probe_transfer_for(probesection.make_probe(lidar.get("probe")), focus)
+    tensor = turbulence_model(settings["turbulence"], settings["wind"]["speed"])
+    grid = WavenumberGrid(tensor.length_scale)
+    unfiltered = dataclasses.replace(geometry, record_duration=np.inf)
+    k1, weight = grid.k1()
+    lidar_terms, point_terms = np.zeros((k1.size, geometry.n_gates)), np.zeros(k1.size)
+    for node in range(k1.size):
+        found = mann_lidar_variances(unfiltered, tensor, transfer, grid=_Nodes(grid, (node,)))
+        lidar_terms[node], point_terms[node] = found.lidar[:, 0], found.true[0]
+    return SpectralTerms(k1, lidar_terms, point_terms, weight, geometry.speed,
+                         geometry.scan_period, geometry.record_duration)
+
+
+def record_high_pass(frequency, scan_period, record_duration):
+    """``1 - |D_N(f)|^2`` [1] of a record of `record_duration` [s] sampled every
+    `scan_period` [s] at `frequency` [Hz]: the spectral path's own high-pass
+    (:func:`uq.physics.lidarspectral.record_filter`)."""
+    from uq.physics.lidarspectral import record_filter
+    return record_filter(frequency, scan_period, record_duration)
+
+
+def spectral_ratio(settings):
+    """The spectral path's u-variance ratio of each gate (its record's high-pass
+    included), as ``uq run`` computes it (:func:`uq.pipeline.records.spectral_variances`),
+    shape (n_gates,)."""
+    from uq.pipeline.records import spectral_variances
+    return np.asarray(spectral_variances(settings)[0].ratio(), float)
+
+
+def point_record_variance(length_scale, anisotropy, intensity, speed, scan_period,
+                          record_duration):
+    """Expected variance [m2 s-2] of u at a point sampled once a scan over a record
+    (the record's high-pass), for a Mann field of point sigma_u / U = `intensity`."""
+    from uq.physics.lidarspectral import record_filter
+    from uq.physics.spectraltensor import mann_tensor_for_intensity, point_variances
+    tensor = mann_tensor_for_intensity(intensity, speed, length_scale, anisotropy)
+    return float(point_variances(tensor, spectral_filter=lambda k1: record_filter(
+        k1 * speed / (2 * np.pi), scan_period, record_duration))[0])
+
+
+# --- the motion ------------------------------------------------------------------------
+
+def motion_scene(settings, components=()):
+    """The time-resolved scene of validated `settings` with the harmonic `components`
+    (:class:`uq.physics.motion.MotionComponent`, random phases) as its motion, its
+    lever arm, scan timing and INS sampling the scenario's (defaults where it gives none);
+    the probe resolved."""
+    from uq.physics import probe
+    from uq.physics.ins import InsSampling
+    from uq.physics.scene import TimeResolved
+    from uq.physics.timing import ScanTiming
+    from uq.pipeline.modelsetup import scene_from_settings
+    from uq.pipeline.motionsection import SCAN_DEFAULTS
+    lidar, ins = settings["lidar"], settings["ins"]
+    motion = Motion(tuple(components), tuple(lidar.get("lever_arm", (0.0, 0.0, 0.0))))
+    resolved = TimeResolved(motion, ScanTiming(**{**SCAN_DEFAULTS, **lidar.get("scan", {})}),
+                            InsSampling(ins.get("rate"), ins.get("interpolation", "linear")))
+    scene = dataclasses.replace(scene_from_settings(settings), time_resolved=resolved)
+    return probe.resolve(scene)
+
+
+def components_of(frequency, amplitude):
+    """MotionComponents (random phases) of frequencies [Hz], shape (K,), and complex
+    amplitudes ``A exp(i psi)`` per degree of freedom, shape (K, 6) [rad, m]."""
+    amplitude = np.asarray(amplitude, complex)
+    return tuple(MotionComponent(2.0 * np.pi * float(f), tuple(np.abs(a).tolist()),
+                                 tuple(np.angle(a).tolist()), None)
+                 for f, a in zip(np.asarray(frequency, float), amplitude))
+
+
+def scan_speeds(settings, components, phases):
+    """Vh [m s-1] of the gate's scan under `components` with the unit phase vectors
+    `phases` (n, K, 2) (the compiled model), every other input at its mean."""
+    from uq.physics.measurement import measurement_model
+    scene = motion_scene(settings, components)
+    fixed = _mean_errors(settings, scene)
+    return np.real(measurement_model(scene, ("wind_speed",), motion_phases=phases,
+                                     **fixed)["wind_speed"])[:, 0]
+
+
+#: The motion's own inputs: the phases the derivatives are taken in (every other input,
+#: the INS's sampling offset among them, is held at its mean, where the GUM linearises).
+PHASE_INPUTS = ("motion_phases", "motion_window")
+
+
+def _mean_errors(settings, scene):
+    """Every input of the scene but the phases at its mean (floats): the bias an error
+    declares, zero otherwise; the INS's sampling offset half its period."""
+    from uq.pipeline.modelsetup import error_inputs
+    from uq.engine.inputs import Input
+    out = {}
+    for name, spec in error_inputs(settings, scene.n_beams, 1).items():
+        if name in PHASE_INPUTS:
+            continue
+        dist = spec.distribution if isinstance(spec, Input) else spec
+        out[name] = dist if isinstance(dist, float) else float(dist.mean())
+    return out
+
+
+def motion_jacobian(settings, frequency, amplitude):
+    """``dVh/dc_1 + i dVh/dc_2`` [m s-1] of each component (frequencies [Hz] (K,),
+    complex amplitudes (K, 6)) at rest (c = 0), shape (K,): central differences of the
+    compiled model, one component moved at a time (:data:`MOTION_CHUNK` components a
+    call)."""
+    return np.concatenate([_jacobian(settings, frequency[i:i + MOTION_CHUNK],
+                                     amplitude[i:i + MOTION_CHUNK])
+                           for i in range(0, len(frequency), MOTION_CHUNK)]) \
+        if len(frequency) else np.zeros(0, complex)
+
+
+def _jacobian(settings, frequency, amplitude):
+    components = components_of(frequency, amplitude)
+    count = len(components)
+    phases = np.zeros((4 * count, count, 2))
+    index = np.arange(count)
+    for sign, offset in ((1.0, 0), (-1.0, 1)):
+        phases[4 * index + offset, index, 0] = sign * RESPONSE_STEP
+        phases[4 * index + 2 + offset, index, 1] = sign * RESPONSE_STEP
+    speed = scan_speeds(settings, components, phases)
+    first = (speed[0::4] - speed[1::4]) / (2 * RESPONSE_STEP)
+    second = (speed[2::4] - speed[3::4]) / (2 * RESPONSE_STEP)
+    return first + 1j * second
+
+
+def motion_shift(settings, frequency, amplitude):
+    """The phase-averaged second-order change of Vh [m s-1] under each component alone
+    (frequencies [Hz] (K,), complex amplitudes (K, 6)): ``(mean over the phases of
+    Vh(s c) - Vh(0)) / s^2`` with s = :data:`CURVATURE_SCALE`, :data:`CURVATURE_PHASES`
+    equally spaced phases (module constants): ``a^H G a`` at unit scale, G the Hermitian
+    form of the second derivatives averaged over the phase."""
+    return np.concatenate([_shift(settings, frequency[i:i + MOTION_CHUNK],
+                                  amplitude[i:i + MOTION_CHUNK])
+                           for i in range(0, len(frequency), MOTION_CHUNK)]) \
+        if len(frequency) else np.zeros(0)
+
+
+def _shift(settings, frequency, amplitude):
+    components = components_of(frequency, amplitude)
+    count, p = len(components), CURVATURE_PHASES
+    angle = 2.0 * np.pi * np.arange(p) / p
+    phases = np.zeros((count * p + 1, count, 2))
+    rows = np.arange(count * p)
+    which = rows // p
+    phases[rows, which, 0] = CURVATURE_SCALE * np.cos(angle[rows % p])
+    phases[rows, which, 1] = CURVATURE_SCALE * np.sin(angle[rows % p])
+    speed = scan_speeds(settings, components, phases)           # last row: at rest
+    return (speed[:-1].reshape(count, p).mean(axis=1) - speed[-1]) / CURVATURE_SCALE ** 2
+
+
+def scan_noise_variance(settings):
+    """The GUM variance [m2 s-2] of one scan's Vh from every input that is not the
+    motion (INS errors, radial noise, the probe's parameters), the platform at rest
+    (complex-step Jacobian, JCGM 100 Eq. 13 with the inputs' correlations)."""
+    from uq.engine.gum import combined_uncertainty, complex_step_jacobian
+    from uq.engine.inputs import input_set
+    from uq.physics.measurement import measurement_model
+    from uq.pipeline.modelsetup import MOTION_INPUTS, error_inputs
+    scene = motion_scene(settings)
+    inputs = {name: spec for name, spec in error_inputs(settings, scene.n_beams, 1).items()
+              if name not in MOTION_INPUTS}
+    layout = input_set(inputs)
+    if layout.dimension == 0:
+        return 0.0
+    _, jacobian = complex_step_jacobian(
+        lambda **errors: measurement_model(scene, ("wind_speed",), **errors), layout)
+    return float(combined_uncertainty(jacobian["wind_speed"], layout)[0] ** 2)
+
+
+# --- Monte Carlo records -----------------------------------------------------------------
+
+def monte_carlo_record(settings, rng):
+    """One Monte Carlo record of validated gate `settings` (with its ``motion`` and
+    ``turbulence``): Vh once a scan [m s-1], shape (n_scans,), and the field's u at the
+    reference point once a scan [m s-1] (:func:`uq.pipeline.records.monte_carlo_record`;
+    `rng` the record's generator)."""
+    from uq.pipeline.records import monte_carlo_record as record
+    from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
+    speed, reference = record(settings, scan_geometry(settings), scans_per_record(settings),
+                              rng)[:2]
+    return np.asarray(speed)[:, 0], np.asarray(reference)
+
+
+def scans_per_record(settings):
+    """Whole scans in one record of validated `settings` [1]."""
+    from uq.pipeline.turbulencesection import scans_per_record as scans
+    return scans(settings)
+
+
+def scan_period(settings):
+    """The scan's period [s] (beams times the beam duration)."""
+    from uq.pipeline.turbulencesection import beam_duration
+    lidar = settings["lidar"]
+    return (len(lidar["azimuths"]) + int(lidar["vertical_beam"])) * beam_duration(lidar)

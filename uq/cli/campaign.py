@@ -1,0 +1,34 @@
+"""``uq campaign CONFIG [-o FOLDER] [--workers N | --scheduler ADDRESS]``."""
+from uq.cli.common import EXIT_OK
+
+
+def add_parser(commands):
+    campaign = commands.add_parser(
+        "campaign", help="correct a floating lidar's ten-minute records for the platform's "
+        "motion and the lidar's filtering: each record's TI with its uncertainty and 95 %% "
+        "interval, the mean speed, per-bin errors against a reference, and a report")
+    campaign.add_argument("config", help="campaign configuration (YAML with a 'campaign' "
+                          "section), or the name of a shipped one, e.g. campaign_buoy")
+    campaign.add_argument("-o", "--output", help="output folder (default results/<name>/)")
+    scale = campaign.add_mutually_exclusive_group()
+    scale.add_argument("--workers", type=int, metavar="N",
+                       help="compute the model's tables and the records on a local dask "
+                       "cluster of N processes (needs the 'dask' extra); same numbers")
+    scale.add_argument("--scheduler", metavar="ADDRESS",
+                       help="... on the dask scheduler at ADDRESS (e.g. tcp://host:8786)")
+    campaign.set_defaults(handler=command)
+    return campaign
+
+
+def command(args):
+    import io
+    import sys
+    from uq.campaign.command import run_campaign
+    from uq.cli.run import check_scale_out, dask_client
+    from uq.pipeline.shipped import scenario_path
+    config = scenario_path(args.config)
+    check_scale_out(args)
+    with dask_client(args) as client:
+        run_campaign(config, args.output, stream=io.StringIO() if args.quiet else sys.stdout,
+                     client=client)
+    return EXIT_OK
