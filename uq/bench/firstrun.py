@@ -44,7 +44,7 @@ def _timed(command, env):
 def _wait_for_background(cache):
     """Wait until the background compile of numba's cache in `cache` has ended; the
     seconds waited."""
-    from uq.cli.firstrun import wait_for_background
+    from uq.compileguard import wait_for_background
     started = time.perf_counter()
     wait_for_background(cache)
     return time.perf_counter() - started
