@@ -242,3 +242,20 @@ def test_a_child_s_peak_is_its_own_not_its_parents():
     parent = np.ones(80_000_000)                       # 640 MB, touched
     cpu, megabytes = targets.child_usage(["list"])
     assert parent[-1] == 1.0 and 0 < megabytes < 500 and cpu > 0, megabytes
+
+
+def test_every_shipped_file_is_timed_with_the_command_that_runs_it(tmp_path):
+    """A golden or campaign configuration is not a scenario: `uq run` refuses it (the
+    full bench stopped at the shipped campaign). Each shipped file's command is the one
+    its top-level section names, and that command validates it (`uq check` reads all
+    three kinds)."""
+    from uq.bench.targets import _command
+    from uq.cli import main
+    from uq.pipeline.shipped import shipped_names
+    kinds = {name: _command(name, str(tmp_path))[0] for name in shipped_names()}
+    assert kinds["golden_campaign"] == "golden" and kinds["campaign_buoy"] == "campaign"
+    assert kinds["rubio2022_case_i"] == "run"
+    assert set(kinds.values()) == {"run", "golden", "campaign"}
+    for name, kind in kinds.items():
+        if kind != "run":
+            assert main(["check", name, "-q"]) == 0, name
