@@ -231,6 +231,11 @@ def test_held_out_dbs_ratios_against_an_independent_integration(held_out, height
     # spectral path's error estimate with them bounds the difference
     difference = abs(ours.ratios()[0, 0] - independent[0])
     assert difference <= 6e-3 * independent[0]
+    if height < 200.0:
+        # 40 and 100 m, where the former log-polar grid was resolved: within 0.1 % of the
+        # independent integration (measured 7e-5; the former grid read 100 m 0.17 % low,
+        # 40 m 0.03 %: that grid's error, not a change of the physics)
+        assert difference <= 1e-3 * independent[0]
     assert difference <= ours.ratio_errors()[0, 0] + 3e-4 * independent[0]
     # Sathe et al. (2011): a pulsed DBS removes 5-45 % of the u-variance
     assert 0.55 < ours.ratios()[0, 0] < 0.95

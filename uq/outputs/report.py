@@ -36,6 +36,7 @@ from uq.outputs.labels import QUANTITIES as LABEL_QUANTITIES
 from uq.outputs.scenes import (gate_words, scene_count, scene_indices, scene_values,
                                swept_keys, where_text)
 from uq.pipeline.metadata import QUANTITIES
+from uq.pipeline.metadata import TI_NAMES as METADATA_TI_NAMES
 
 #: Units as the report's text writes them.
 HTML_UNITS = {"degree": "deg", "m s-1": "m/s", "1": "", "m": "m"}
@@ -52,24 +53,9 @@ _ZERO = f"{NUMERICAL_ZERO:.0e}".replace("e-0", "e-")
 #: with motion but no records: 6 %, a typical offshore value at hub height in moderate
 #: wind (IEC 61400-1 class C at 15 m/s is ~14 %; measured North Sea means are 5-8 %).
 DEFAULT_TRUE_TI = 0.06
-#: The turbulence intensities of record mode: variable -> (name, what it is).
-TI_NAMES = {
-    "turbulence.intensity": ("the field's point TI", "the scenario's input: sigma_u / U of "
-                             "the field at the reference point, over all time scales"),
-    "turbulence_intensity_true": ("the field's TI over a record", "what a ten-minute "
-                                  "record of the field at the reference point shows (its "
-                                  "slowest eddies fall outside the record): the TI the "
-                                  "lidar's is compared with"),
-    "turbulence_intensity_spectral": ("the lidar's apparent TI, spectral", "expected from "
-                                      "the spectral path: the filtered turbulence and each "
-                                      "scan's errors"),
-    "turbulence_intensity_mc_mean": ("the lidar's apparent TI, records", "the mean over the "
-                                     "Monte Carlo records (with the 2.5 and 97.5 % points "
-                                     "of the records)"),
-    "turbulence_intensity_true_mc_mean": ("the records' field TI", "the field's TI over a "
-                                          "record in those Monte Carlo records: what the "
-                                          "records' apparent TI is compared with"),
-}
+#: The turbulence intensities of record mode: variable -> (name, what it is); the same
+#: words as the result files' attributes.
+TI_NAMES = METADATA_TI_NAMES
 STYLE = """body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;color:#222}
 table{border-collapse:collapse;margin:.6em 0}td,th{border:1px solid #bbb;padding:3px 8px;
 font-size:90%;text-align:left}th{background:#eee}pre{background:#f6f6f6;padding:.8em;
@@ -365,7 +351,9 @@ def _record_ti(dataset):
             "<p>The lidar's apparent TI against the field's TI over a record, which it is "
             "compared with. The names:</p><ul>" + names + "</ul><p>\u201cSpectral vs "
             "records\u201d: the spectral expectation of TI^2 against the records' mean, in "
-            "standard errors of that mean (agree where |z| &le; 2). The variance ratios are "
+            "standard errors of that mean (agree where |z| is within the check's limit, "
+            "turbulence_intensity_spectral_z_limit: Student's t at 97.5 % with one degree "
+            "of freedom fewer than the records, a 5 % false-alarm rate). The variance ratios are "
             "the lidar's filtered variance of each wind component over the field's at the "
             "reference point (spectral path).</p>" + _table(header, rows))
 

@@ -135,13 +135,77 @@ ANCILLARY = {"mc_mean": ("mc_low", "mc_high", "mc_u", "mc_u_standard_error",
                            "gum_covariance")}
 
 
+#: The turbulence intensities of record mode, one name each: TI name -> (name, what it
+#: is). The report (:mod:`uq.outputs.report`), the summary's legend and the netCDF
+#: attributes (:func:`turbulence_intensity_attributes`) say the same words.
+TI_NAMES = {
+    "turbulence.intensity": ("the field's point TI", "the scenario's input: sigma_u / U of "
+                             "the field at the reference point, over all time scales"),
+    "turbulence_intensity_true": ("the field's TI over a record", "what a ten-minute "
+                                  "record of the field at the reference point shows (its "
+                                  "slowest eddies fall outside the record): the TI the "
+                                  "lidar's is compared with"),
+    "turbulence_intensity_spectral": ("the lidar's apparent TI, spectral", "expected from "
+                                      "the spectral path: the filtered turbulence and each "
+                                      "scan's errors"),
+    "turbulence_intensity_mc_mean": ("the lidar's apparent TI, records", "the mean over the "
+                                     "Monte Carlo records (with the 2.5 and 97.5 % points "
+                                     "of the records)"),
+    "turbulence_intensity_true_mc_mean": ("the records' field TI", "the field's TI over a "
+                                          "record in those Monte Carlo records: what the "
+                                          "records' apparent TI is compared with"),
+}
+#: Each record-mode variable (and the swept coordinate of ``turbulence.intensity``) ->
+#: the TI of :data:`TI_NAMES` it is or is a statistic of, and its wind component.
+TI_VARIABLES = {
+    "turbulence_intensity": ("turbulence.intensity", None),
+    "turbulence_intensity_true": ("turbulence_intensity_true", None),
+    "turbulence_intensity_true_error": ("turbulence_intensity_true", None),
+    "turbulence_intensity_v_true": ("turbulence_intensity_true", "lateral, v"),
+    "turbulence_intensity_w_true": ("turbulence_intensity_true", "vertical, w"),
+    "turbulence_intensity_spectral": ("turbulence_intensity_spectral", None),
+    "turbulence_intensity_spectral_error": ("turbulence_intensity_spectral", None),
+    "turbulence_intensity_spectral_turbulence": ("turbulence_intensity_spectral", None),
+    "turbulence_intensity_v_spectral": ("turbulence_intensity_spectral", "lateral, v"),
+    "turbulence_intensity_w_spectral": ("turbulence_intensity_spectral", "vertical, w"),
+    "turbulence_intensity_mc_mean": ("turbulence_intensity_mc_mean", None),
+    "turbulence_intensity_mc_u": ("turbulence_intensity_mc_mean", None),
+    "turbulence_intensity_mc_low": ("turbulence_intensity_mc_mean", None),
+    "turbulence_intensity_mc_high": ("turbulence_intensity_mc_mean", None),
+    "turbulence_intensity_v_mc_mean": ("turbulence_intensity_mc_mean", "lateral, v"),
+    "turbulence_intensity_w_mc_mean": ("turbulence_intensity_mc_mean", "vertical, w"),
+    "turbulence_intensity_true_mc_mean": ("turbulence_intensity_true_mc_mean", None),
+    "turbulence_intensity_v_true_mc_mean": ("turbulence_intensity_true_mc_mean",
+                                            "lateral, v"),
+    "turbulence_intensity_w_true_mc_mean": ("turbulence_intensity_true_mc_mean",
+                                            "vertical, w"),
+}
+
+
+def turbulence_intensity_attributes(variable, attributes):
+    """`attributes` (a dict with a ``long_name``) of a turbulence-intensity `variable` of
+    :data:`TI_VARIABLES` with its one name: the ``long_name`` led by the name (``"the
+    field's TI over a record: ..."``; a v or w component's said after it) and a
+    ``comment`` with the name and what it is (:data:`TI_NAMES`). Other variables'
+    attributes are returned unchanged."""
+    if variable not in TI_VARIABLES:
+        return dict(attributes)
+    key, component = TI_VARIABLES[variable]
+    name, meaning = TI_NAMES[key]
+    named = name if component is None else f"{name} ({component})"
+    return {**attributes, "long_name": f"{named}: {attributes['long_name']}",
+            "comment": f"{name}: {meaning}"}
+
+
 def swept_key_attributes(key, linked_to=None):
     """long_name and units (where it has one) of the coordinate of a swept scenario key
     (``wind.direction`` -> ``wind_direction``), or of a key linked to one."""
     long_name = f"swept scenario key {key}" if linked_to is None else \
         f"scenario key {key}, linked to the swept key {linked_to}"
     units = scenario_key_units(key)
-    return {"long_name": long_name, **({"units": units} if units else {})}
+    return turbulence_intensity_attributes(
+        key.replace(".", "_") if key in TI_NAMES else None,
+        {"long_name": long_name, **({"units": units} if units else {})})
 
 
 def scenario_key_units(key):

@@ -48,6 +48,7 @@ from scipy import signal
 from uq.physics.lidarspectral import lidar_variances, probe_transfer_for
 from uq.physics.spectraltensor import KaimalSpectra, mann_tensor_for_intensity
 from uq.pipeline import probesection
+from uq.pipeline.metadata import turbulence_intensity_attributes
 from uq.constants import KAIMAL_LENGTH_FACTOR as LENGTH_FACTORS_KAIMAL
 from uq.constants import (RECORD_BOX_SLAB_CELLS, RECORD_FFT_WORKERS, RECORD_SPECTRA_BYTES,
                           RECORD_MAX_BOX_CELLS,
@@ -163,6 +164,13 @@ RECORD_ATTRIBUTES = {
         "units": "1", "long_name": "Monte Carlo mean over records of the field's std(w) / "
         "mean(u) at the reference point, sampled once a scan"},
 }
+
+
+#: Each turbulence intensity carries its one name (the field's point TI, the field's TI
+#: over a record, the records' field TI, the lidar's apparent TI: spectral or records)
+#: in its long_name and comment, the report's words.
+RECORD_ATTRIBUTES = {name: turbulence_intensity_attributes(name, attributes)
+                     for name, attributes in RECORD_ATTRIBUTES.items()}
 
 
 def turbulence_model(turbulence, speed):
