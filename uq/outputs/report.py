@@ -142,9 +142,12 @@ def _records_table(dataset):
                    f"(Student's t of the run's records, 5 % false alarms); at this record "
                    f"count the check tells a "
                    f"relative difference of the TI of {', '.join(_number(100 * r) for r in resolution)} % "
-                   f"from none. The records' field keeps "
-                   f"{_number(float(data['turbulence_intensity_box_kept']))} of the field's "
-                   f"u-variance at the reference point over a record.</p>")
+                   f"from none. The turbulence box the lidar's beams read keeps "
+                   f"{_number(float(data['turbulence_intensity_box_kept']))} of the model's "
+                   f"u-variance over a record (the scales below its cells are drawn at the "
+                   f"reference point alone): the records' lidar TI^2 reads up to that "
+                   f"share low against the spectral path's, and the check may then say "
+                   f"the paths differ where the spectral path is right.</p>")
     if "turbulence_spectral_converged" in data and not bool(
             np.all(data["turbulence_spectral_converged"].values)):
         out.append("<p><b>The spectral path did not reach its tolerance</b>: its stated "

@@ -91,9 +91,11 @@ RECORD_ATTRIBUTES = {
         "check tells from none at this record count (half its TI^2 interval over the "
         "records' mean TI^2): a check that is to decide a difference needs it smaller"},
     "turbulence_intensity_box_kept": {
-        "units": "1", "long_name": "u-variance the records' field keeps at the reference "
-        "point of the model's over a record (the record's high-pass): the turbulence box's "
-        "discrete wavenumbers and the scales below its cells, drawn once a scan"},
+        "units": "1", "long_name": "u-variance the turbulence box keeps of the model's "
+        "over a record (the record's high-pass): what the lidar's beams read; the scales "
+        "below its cells are drawn once a scan at the reference point alone, so the "
+        "records' truth carries the model's variance and the lidar's records up to this "
+        "share less"},
     "wind_speed_record_bias": {
         "units": "m s-1", "long_name": "Monte Carlo mean over records of the record's mean "
         "horizontal wind speed minus the field's true mean"},
@@ -497,8 +499,9 @@ def reference_complement(settings, geometry, grid):
     their record variance about its mean is (1 - 1/N) of theirs). Returns the lower
     Cholesky factor of that covariance (3, 3), negative eigenvalues (the box holding
     more than the field: rounding) set to zero, and the u-variance the records' field
-    then keeps of the field's at the record's scales [1] (``turbulence_intensity_
-    box_kept``: the box's and the complement's over the field's, with the high-pass)."""
+    the box alone keeps of the field's at the record's scales [1] (``turbulence_intensity_
+    box_kept``: the box's over the field's, with the high-pass: what the lidar's beams
+    read, the complement being drawn at the reference point alone)."""
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
     if turbulence["model"] == "mann":
         return _mann_complement(grid, turbulence["length_scale"], turbulence["anisotropy"],
@@ -514,7 +517,9 @@ def _complement_factor(field, box, scans):
     missing = (vectors * np.maximum(values, 0.0)) @ vectors.T
     factor = np.linalg.cholesky(missing / max(1.0 - 1.0 / scans, 1e-12)
                                 + 1e-300 * np.eye(3))
-    return factor, float((box[0, 0] + missing[0, 0]) / field[0, 0])
+    # what the lidar's beams read: the box alone (the complement is drawn at the
+    # reference point only, where the records' truth is taken)
+    return factor, float(box[0, 0] / field[0, 0])
 
 
 @functools.lru_cache(maxsize=8)
