@@ -529,13 +529,13 @@ def scan_noise_variance(settings):
 def monte_carlo_record(settings, rng):
     """One Monte Carlo record of validated gate `settings` (with its ``motion`` and
     ``turbulence``): Vh once a scan [m s-1], shape (n_scans,), and the field's u at the
-    reference point once a scan [m s-1] (:func:`uq.pipeline.records.monte_carlo_record`;
-    `rng` the record's generator)."""
+    reference point once a scan [m s-1], shape (n_scans,), the mean speed included
+    (:func:`uq.pipeline.records.monte_carlo_record`'s
+    :class:`~uq.pipeline.records.RecordSeries`; `rng` the record's generator)."""
     from uq.pipeline.records import monte_carlo_record as record
     from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
-    speed, reference = record(settings, scan_geometry(settings), scans_per_record(settings),
-                              rng)[:2]
-    return np.asarray(speed)[:, 0], np.asarray(reference)
+    series = record(settings, scan_geometry(settings), scans_per_record(settings), rng)
+    return np.asarray(series.speed)[:, 0], np.asarray(series.reference)[:, 0]
 
 
 def scans_per_record(settings):
