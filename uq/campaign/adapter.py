@@ -353,10 +353,21 @@ class _Nodes:
 
 def _vector_terms(geometry, tensor, transfer):
     """(k1, weights, lidar terms, point terms, high-pass) of the vector path (many
-    beams: :func:`spectral_terms`), on the standard log-polar grid."""
-    from uq.physics.lidarspectral import _one_dimensional_spectra, _vector_sum
+    beams: :func:`spectral_terms`) on the log-polar grid the path accepts (its own
+    estimate and refinements: :func:`uq.physics.lidarspectral.mann_lidar_variances`);
+    the path takes the record's high-pass at the grid's k1 nodes, and so do the terms."""
+    from uq.constants import SPECTRAL_REFINEMENTS, SPECTRAL_TOLERANCE
+    from uq.physics.lidarspectral import (_one_dimensional_spectra, _refined_polar,
+                                          _relative_error, _vector_sum, _vector_variances,
+                                          mann_point_variances)
     from uq.physics.spectraltensor import WavenumberGrid
     grid = WavenumberGrid(tensor.length_scale)
+    true = mann_point_variances(geometry, tensor)[0]
+    for attempt in range(SPECTRAL_REFINEMENTS):
+        lidar, error = _vector_variances(geometry, tensor, transfer, grid)
+        if _relative_error(lidar, error, true) <= SPECTRAL_TOLERANCE:
+            break
+        grid = _refined_polar(grid)
     unfiltered = dataclasses.replace(geometry, record_duration=np.inf)
     k1, weight = grid.k1()
     lidar = np.stack([_vector_sum(unfiltered, tensor, transfer, _Nodes(grid, (node,)))[:, 0]
