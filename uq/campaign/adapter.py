@@ -41,7 +41,7 @@ variance ``|sum_d z_d conj(a_d)|^2 / 2 = z^H M z`` with ``M = a a^H / 2``.
 """
 import copy
 import dataclasses
-import math
+import functools
 
 import numpy as np
 
@@ -265,10 +265,8 @@ def _pair_level(geometry, tensor, transfer, level, coarse=False):
     (:class:`~uq.physics.lidarspectral.PairResolution`; `coarse`: two nodes fewer a
     panel, the path's error estimate)."""
     from uq.physics import spectralkernels, turbulencebox
-    from uq.physics.lidarspectral import (_colocated_pairs, _one_dimensional_spectra,
-                                          _pair_separations)
+    from uq.physics.lidarspectral import _pair_separations
     from uq.physics.spectralquadrature import PanelRule, geometric_edges, record_weights
-    from uq.physics.spectraltensor import WavenumberGrid
     length = tensor.length_scale
     first, second, delta = _pair_separations(geometry)
     colocated = None
@@ -303,11 +301,9 @@ def _pair_level(geometry, tensor, transfer, level, coarse=False):
         # beyond rule1 (the tail) the probes pass nothing: 0
         pairs[..., :rule1.size] = 2.0 * (sums * rule1.filon(delta[..., 0])).real
     directions = np.asarray(geometry.directions, dtype=float)
-    grid = WavenumberGrid(length, radius_per_decade=8 if coarse else 12,
-                          angle_nodes=48 if coarse else 64)
-    spectra = tensor.alpha_epsilon * np.concatenate(
-        [_one_dimensional_spectra(_unit_tensor(tensor), grid, k1[s:s + 12])
-         for s in range(0, k1.size, 12)])                                # (n, 3, 3)
+    spectra = tensor.alpha_epsilon * _unit_point_spectra(
+        length, tensor.anisotropy, tuple(np.concatenate([r.edges for r in rules])), order,
+        (8, 48) if coarse else (12, 64))                                  # (n, 3, 3)
     if colocated is not None and colocated.any():     # point probes: the whole rule
         dwell = np.sinc(k1 * geometry.speed * geometry.dwell / (2 * np.pi)) ** 2
         same = np.einsum("pi,nij,pj->pn", directions[first], spectra,
@@ -323,6 +319,29 @@ def _pair_level(geometry, tensor, transfer, level, coarse=False):
         record_weights(r, 0.0, geometry.speed, geometry.scan_period,
                        geometry.record_duration).real / r.weights for r in rules])
     return k1, weight, lidar, point, high_pass
+
+
+@functools.lru_cache(maxsize=32)
+def _unit_point_spectra(length, anisotropy, edges, order, cross_section):
+    """The 1-D cross-spectra (n, 3, 3) [m3 s-2] of the Mann tensor of unit alpha
+    eps^(2/3), scale `length` [m] and `anisotropy`, at the nodes of the panels `edges`
+    (the rules of :func:`_pair_level`, concatenated; `order` nodes each) on the log-polar
+    cross-section (radial nodes a decade, angles) of ``mann_point_variances``: a function
+    of these alone, so kept per process (a campaign's gates share L and Gamma whatever
+    the wind)."""
+    from uq.physics.lidarspectral import _one_dimensional_spectra
+    from uq.physics.spectralquadrature import PanelRule
+    from uq.physics.spectraltensor import MannTensor, WavenumberGrid
+    edges = np.asarray(edges)
+    breaks = np.flatnonzero(np.diff(edges) <= 0) + 1           # where a rule starts again
+    k1 = np.concatenate([PanelRule(part, order).nodes for part in np.split(edges, breaks)])
+    grid = WavenumberGrid(length, radius_per_decade=cross_section[0],
+                          angle_nodes=cross_section[1])
+    tensor = MannTensor(length, anisotropy)
+    out = np.concatenate([_one_dimensional_spectra(tensor, grid, k1[s:s + 12])
+                          for s in range(0, k1.size, 12)])
+    out.flags.writeable = False
+    return out
 
 
 def _unit_tensor(tensor):
