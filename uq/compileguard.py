@@ -13,6 +13,10 @@ The test is numba's own: its ``numba:compile`` event (the documented event API,
 index (wrong source stamp, numba version, CPU or signature) and before it compiles; the
 listener raises there, which ends that compile before it starts. A kernel found in the
 cache loads as usual. Imports numba only when entered.
+
+The lock of the background compile of a numba cache (:func:`lock_path`, one per cache
+folder and user; :mod:`uq.cli.firstrun` takes it) is here too, so that whatever waits
+for that compile (``uq bench``, CI) needs no command-line module.
 """
 import contextlib
 import threading
@@ -62,3 +66,33 @@ def _kernel_name(data):
     """'module.function' of a compile event's data."""
     function = getattr(data.get("dispatcher"), "py_func", None)
     return f"{function.__module__}.{function.__name__}" if function else "a kernel"
+
+
+def lock_path(folder=None):
+    """The lock file of the background compile of numba's cache in `folder` (default:
+    this process's, ``NUMBA_CACHE_DIR`` or beside the code): one per cache folder and
+    user, in the temporary folder."""
+    import hashlib
+    import os
+    import tempfile
+    if folder is None:
+        import numba
+        folder = numba.config.CACHE_DIR or os.path.dirname(os.path.abspath(__file__))
+    digest = hashlib.sha256(os.path.abspath(folder).encode()).hexdigest()[:16]
+    return os.path.join(tempfile.gettempdir(), f"uq-compile-{os.getuid()}-{digest}.lock")
+
+
+def wait_for_background(folder=None):
+    """Wait until no background compile of numba's cache in `folder` (default this
+    process's) holds its lock, i.e. until one running has ended; returns at once when
+    none runs."""
+    import fcntl
+    import os
+    try:
+        handle = os.open(lock_path(folder), os.O_RDWR | os.O_CREAT, 0o600)
+    except OSError:
+        return
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX)                 # blocks while one compiles
+    finally:
+        os.close(handle)

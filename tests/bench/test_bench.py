@@ -203,8 +203,10 @@ def test_the_record_count_of_the_shipped_record_scenarios():
     counts = {name: records.record_count(load_scenario(scenario_path(name)))
               for name in records.SCENARIOS}
     assert counts == {"sathe2011_ti": 8, "sathe2011_ti_cw": 4, "floating_lidar_ti": 60}
-    calm = load_scenario(scenario_path("sathe2011_ti"), {"sweep.wind.speed": [0.0, 8.0]})
-    assert records.record_count(calm) == 8                   # the calm scene has none
+    # a sweep of two wind speeds: each scene its records (a calm scene, wind.speed 0, is
+    # refused at validation: a frozen field needs a mean wind)
+    two = load_scenario(scenario_path("sathe2011_ti"), {"sweep.wind.speed": [6.0, 8.0]})
+    assert records.record_count(two) == 16
 
 
 def test_the_first_run_figures_name_the_worst(monkeypatch):
@@ -240,3 +242,20 @@ def test_a_child_s_peak_is_its_own_not_its_parents():
     parent = np.ones(80_000_000)                       # 640 MB, touched
     cpu, megabytes = targets.child_usage(["list"])
     assert parent[-1] == 1.0 and 0 < megabytes < 500 and cpu > 0, megabytes
+
+
+def test_every_shipped_file_is_timed_with_the_command_that_runs_it(tmp_path):
+    """A golden or campaign configuration is not a scenario: `uq run` refuses it (the
+    full bench stopped at the shipped campaign). Each shipped file's command is the one
+    its top-level section names, and that command validates it (`uq check` reads all
+    three kinds)."""
+    from uq.bench.targets import _command
+    from uq.cli import main
+    from uq.pipeline.shipped import shipped_names
+    kinds = {name: _command(name, str(tmp_path))[0] for name in shipped_names()}
+    assert kinds["golden_campaign"] == "golden" and kinds["campaign_buoy"] == "campaign"
+    assert kinds["rubio2022_case_i"] == "run"
+    assert set(kinds.values()) == {"run", "golden", "campaign"}
+    for name, kind in kinds.items():
+        if kind != "run":
+            assert main(["check", name, "-q"]) == 0, name

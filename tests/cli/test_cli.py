@@ -143,8 +143,7 @@ def test_every_help_prints(capsys):
     """uq --help and every command's --help: argparse formats each help text with %, so
     a bare % in one (a '95 % interval') breaks every help that lists it."""
     from uq.cli import SUBCOMMANDS, main
-    names = [module.__name__.rsplit(".", 1)[1] for module in SUBCOMMANDS]
-    names = ["list" if name == "listing" else name for name in names]
+    names = ["list" if name == "listing" else name for name in SUBCOMMANDS]
     for argv in [["--help"]] + [[name, "--help"] for name in names]:
         with pytest.raises(SystemExit) as raised:
             main(argv)

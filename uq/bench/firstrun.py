@@ -19,6 +19,8 @@ import time
 
 import numpy as np
 
+from uq.pipeline.shipped import shipped_command
+
 #: Variables compared between the first and the second run (each output's).
 COMPARED = ("mc_mean", "mc_u", "mc_low", "mc_high")
 #: Outputs compared (speed, direction as arc length at the scene's speed is not needed:
@@ -27,10 +29,8 @@ COMPARED_OUTPUTS = ("wind_speed", "vertical_wind")
 
 
 def _command(name, folder):
-    from uq.bench.targets import uq_command
-    if name.startswith("golden_campaign"):
-        return uq_command() + ["golden", name, "-o", os.path.join(folder, name), "-q"]
-    return uq_command() + ["run", name, "-o", os.path.join(folder, f"{name}.nc"), "-q"]
+    from uq.bench.targets import _command as command, uq_command
+    return uq_command() + command(name, folder)
 
 
 def _timed(command, env):
@@ -44,7 +44,7 @@ def _timed(command, env):
 def _wait_for_background(cache):
     """Wait until the background compile of numba's cache in `cache` has ended; the
     seconds waited."""
-    from uq.cli.firstrun import wait_for_background
+    from uq.compileguard import wait_for_background
     started = time.perf_counter()
     wait_for_background(cache)
     return time.perf_counter() - started
@@ -52,8 +52,7 @@ def _wait_for_background(cache):
 
 def _results(name, folder):
     import xarray as xr
-    path = os.path.join(folder, name, f"{name}.nc") if name.startswith("golden") else \
-        os.path.join(folder, f"{name}.nc")
+    path = os.path.join(folder, f"{name}.nc")
     with xr.open_dataset(path) as dataset:
         return dataset.load()
 
@@ -75,7 +74,7 @@ def first_run(name):
             if kind == "cold":
                 out["background_after_s"] = _wait_for_background(cache)
         out["over_warm_s"] = out["cold_s"] - out["warm_s"]
-        if not name.startswith("golden"):
+        if shipped_command(name) == "run":            # a folder's file has other names
             cold, warm = (_results(name, os.path.join(folder, k)) for k in ("cold", "warm"))
             out["warm_compiled"] = "model" not in warm.attrs
             out["cold_numpy"] = cold.attrs.get("model", "").startswith("numpy")

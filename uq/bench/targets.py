@@ -164,10 +164,13 @@ def process_start(repeats=3):
 
 
 def _command(name, folder):
-    """The command a user runs for shipped scenario `name` (golden configurations run
-    with ``uq golden``), writing into `folder`."""
-    if name.startswith("golden_campaign"):
-        return ["golden", name, "-o", os.path.join(folder, name), "-q"]
+    """The command a user runs for shipped scenario `name` (golden and campaign
+    configurations run with ``uq golden`` and ``uq campaign`` into a folder), writing
+    into `folder`."""
+    from uq.pipeline.shipped import shipped_command
+    kind = shipped_command(name)
+    if kind != "run":
+        return [kind, name, "-o", os.path.join(folder, name), "-q"]
     return ["run", name, "-o", os.path.join(folder, f"{name}.nc"), "-q"]
 
 

@@ -30,6 +30,8 @@ import subprocess
 import sys
 import tempfile
 
+from uq.compileguard import lock_path, wait_for_background  # noqa: F401 (public here too)
+
 #: The environment variable that turns the background compile off ("0"): the run then
 #: compiles what it calls in its own process first (``--model compiled``).
 BACKGROUND_VARIABLE = "UQ_BACKGROUND_COMPILE"
@@ -48,18 +50,6 @@ def wanted(args):
             and getattr(args, "workers", None) is None
             and getattr(args, "scheduler", None) is None
             and available_memory_mb() >= SIDE_COMPILE_MIN_AVAILABLE_MB)
-
-
-def lock_path(folder=None):
-    """The lock file of the background compile of numba's cache in `folder` (default:
-    this process's, ``NUMBA_CACHE_DIR`` or beside the code): one per cache folder and
-    user, in the temporary folder."""
-    import hashlib
-    if folder is None:
-        import numba
-        folder = numba.config.CACHE_DIR or os.path.dirname(os.path.dirname(__file__))
-    digest = hashlib.sha256(os.path.abspath(folder).encode()).hexdigest()[:16]
-    return os.path.join(tempfile.gettempdir(), f"uq-compile-{os.getuid()}-{digest}.lock")
 
 
 def _take_lock():
@@ -84,20 +74,6 @@ def compile_running():
         return True
     os.close(handle)                      # (closing releases it)
     return False
-
-
-def wait_for_background(folder=None):
-    """Wait until no background compile of numba's cache in `folder` (default this
-    process's) holds its lock, i.e. until one running has ended; returns at once when
-    none runs."""
-    try:
-        handle = os.open(lock_path(folder), os.O_RDWR | os.O_CREAT, 0o600)
-    except OSError:
-        return
-    try:
-        fcntl.flock(handle, fcntl.LOCK_EX)                 # blocks while one compiles
-    finally:
-        os.close(handle)
 
 
 class Background:

@@ -35,6 +35,7 @@ import numpy as np
 from uq.constants import (COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG,
                           ONE_PASS_MIN_TRIALS, STORED_VALUES)
 from uq.engine.orderstats import order_statistics
+from uq.engine.statnumpy import unwrap  # noqa: F401 (public here, as before)
 
 INTERVALS = ("symmetric", "shortest")
 
@@ -57,12 +58,6 @@ def _pass_kernels():
     compile, ~2 s after an install, is for runs of ONE_PASS_MIN_TRIALS and more)."""
     from uq.engine import passkernels
     return passkernels
-
-
-def unwrap(values, reference):
-    """Angles [deg] moved by whole turns into (reference - 180, reference + 180]."""
-    return reference - np.mod(reference - values + HALF_CIRCLE_DEG, FULL_CIRCLE_DEG) \
-        + HALF_CIRCLE_DEG
 
 
 def circular_mean_deg(values, axis=0):

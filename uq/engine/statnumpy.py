@@ -19,7 +19,14 @@ store-then-select path, whose results the one-pass batches reproduce.
 """
 import numpy as np
 
-from uq.engine.statistics import unwrap
+from uq.constants import FULL_CIRCLE_DEG, HALF_CIRCLE_DEG
+
+
+def unwrap(values, reference):
+    """Angles [deg] moved by whole turns into (reference - 180, reference + 180]."""
+    return reference - np.mod(reference - values + HALF_CIRCLE_DEG, FULL_CIRCLE_DEG) \
+        + HALF_CIRCLE_DEG
+
 
 #: Values per side of the scratch :func:`select_pairs` needs: none (numpy's partition
 #: makes its own copies; the argument is kept for the kernels' call signature).

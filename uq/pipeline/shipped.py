@@ -32,6 +32,15 @@ def shipped_names():
     return sorted(path.stem for path in shipped_folder().glob(f"*{SUFFIX}"))
 
 
+def shipped_command(name):
+    """The ``uq`` command that runs the shipped file `name`: ``golden`` for a golden-lidar
+    configuration (a top-level ``golden`` section), ``campaign`` for a campaign
+    configuration (``campaign``), else ``run`` (a scenario)."""
+    import yaml
+    raw = yaml.safe_load(shipped_path(name).read_text()) or {}
+    return next((kind for kind in ("golden", "campaign") if kind in raw), "run")
+
+
 def shipped_path(name):
     """Path of the shipped scenario `name` (with or without ``.yaml``)."""
     return shipped_folder() / (name if name.endswith(SUFFIX) else name + SUFFIX)
