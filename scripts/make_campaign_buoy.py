@@ -18,7 +18,6 @@ import numpy as np
 import pandas as pd
 
 from uq.campaign import synthetic
-from uq.pipeline import records as pipeline_records
 from uq.pipeline.scenario import load_scenario
 
 
@@ -37,9 +36,6 @@ def main(argv=None):
     partial = folder / f"records.partial.{index}.csv"
     done = _read(partial, table) if partial.exists() else None
     started = time.time()
-    # The box's kept share of the variance (a diagnostic of uq run's records, 1.3 s a
-    # record here) does not enter a record's values: not computed.
-    pipeline_records._unit_kept = lambda settings, grid: np.nan
 
     def report(made, total, out):
         if made % 5 == 0 or made == total:

@@ -96,18 +96,54 @@ def test_the_scan_noise_variance_is_the_pipelines_gum_at_rest():
 
 def test_the_terms_summed_are_the_spectral_paths_record_variances():
     """The node-by-node terms, summed with the record's high-pass, give the spectral
-    path's own variances (uq.pipeline.records.spectral_variances) to its pruning
-    (points below 1e-10 of the trace, chosen per call: 1e-6 relative)."""
+    path's own variances (uq.pipeline.records.spectral_variances). The lidar's terms are
+    the path's own pair sums on its own rule; they differ from it only where the path
+    integrates each pair's phase exp(i k1 delta_x) across the record's peaks (the terms
+    carry the high-pass of delta = 0): over the mean's peak (width 2 pi / (U T) = 1.3e-3
+    rad/m) a separation of <= 100 m turns the phase by < 0.13 rad, and the peaks hold a
+    few % of the variance, so <= 2e-4 relative is allowed (3.5e-5 measured). The point's
+    terms are its 1-D spectrum on that rule (from 0) where the path's point rule starts
+    at 1e-6 / L: 1e-5 measured, 5e-5 allowed. Without the high-pass (an infinite record)
+    the lidar's terms are the path's sums on the same rule: 1e-9 (rounding of sums of
+    ~1e2 terms of both signs)."""
+    import dataclasses
+    from uq.physics.lidarspectral import mann_lidar_variances, probe_transfer_for
+    from uq.pipeline import probesection
+    from uq.pipeline.records import spectral_variances, turbulence_model
+    from uq.pipeline.turbulencesection import scan_geometry, slant_ranges
     settings = adapter.gate_settings(LIDAR, [40.0, 80.0], TURBULENCE, 600.0, 8.0, 120.0)
     terms = adapter.spectral_terms(settings)
-    from uq.pipeline.records import spectral_variances
     direct = spectral_variances(settings)[0]
     for gate in range(2):
         lidar, point = spectra.record_variances(terms.gate(gate))
-        assert lidar == pytest.approx(direct.lidar[gate, 0], rel=1e-6)
-        assert point == pytest.approx(direct.true[0], rel=1e-12)
+        assert lidar == pytest.approx(direct.lidar[gate, 0], rel=2e-4)
+        assert point == pytest.approx(direct.true[0], rel=5e-5)
     np.testing.assert_allclose([spectra.filtering_factor(terms.gate(g)) for g in range(2)],
-                               adapter.spectral_ratio(settings), rtol=1e-6)
+                               adapter.spectral_ratio(settings), rtol=2.5e-4)
+    geometry = dataclasses.replace(scan_geometry(settings), record_duration=np.inf)
+    infinite = mann_lidar_variances(
+        geometry, turbulence_model(settings["turbulence"], settings["wind"]["speed"]),
+        probe_transfer_for(probesection.make_probe(settings["lidar"]["probe"]),
+                           slant_ranges(settings["lidar"])))
+    np.testing.assert_allclose(terms.lidar.sum(axis=0), infinite.lidar[:, 0], rtol=1e-9)
+    assert np.all(terms.high_pass[terms.k1 > 100 / (8.0 * 600.0)] > 0.9)   # beyond the peak
+
+
+def test_a_vads_terms_summed_are_its_spectral_paths_record_variances():
+    """Many beams (a CW VAD of 50 lines of sight): the path's vector sums on its log-polar
+    grid, one k1 node at a time, with the high-pass at the nodes as the path takes it:
+    the lidar's sum is the path's to rounding (1e-10 allowed; 2e-13 measured). The
+    point's terms are its 1-D spectrum at the grid's k1 nodes (12 a decade, the
+    high-pass at the nodes) where the path integrates it on Gauss-Legendre panels with
+    the record's peaks resolved: 3.9e-5 measured, 2e-4 allowed (the nodes' sampling of
+    the mean's peak, ~1e-3 of the few % of the variance it holds)."""
+    from uq.pipeline.records import spectral_variances
+    cw = load_scenario(ROOT / "scenarios" / "sathe2011_ti_cw.yaml").settings
+    settings = adapter.gate_settings(cw, [80.0], TURBULENCE, 600.0, 10.0, 270.0)
+    lidar, point = spectra.record_variances(adapter.spectral_terms(settings).gate(0))
+    direct = spectral_variances(settings)[0]
+    assert lidar == pytest.approx(direct.lidar[0, 0], rel=1e-10)
+    assert point == pytest.approx(direct.true[0], rel=2e-4)
 
 
 def test_a_lidar_that_is_a_point_does_not_filter():

@@ -41,7 +41,7 @@ variance ``|sum_d z_d conj(a_d)|^2 / 2 = z^H M z`` with ``M = a a^H / 2``.
 """
 import copy
 import dataclasses
-import math
+import functools
 
 import numpy as np
 
@@ -164,6 +164,11 @@ class SpectralTerms:
         Mean speed [m s-1]; ``f = k1 U / (2 pi)``.
     scan_period, record_duration : float
         [s].
+    high_pass : ndarray, shape (n,), optional
+        Each node's share of the record's high-pass ``1 - |D_N(f)|^2`` [1]: the weight
+        of the node in the spectral path's record integral over its weight without the
+        high-pass (:func:`spectral_terms`); None: the high-pass at the node
+        (:func:`record_high_pass`).
     """
 
     k1: np.ndarray
@@ -173,6 +178,7 @@ class SpectralTerms:
     speed: float
     scan_period: float
     record_duration: float
+    high_pass: np.ndarray = None
 
     @property
     def frequency(self):
@@ -184,10 +190,170 @@ class SpectralTerms:
         return dataclasses.replace(self, lidar=np.asarray(self.lidar)[:, index])
 
 
+def spectral_terms(settings):
+    """:class:`SpectralTerms` of validated gate `settings` (:func:`gate_settings`): the
+    spectral path (:func:`uq.physics.lidarspectral.mann_lidar_variances`) per node of
+    its own k1 rule, without the record's high-pass.
+
+    A few beams (a DBS): the path integrates each beam pair's ``exp(i k . delta)`` on
+    Cartesian Gauss-Legendre panels with Filon weights (k2, k3 in its compiled kernel,
+    then k1). Here the kernel's (k2, k3) sums are taken as the path takes them, at the
+    nodes of its k1 rule, and each k1 node's term is the pair's sum times the node's
+    Filon weight in k1 (no high-pass): summed, the terms are the path's variance of an
+    infinite record exactly. The record's high-pass is carried as each node's share of
+    the path's record weights (:func:`~uq.physics.spectralquadrature.record_weights` at
+    zero separation over the Filon weights: ``high_pass``), so that the terms summed
+    with it are the path's record variances (to the phase of the pairs inside the
+    record's peaks: tested against :func:`uq.pipeline.records.spectral_variances`). The
+    rule is the path's first that meets :data:`~uq.constants.SPECTRAL_TOLERANCE`
+    (the same estimate: two nodes fewer a panel), refined as the path refines it. The
+    point's terms are its 1-D spectrum at the same nodes, the rule continued to the
+    path's ``10^6 / L`` (the lidar's terms there are 0: beyond its probe's reach).
+
+    Many beams (a VAD): the log-polar grid's k1 nodes, one call of the path's vector
+    sums a node (the path's own chunks of k1), the high-pass at the nodes."""
+    from uq.physics.lidarspectral import PAIR_BEAMS, as_transfer, probe_transfer_for
+    from uq.pipeline import probesection
+    from uq.pipeline.records import turbulence_model
+    from uq.pipeline.turbulencesection import scan_geometry, slant_ranges
+    geometry = scan_geometry(settings)
+    lidar = settings["lidar"]
+    tensor = turbulence_model(settings["turbulence"], settings["wind"]["speed"])
+    if not hasattr(tensor, "anisotropy"):
+        raise ValueError("campaign: the spectral terms need the Mann tensor "
+                         "(turbulence.model: mann)")
+    transfer = as_transfer(probe_transfer_for(probesection.make_probe(lidar.get("probe")),
+                                              slant_ranges(lidar)),
+                           geometry.n_gates, tensor.length_scale)
+    if geometry.n_beams <= PAIR_BEAMS:
+        k1, weight, lidar_terms, point_terms, high = _pair_terms(geometry, tensor, transfer)
+    else:
+        k1, weight, lidar_terms, point_terms, high = _vector_terms(geometry, tensor, transfer)
+    return SpectralTerms(k1, lidar_terms, point_terms, weight, geometry.speed,
+                         geometry.scan_period, geometry.record_duration, high)
+
+
+def _pair_terms(geometry, tensor, transfer):
+    """(k1, weights, lidar terms (n, n_gates), point terms (n,), high-pass (n,)) of the
+    beam-pair path (:func:`spectral_terms`)."""
+    from uq.constants import SPECTRAL_REFINEMENTS, SPECTRAL_TOLERANCE
+    from uq.physics.lidarspectral import PAIR_ERROR_FLOOR, PairResolution
+    length = tensor.length_scale
+    level = PairResolution()
+    for attempt in range(SPECTRAL_REFINEMENTS + 1):
+        found = _pair_level(geometry, tensor, transfer, level)
+        fine = _summed(found, found[4])
+        coarse_found = _pair_level(geometry, tensor, transfer, level, coarse=True)
+        coarse = _summed(coarse_found, coarse_found[4])
+        lidar_fine, point_fine = fine
+        error = np.maximum(np.abs(lidar_fine - coarse[0]), PAIR_ERROR_FLOOR * np.abs(lidar_fine))
+        if np.max(error / np.maximum(np.abs(lidar_fine), 0.05 * point_fine)) \
+                <= SPECTRAL_TOLERANCE or attempt == SPECTRAL_REFINEMENTS:
+            return found
+        level = level.refined()
+    return found                                                   # pragma: no cover
+
+
+def _summed(found, high):
+    """(lidar (n_gates,), point) record variances of :func:`_pair_level`'s terms."""
+    _, _, lidar, point, _ = found
+    return np.einsum("ng,n->g", lidar, high), float(np.sum(point * high))
+
+
+def _pair_level(geometry, tensor, transfer, level, coarse=False):
+    """The beam-pair path's terms per k1 node on the rules of `level`
+    (:class:`~uq.physics.lidarspectral.PairResolution`; `coarse`: two nodes fewer a
+    panel, the path's error estimate)."""
+    from uq.physics import spectralkernels, turbulencebox
+    from uq.physics.lidarspectral import _pair_separations
+    from uq.physics.spectralquadrature import PanelRule, geometric_edges, record_weights
+    length = tensor.length_scale
+    first, second, delta = _pair_separations(geometry)
+    colocated = None
+    if np.isfinite(transfer.reach):        # as uq.physics.lidarspectral._pair_variances
+        high = max(1e3, min(1e6, transfer.reach * length))
+    else:
+        distance = np.linalg.norm(delta, axis=-1)
+        colocated = distance <= length * 1e-3
+        apart = distance[~colocated]
+        high = 1e3 if apart.size == 0 else float(np.clip(100 * length / apart.min(), 10, 1e3))
+    order = max(1, level.order - 2) if coarse else level.order
+    rule1, rule2, rule3 = level.rules(length, high, order)
+    # the point's rule: the lidar's continued to 10^6 / L (mann_point_variances' reach)
+    tail = PanelRule(geometric_edges(high / length, 1e6 / length, level.per_decade,
+                                     zero=False), order) if high < 1e6 else None
+    rules = [rule1] if tail is None else [rule1, tail]
+    k1 = np.concatenate([r.nodes for r in rules])
+    weight = 2.0 * np.concatenate([r.weights for r in rules])     # k1 > 0, doubled
+    pairs = np.zeros((geometry.n_gates, first.size, k1.size))
+    if colocated is None or not colocated.all():
+        sums = np.zeros((geometry.n_gates, first.size, rule1.size), dtype=complex)
+        table = turbulencebox._TABLE
+        spectralkernels.pair_sums(
+            rule1.nodes, rule2.nodes, rule3.nodes, tensor.alpha_epsilon, length,
+            tensor.anisotropy, float(table[0][0]), float(table[0][1] - table[0][0]),
+            np.ascontiguousarray(table[1]),
+            np.ascontiguousarray(geometry.directions, dtype=float), first.astype(np.int64),
+            second.astype(np.int64), np.ascontiguousarray(transfer.table, dtype=complex),
+            float(transfer.step), float(transfer.tail), geometry.speed * geometry.dwell,
+            np.ascontiguousarray(rule2.filon(delta[..., 1])),
+            np.ascontiguousarray(rule3.filon(delta[..., 2])), sums)
+        # beyond rule1 (the tail) the probes pass nothing: 0
+        pairs[..., :rule1.size] = 2.0 * (sums * rule1.filon(delta[..., 0])).real
+    directions = np.asarray(geometry.directions, dtype=float)
+    spectra = tensor.alpha_epsilon * _unit_point_spectra(
+        length, tensor.anisotropy, tuple(np.concatenate([r.edges for r in rules])), order,
+        (8, 48) if coarse else (12, 64))                                  # (n, 3, 3)
+    if colocated is not None and colocated.any():     # point probes: the whole rule
+        dwell = np.sinc(k1 * geometry.speed * geometry.dwell / (2 * np.pi)) ** 2
+        same = np.einsum("pi,nij,pj->pn", directions[first], spectra,
+                         directions[second]) * dwell * weight
+        pairs = np.where(colocated[..., None], same[None], pairs)
+    matrix = np.zeros((geometry.n_gates, geometry.n_beams, geometry.n_beams, k1.size))
+    matrix[:, first, second] = pairs
+    matrix[:, second, first] = pairs
+    reconstruction = np.asarray(geometry.reconstruction, dtype=float)[:, 0]   # u: (G, B)
+    lidar = np.einsum("gb,gbdn,gd->ng", reconstruction, matrix, reconstruction)
+    point = weight * spectra[:, 0, 0]
+    high_pass = np.concatenate([
+        record_weights(r, 0.0, geometry.speed, geometry.scan_period,
+                       geometry.record_duration).real / r.weights for r in rules])
+    return k1, weight, lidar, point, high_pass
+
+
+@functools.lru_cache(maxsize=32)
+def _unit_point_spectra(length, anisotropy, edges, order, cross_section):
+    """The 1-D cross-spectra (n, 3, 3) [m3 s-2] of the Mann tensor of unit alpha
+    eps^(2/3), scale `length` [m] and `anisotropy`, at the nodes of the panels `edges`
+    (the rules of :func:`_pair_level`, concatenated; `order` nodes each) on the log-polar
+    cross-section (radial nodes a decade, angles) of ``mann_point_variances``: a function
+    of these alone, so kept per process (a campaign's gates share L and Gamma whatever
+    the wind)."""
+    from uq.physics.lidarspectral import _one_dimensional_spectra
+    from uq.physics.spectralquadrature import PanelRule
+    from uq.physics.spectraltensor import MannTensor, WavenumberGrid
+    edges = np.asarray(edges)
+    breaks = np.flatnonzero(np.diff(edges) <= 0) + 1           # where a rule starts again
+    k1 = np.concatenate([PanelRule(part, order).nodes for part in np.split(edges, breaks)])
+    grid = WavenumberGrid(length, radius_per_decade=cross_section[0],
+                          angle_nodes=cross_section[1])
+    tensor = MannTensor(length, anisotropy)
+    out = np.concatenate([_one_dimensional_spectra(tensor, grid, k1[s:s + 12])
+                          for s in range(0, k1.size, 12)])
+    out.flags.writeable = False
+    return out
+
+
+def _unit_tensor(tensor):
+    """The Mann tensor of `tensor`'s L and Gamma at unit alpha eps^(2/3)."""
+    from uq.physics.spectraltensor import MannTensor
+    return MannTensor(tensor.length_scale, tensor.anisotropy)
+
+
 @dataclasses.dataclass(frozen=True)
 class _Nodes:
     """A :class:`~uq.physics.spectraltensor.WavenumberGrid` restricted to some of its k1
-    nodes (their weights unchanged): the spectral path over those nodes alone."""
+    nodes (their weights unchanged): the vector sums over those nodes alone."""
 
     grid: object
     nodes: tuple
@@ -204,33 +370,33 @@ class _Nodes:
         return self.grid.cross_section(k1)
 
 
-def spectral_terms(settings):
-    """:class:`SpectralTerms` of validated gate `settings` (:func:`gate_settings`).
-
-    The probe's own transfer function at the gate's focus, the Mann tensor of the
-    settings' turbulence, the scan geometry of the pipeline (:func:`uq.pipeline.
-    turbulencesection.scan_geometry`); each k1 node is one call of the spectral path
-    with an infinite record (no high-pass), so that the node's terms are the integrand
-    itself."""
-    from uq.physics.lidarspectral import mann_lidar_variances, probe_transfer_for
+def _vector_terms(geometry, tensor, transfer):
+    """(k1, weights, lidar terms, point terms, high-pass) of the vector path (many
+    beams: :func:`spectral_terms`) on the log-polar grid the path accepts (its own
+    estimate and refinements: :func:`uq.physics.lidarspectral.mann_lidar_variances`);
+    the path takes the record's high-pass at the grid's k1 nodes, and so do the terms."""
+    from uq.constants import SPECTRAL_REFINEMENTS, SPECTRAL_TOLERANCE
+    from uq.physics.lidarspectral import (_one_dimensional_spectra, _refined_polar,
+                                          _relative_error, _vector_sum, _vector_variances,
+                                          mann_point_variances)
     from uq.physics.spectraltensor import WavenumberGrid
-    from uq.pipeline import probesection
-    from uq.pipeline.records import turbulence_model
-    from uq.pipeline.turbulencesection import scan_geometry
-    geometry = scan_geometry(settings)
-    lidar = settings["lidar"]
-    focus = np.asarray(lidar["ranges"], float) / math.cos(math.radians(lidar["half_cone"]))
-    transfer = probe_transfer_for(probesection.make_probe(lidar.get("probe")), focus)
-    tensor = turbulence_model(settings["turbulence"], settings["wind"]["speed"])
     grid = WavenumberGrid(tensor.length_scale)
+    true = mann_point_variances(geometry, tensor)[0]
+    for attempt in range(SPECTRAL_REFINEMENTS):
+        lidar, error = _vector_variances(geometry, tensor, transfer, grid)
+        if _relative_error(lidar, error, true) <= SPECTRAL_TOLERANCE:
+            break
+        grid = _refined_polar(grid)
     unfiltered = dataclasses.replace(geometry, record_duration=np.inf)
     k1, weight = grid.k1()
-    lidar_terms, point_terms = np.zeros((k1.size, geometry.n_gates)), np.zeros(k1.size)
-    for node in range(k1.size):
-        found = mann_lidar_variances(unfiltered, tensor, transfer, grid=_Nodes(grid, (node,)))
-        lidar_terms[node], point_terms[node] = found.lidar[:, 0], found.true[0]
-    return SpectralTerms(k1, lidar_terms, point_terms, weight, geometry.speed,
-                         geometry.scan_period, geometry.record_duration)
+    lidar = np.stack([_vector_sum(unfiltered, tensor, transfer, _Nodes(grid, (node,)))[:, 0]
+                      for node in range(k1.size)])
+    point = weight * tensor.alpha_epsilon * np.concatenate(
+        [_one_dimensional_spectra(_unit_tensor(tensor), grid, k1[s:s + 12])[:, 0, 0]
+         for s in range(0, k1.size, 12)])
+    high = record_high_pass(k1 * geometry.speed / (2 * np.pi), geometry.scan_period,
+                            geometry.record_duration)
+    return k1, weight, lidar, point, high
 
 
 def record_high_pass(frequency, scan_period, record_duration):
@@ -393,13 +559,13 @@ def scan_noise_variance(settings):
 def monte_carlo_record(settings, rng):
     """One Monte Carlo record of validated gate `settings` (with its ``motion`` and
     ``turbulence``): Vh once a scan [m s-1], shape (n_scans,), and the field's u at the
-    reference point once a scan [m s-1] (:func:`uq.pipeline.records.monte_carlo_record`;
-    `rng` the record's generator)."""
+    reference point once a scan [m s-1], shape (n_scans,), the mean speed included
+    (:func:`uq.pipeline.records.monte_carlo_record`'s
+    :class:`~uq.pipeline.records.RecordSeries`; `rng` the record's generator)."""
     from uq.pipeline.records import monte_carlo_record as record
     from uq.pipeline.turbulencesection import scan_geometry, scans_per_record
-    speed, reference = record(settings, scan_geometry(settings), scans_per_record(settings),
-                              rng)[:2]
-    return np.asarray(speed)[:, 0], np.asarray(reference)
+    series = record(settings, scan_geometry(settings), scans_per_record(settings), rng)
+    return np.asarray(series.speed)[:, 0], np.asarray(series.reference)[:, 0]
 
 
 def scans_per_record(settings):

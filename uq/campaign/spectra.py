@@ -73,7 +73,11 @@ LAG_BLOCK = 512
 
 
 def high_pass(terms):
-    """``1 - |D_N(f)|^2`` [1] at each node of `terms` (the record's own, Eq. 3)."""
+    """``1 - |D_N(f)|^2`` [1] at each node of `terms` (the record's own, Eq. 3): the
+    node's share of it in the spectral path's rule where the terms carry it
+    (:attr:`uq.campaign.adapter.SpectralTerms.high_pass`), else its value at the node."""
+    if terms.high_pass is not None:
+        return terms.high_pass
     return record_high_pass(terms.frequency, terms.scan_period, terms.record_duration)
 
 
