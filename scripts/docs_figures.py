@@ -54,6 +54,7 @@ RUNS = {
     "probe": [["run", "probe_volume", "-o", "p.nc"]],
     "profile": [["run", "floating_lidar_profile", "-o", "f.nc"], ["fit", "f.nc"]],
     "golden": [["golden", "golden_campaign", "-o", "g"]],
+    "campaign": [["campaign", "campaign_buoy", "-o", "cb"]],
 }
 
 #: docs figure -> (runs it needs, the plot commands, the figure they write in the folder)
@@ -74,6 +75,7 @@ PLOTTED = {
                          "p_figures/probe_bias_against_range.png"),
     "profile_fit.png": (["profile"], [], "f_fit_profile.png"),
     "golden_uncertainty_terms.png": (["golden"], [], "g/figures/uncertainty_terms.png"),
+    "campaign_buoy_scatter.png": (["campaign"], [], "cb/figures/scatter.png"),
 }
 
 
@@ -190,6 +192,31 @@ def table_golden(folder):
     return "\n".join(lines) + "\n\n(m/s; the unit FLSa at 80 m, mean over the required bins 4-16 m/s)"
 
 
+def table_campaign(folder):
+    """uq campaign campaign_buoy: per height, the records' mean TI of the reference, as
+    measured and as corrected, the mean bias of each against the reference, and the
+    corrected intervals' coverage of the reference's TI (binomial test)."""
+    import numpy as np
+    ds = _open(folder, "cb/campaign_buoy.nc")
+    lines = [_row("height", "records", "TI mast", "TI buoy, measured", "TI buoy, corrected",
+                  "MBE measured", "MBE corrected", "95 % intervals covering the mast's TI"),
+             _row(*["---"] * 8)]
+    for h, height in enumerate(ds["height"].values):
+        at = ds.isel(height=h)
+        ref, measured, corrected = (100 * at[f"turbulence_intensity_{name}"].values
+                                    for name in ("reference", "measured", "corrected"))
+        both = np.isfinite(ref) & np.isfinite(corrected)
+        n, covered = int(at["coverage_n_records"]), int(at["coverage_n_covered"])
+        lines.append(_row(f"{height:g} m", int(both.sum()), f"{ref[both].mean():.2f} %",
+                          f"{measured[both].mean():.2f} %", f"{corrected[both].mean():.2f} %",
+                          f"{(measured - ref)[both].mean():+.2f} %",
+                          f"{(corrected - ref)[both].mean():+.2f} %",
+                          f"{covered}/{n} = {100 * covered / n:.1f} % "
+                          f"(p = {float(at['coverage_p_value']):.2f})"))
+    return "\n".join(lines) + ("\n\n(TI in percent points; means over the records the "
+                               "buoy's lidar corrected and the mast measured)")
+
+
 #: README table name -> (runs it needs, the function that renders it)
 TABLES = {
     "rubio2022_case_i": (["case_i", "case_i_beam"], table_case_i),
@@ -198,6 +225,7 @@ TABLES = {
     "nacelle_floating": (["nacelle", "nacelle_fixed"], table_nacelle),
     "profile_fit": (["profile"], table_profile),
     "golden_campaign": (["golden"], table_golden),
+    "campaign_buoy": (["campaign"], table_campaign),
 }
 
 BLOCK = re.compile(r"(<!-- table: (?P<name>[\w.-]+) -->\n)(?P<body>.*?)(\n?<!-- end table -->)",
