@@ -136,6 +136,8 @@ def _in_view(line):
     finite = np.isfinite(x) & np.isfinite(y)
     if not finite.any():
         return False
+    if line.get_marker() in (None, "None", "", " ") and finite.sum() < 2:
+        return False                   # one point and no marker: nothing is drawn
     (x0, x1), (y0, y1) = sorted(line.axes.get_xlim()), sorted(line.axes.get_ylim())
     inside = finite & (x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)
     return bool(inside.any())

@@ -360,8 +360,8 @@ def component_ratios(dataset):
         values = np.atleast_1d(data[ratio].values)
         left.errorbar(gates, values, yerr=np.atleast_1d(data[error].values), fmt="o-",
                       color=f"C{k}", capsize=3, label=label)
-        right.plot(gates, 100 * np.atleast_1d(data[spectral].values), "-", color=f"C{k}",
-                   label=f"{label}: spectral (turbulence)")
+        right.plot(gates, 100 * np.atleast_1d(data[spectral].values), "s-", color=f"C{k}",
+                   mfc="none", label=f"{label}: spectral (turbulence)")
         if mc in data:
             right.plot(gates, 100 * np.atleast_1d(data[mc].values), "o", color=f"C{k}",
                        label=f"{label}: Monte Carlo records")
