@@ -179,6 +179,8 @@ def fig4b_relative_against_speed(dataset):
             at, line = lines[ratio]
             style = model_style(model)
             style.update(color=colour, label=f"VR = {ratio:g}, {MODELS[model][0]}")
+            if np.size(at) < 2 and not style.get("marker"):
+                style["marker"] = "_"          # one speed on the line: a tick shows it
             ax.plot(at, 100 * line / at, **style)
             if ratio != VELOCITY_RATIOS[0]:
                 common = np.isin(base_at, at)

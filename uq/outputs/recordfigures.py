@@ -318,7 +318,13 @@ def apparent_against_true(dataset):
                         label=f"{label}: Monte Carlo records (mean, 95 % of records)")
     field = data["turbulence_intensity_true"]
     field = (field.isel({others[0]: 0}) if others else field).values * 100
-    ax.plot(field, field, color="k", ls="--", lw=1, label="apparent = field")
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    low, high = max(x0, y0), min(x1, y1)           # where the identity is in view
+    if low < high:
+        identity = np.linspace(low, high, 101)
+        ax.plot(identity, identity, color="k", ls="--", lw=1, label="apparent = field")
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
     ax.set_xlabel("the field's TI over a record [%]")
     ax.set_ylabel("the lidar's apparent TI [%]")
     top = ax.secondary_xaxis("top")
