@@ -213,8 +213,7 @@ def table_campaign(folder):
                           f"{(corrected - ref)[both].mean():+.2f} %",
                           f"{covered}/{n} = {100 * covered / n:.1f} % "
                           f"(p = {float(at['coverage_p_value']):.2f})"))
-    return "\n".join(lines) + ("\n\n(TI in percent points; means over the records the "
-                               "buoy's lidar corrected and the mast measured)")
+    return "\n".join(lines)
 
 
 #: README table name -> (runs it needs, the function that renders it)
