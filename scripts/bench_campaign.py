@@ -47,8 +47,13 @@ def main(argv=None):
                record_heights_per_second=count / wall, workers=args.workers or 1,
                surrogate_ti_error=attrs["surrogate_ti_error"],
                load_average_after=os.getloadavg())
-    print(json.dumps(out, indent=1))
+    print(json.dumps(out, indent=1, default=_plain))
     return 0
+
+
+def _plain(value):
+    """A numpy scalar (a Dataset's attribute) as the Python number JSON takes."""
+    return value.item() if hasattr(value, "item") else str(value)
 
 
 if __name__ == "__main__":
