@@ -1,5 +1,5 @@
-"""The first run after an install, as a user times it: ``uq run NAME`` (``uq golden`` for
-a golden configuration) in a new process with numba's cache empty (a fresh
+"""The first run after an install, as a user times it: ``uq run NAME`` (``uq golden`` or
+``uq campaign`` for their configurations) in a new process with numba's cache empty (a fresh
 ``NUMBA_CACHE_DIR``), then, once the background compile it started has ended
 (:mod:`uq.cli.firstrun`), the same command with that cache filled. Wall times of the
 whole commands, from the same run; the target is the difference: a first run within
@@ -109,7 +109,7 @@ def measure(names=None, progress=None):
             figures[f"first_run_{name}_warm_compiled"] = int(row["warm_compiled"])
             figures[f"first_run_{name}_largest_difference"] = row["largest_difference"]
         worst = max(worst, (row["over_warm_s"], name))
-        say(f"uq run {name}: first run {row['cold_s']:.1f} s (load {row['cold_load']:.1f}), "
+        say(f"uq {shipped_command(name)} {name}: first run {row['cold_s']:.1f} s (load {row['cold_load']:.1f}), "
             f"then the background compile {row['background_after_s']:.1f} s more, a warm "
             f"run {row['warm_s']:.1f} s")
     figures["first_run_worst_over_warm_s"], figures["first_run_worst_name"] = worst
