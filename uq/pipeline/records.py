@@ -624,6 +624,16 @@ _UNIT_RECORDS = collections.OrderedDict()
 _UNIT_RECORDS_LOCK = threading.Lock()
 
 
+def forget_kept():
+    """Drop the records and spectral paths this process keeps for reuse
+    (:func:`unit_record`, :data:`_SPECTRAL_PATHS`): the next run makes them as a new
+    ``uq run`` process does (the benchmark times that)."""
+    with _UNIT_RECORDS_LOCK:
+        _UNIT_RECORDS.clear()
+    with _SPECTRAL_PATHS_LOCK:
+        _SPECTRAL_PATHS.clear()
+
+
 def unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest=False):
     """The turbulence of one record, for a field of unit :func:`field_scale`, drawn from
     `rng` as :func:`unit_box` draws it (`rng` is left where the box's draw leaves it).
