@@ -217,8 +217,9 @@ def _component_lines(dataset):
     return lines
 
 
-def _extent(dataset, name):
-    values = np.asarray(dataset[name].values, dtype=float)
+def _extent(dataset, name, scale=1.0):
+    """'low..high' of the variable `name` times `scale` ('nan' where all are NaN)."""
+    values = scale * np.asarray(dataset[name].values, dtype=float)
     if np.all(np.isnan(values)):
         return "nan"
     low, high = np.nanmin(values), np.nanmax(values)
@@ -236,11 +237,7 @@ def _point_ti(dataset, index):
 
 
 def _percent_extent(dataset, name):
-    values = 100 * np.asarray(dataset[name].values, dtype=float)
-    if np.all(np.isnan(values)):
-        return "nan"
-    low, high = np.nanmin(values), np.nanmax(values)
-    return _number(low) if _same(low, high) else f"{_number(low)}..{_number(high)}"
+    return _extent(dataset, name, scale=100.0)
 
 
 def _motion_note(dataset):
