@@ -629,3 +629,18 @@ CAMPAIGN_RECORD_SECONDS = 600.0
 #: Records of one chunk of the correction (the fast path's arrays: ~50 MB at 24 motion
 #: components; a dask task each).
 CAMPAIGN_CHUNK_RECORDS = 4096
+
+#: The per-axis rule of the unresolved scales' integral (:mod:`uq.physics.unresolved`):
+#: Gauss-Legendre panels per decade outside the box's Nyquist cube and inside it, down
+#: to the fraction of the Nyquist wavenumber given (below it the integrand vanishes as
+#: (k d)^2: the interpolation and the probe's quadrature pass those scales whole) [1].
+#: One refinement (twice the panels) moves the beams' unresolved variance by under
+#: 1 % of itself on the shipped record scenarios (tests/physics/test_unresolved.py).
+UNRESOLVED_PANELS = (4, 1e-2)
+#: Gauss-Legendre nodes per panel of that rule [1].
+UNRESOLVED_ORDER = 4
+#: Reach of that rule, in Nyquist wavenumbers pi / d: beyond it the tensor's k^(-11/3)
+#: leaves (1 / reach)^(2/3) = 1 % of the outer shell's variance [1].
+UNRESOLVED_REACH = 1000.0
+#: Nodes of the table of the probe quadrature's power up to the cube's corner [1].
+UNRESOLVED_QUADRATURE_TABLE = 8193

@@ -414,7 +414,7 @@ def test_a_nacelle_lidar_s_records_agree_with_its_spectral_path():
 #: Record-mode variables named turbulence_intensity_* that are not turbulence
 #: intensities: the spectral path's ratios and the check's statistics.
 NOT_A_TI = ("_ratio", "_ratio_error", "_z", "_valid", "_z_limit", "_check_resolution",
-            "_box_kept")
+            "_box_kept", "_box_resolved")
 
 
 def test_each_turbulence_intensity_carries_its_one_name_in_the_file(tmp_path, cf_compliance):

@@ -142,17 +142,31 @@ def _records_table(dataset):
                    f"(Student's t of the run's records, 5 % false alarms); at this record "
                    f"count the check tells a "
                    f"relative difference of the TI of {', '.join(_number(100 * r) for r in resolution)} % "
-                   f"from none. The turbulence box the lidar's beams read keeps "
-                   f"{_number(float(data['turbulence_intensity_box_kept']))} of the model's "
-                   f"u-variance over a record (the scales below its cells are drawn at the "
-                   f"reference point alone): the records' lidar TI^2 reads up to that "
-                   f"share low against the spectral path's, and the check may then say "
-                   f"the paths differ where the spectral path is right.</p>")
+                   f"from none. {_box_sentence(data)}</p>")
     if "turbulence_spectral_converged" in data and not bool(
             np.all(data["turbulence_spectral_converged"].values)):
         out.append("<p><b>The spectral path did not reach its tolerance</b>: its stated "
                    "errors say by how much.</p>")
     return "\n".join(out)
+
+
+def _box_sentence(data):
+    """What the records' turbulence box holds of the model's u-variance, from the run's
+    stored shares (the box alone; with the scales below its cells drawn at the beams)."""
+    kept = float(np.atleast_1d(data["turbulence_intensity_box_kept"].values)[0])
+    if "turbulence_intensity_box_resolved" not in data:
+        return (f"The records' field at the lidar's beams keeps {_number(kept)} of the "
+                f"model's u-variance over a record.")
+    resolved = float(np.atleast_1d(data["turbulence_intensity_box_resolved"].values)[0])
+    if not np.isfinite(resolved) or resolved == kept:
+        return (f"The turbulence box keeps {_number(kept)} of the model's u-variance over "
+                f"a record (its scales below the cells are drawn at the reference point "
+                f"alone): the records' lidar TI^2 may read up to that share low.")
+    return (f"The turbulence box resolves {_number(resolved)} of the model's u-variance over "
+            f"a record; the scales below its cells are drawn at every beam, gate and scan "
+            f"(independent: they decorrelate within a few cells) and at the reference "
+            f"point, so the records' field where the beams read it keeps {_number(kept)} "
+            f"(the rest: eddies longer than the box along the wind).")
 
 
 def _table(header, rows):

@@ -91,11 +91,16 @@ RECORD_ATTRIBUTES = {
         "check tells from none at this record count (half its TI^2 interval over the "
         "records' mean TI^2): a check that is to decide a difference needs it smaller"},
     "turbulence_intensity_box_kept": {
-        "units": "1", "long_name": "u-variance the turbulence box keeps of the model's "
-        "over a record (the record's high-pass): what the lidar's beams read; the scales "
-        "below its cells are drawn once a scan at the reference point alone, so the "
-        "records' truth carries the model's variance and the lidar's records up to this "
-        "share less"},
+        "units": "1", "long_name": "u-variance the records' field keeps of the model's "
+        "over a record (the record's high-pass) where the lidar's beams read it: the box's "
+        "resolved scales plus the scales below its cells, drawn at each beam and gate once "
+        "a scan; what is missing is the band of the largest eddies below the box's lowest "
+        "wavenumber along the wind (the records' truth at the reference point carries "
+        "it too)"},
+    "turbulence_intensity_box_resolved": {
+        "units": "1", "long_name": "u-variance the turbulence box alone resolves of the "
+        "model's over a record (the record's high-pass): the rest, the scales below its "
+        "cells, is drawn at the beams and the reference point"},
     "wind_speed_record_bias": {
         "units": "m s-1", "long_name": "Monte Carlo mean over records of the record's mean "
         "horizontal wind speed minus the field's true mean"},
@@ -498,10 +503,11 @@ def reference_complement(settings, geometry, grid):
     records draw them as independent values once a scan (:func:`_draw_unit_record`;
     their record variance about its mean is (1 - 1/N) of theirs). Returns the lower
     Cholesky factor of that covariance (3, 3), negative eigenvalues (the box holding
-    more than the field: rounding) set to zero, and the u-variance the records' field
-    the box alone keeps of the field's at the record's scales [1] (``turbulence_intensity_
-    box_kept``: the box's over the field's, with the high-pass: what the lidar's beams
-    read, the complement being drawn at the reference point alone)."""
+    more than the field: rounding) set to zero, the u-variance share of the field's at
+    the record's scales that the lidar's beams read [1] (``turbulence_intensity_box_
+    kept``: the box and the scales below its cells, which :func:`beam_complement` draws
+    at each beam; the rest is the band of eddies longer than the box along the wind),
+    and the box's alone [1] (``turbulence_intensity_box_resolved``)."""
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
     if turbulence["model"] == "mann":
         return _mann_complement(grid, turbulence["length_scale"], turbulence["anisotropy"],
@@ -510,16 +516,17 @@ def reference_complement(settings, geometry, grid):
                               geometry.record_duration)
 
 
-def _complement_factor(field, box, scans):
-    """(Cholesky factor of the white complement's covariance, kept fraction of u)."""
+def _complement_factor(field, box, scans, unresolved_u=0.0):
+    """(Cholesky factor of the white complement's covariance, the u-variance share the
+    records' beams keep (the box and `unresolved_u`, the scales below its cells that
+    :func:`beam_complement` draws at the beams), the share the box alone resolves)."""
     missing = field - box
     values, vectors = np.linalg.eigh(missing)
     missing = (vectors * np.maximum(values, 0.0)) @ vectors.T
     factor = np.linalg.cholesky(missing / max(1.0 - 1.0 / scans, 1e-12)
                                 + 1e-300 * np.eye(3))
-    # what the lidar's beams read: the box alone (the complement is drawn at the
-    # reference point only, where the records' truth is taken)
-    return factor, float(box[0, 0] / field[0, 0])
+    return (factor, float((box[0, 0] + unresolved_u) / field[0, 0]),
+            float(box[0, 0] / field[0, 0]))
 
 
 @functools.lru_cache(maxsize=8)
@@ -531,6 +538,7 @@ def _mann_complement(grid, length_scale, anisotropy, speed, scan_period, duratio
     from uq.physics.scangeometry import ScanGeometry
     from uq.physics.spectraltensor import MannTensor
     from uq.physics.spectralquadrature import record_scans
+    from uq.physics.unresolved import unresolved_point_variances
     point = ScanGeometry(np.array([[1.0, 0, 0]]), np.zeros((1, 1, 3)), np.zeros(1), 0.0,
                          scan_period, np.zeros(1), np.ones((1, 1)), np.ones((1, 3, 1)),
                          speed, duration)
@@ -540,7 +548,11 @@ def _mann_complement(grid, length_scale, anisotropy, speed, scan_period, duratio
         spectral_filter=lambda k1: record_filter(k1 * speed / (2 * np.pi), scan_period,
                                                  duration))
     box = np.array([[u, 0.0, uw], [0.0, v, 0.0], [uw, 0.0, w]])
-    return _complement_factor(field, box, record_scans(scan_period, duration))
+    # the scales below the box's cells, which the beams get too (beam_complement); the
+    # record's high-pass is 1 there (their wavenumbers are far above 1 / (U T))
+    unresolved_u = unresolved_point_variances(grid.spacing[0], 1.0, length_scale,
+                                              anisotropy)[0]
+    return _complement_factor(field, box, record_scans(scan_period, duration), unresolved_u)
 
 
 @functools.lru_cache(maxsize=8)
@@ -565,6 +577,47 @@ def _kaimal_complement(grid, length_u, speed, scan_period, duration):
     box = np.diag([np.sum(spectra.spectrum(c, f) * speed / (4 * np.pi) * highpass) * dk
                    for c in range(3)])
     return _complement_factor(field, box, record_scans(scan_period, duration))
+
+
+_BEAM_COMPLEMENTS = {}
+_BEAM_COMPLEMENTS_LOCK = threading.Lock()
+
+
+def beam_complement(settings, geometry, grid):
+    """The standard deviation [m s-1 per unit field scale] of the scales a Mann box does
+    not resolve, as each beam and gate of `geometry` reads them (the probe's own
+    weighting, the dwell), less what the box's interpolation passes of them: shape
+    (n_beams, n_gates), :func:`uq.physics.unresolved.unresolved_radial_variances`. The
+    records draw them independent between beams, gates and scans (their scales are
+    below a few cells; the module docstring there). None for a Kaimal box (its field is
+    made on the box's nodes across the wind; what it lacks along the wind is stated,
+    not drawn). Kept per grid, model, probe and geometry (~2 s CPU each)."""
+    from uq.physics import turbulencesampling
+    from uq.physics.unresolved import unresolved_radial_variances
+    turbulence = settings["turbulence"]
+    if turbulence["model"] != "mann":
+        return None
+    lidar = settings["lidar"]
+    digest = hashlib.sha256()
+    for value in (getattr(geometry, f.name) for f in dataclasses.fields(geometry)):
+        digest.update(np.ascontiguousarray(value, dtype=float).tobytes())
+    key = (grid, turbulence["length_scale"], turbulence["anisotropy"],
+           repr(lidar.get("probe")), repr(lidar["ranges"]), lidar["half_cone"],
+           digest.hexdigest())
+    with _BEAM_COMPLEMENTS_LOCK:
+        found = _BEAM_COMPLEMENTS.get(key)
+    if found is None:
+        transfer = probe_transfer_for(probesection.make_probe(lidar.get("probe")),
+                                      slant_ranges(lidar))
+        spacing = grid.spacing[0]
+        found = np.sqrt(unresolved_radial_variances(
+            spacing, geometry, turbulencesampling.dwell_offsets(geometry, min(grid.spacing)),
+            transfer, 1.0, turbulence["length_scale"], turbulence["anisotropy"]))
+        with _BEAM_COMPLEMENTS_LOCK:
+            if len(_BEAM_COMPLEMENTS) >= 16:
+                _BEAM_COMPLEMENTS.pop(next(iter(_BEAM_COMPLEMENTS)))
+            _BEAM_COMPLEMENTS[key] = found
+    return found
 
 
 def record_grid(settings, geometry, motion_margin=0.0):
@@ -603,9 +656,12 @@ class UnitRecord:
     at_rest : ndarray or None
         ``radial`` at the nominal positions (the lidar at rest), where asked for.
     kept : float
-        u-variance fraction the box keeps [1].
+        u-variance fraction the records' beams keep [1] (the box and the scales below
+        its cells, :func:`beam_complement`).
     state : dict
         The record generator's state after the box's draw.
+    resolved : float
+        u-variance fraction the box alone resolves [1].
     """
 
     radial: np.ndarray
@@ -613,6 +669,7 @@ class UnitRecord:
     at_rest: object
     kept: float
     state: dict
+    resolved: float = float("nan")
 
     @property
     def nbytes(self):
@@ -632,6 +689,8 @@ def forget_kept():
         _UNIT_RECORDS.clear()
     with _SPECTRAL_PATHS_LOCK:
         _SPECTRAL_PATHS.clear()
+    with _BEAM_COMPLEMENTS_LOCK:
+        _BEAM_COMPLEMENTS.clear()
 
 
 def unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest=False):
@@ -686,11 +745,18 @@ def _draw_unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest)
         del box
     radial, reference, rest = found
     # the scales below the box's cells at the reference point, once a scan, drawn after
-    # the box (reference_complement)
-    factor = reference_complement(settings, geometry, record_grid(settings, geometry,
-                                                                  margin))[0]
+    # the box (reference_complement), then at each beam and gate (beam_complement)
+    grid = record_grid(settings, geometry, margin)
+    factor, _, resolved = reference_complement(settings, geometry, grid)
     reference = reference + rng.standard_normal((n_scans, 3)) @ factor.T
-    return UnitRecord(radial, reference, rest, kept, rng.bit_generator.state)
+    deviation = beam_complement(settings, geometry, grid)
+    if deviation is not None:
+        unresolved = rng.standard_normal(radial.shape) * deviation
+        radial = radial + unresolved
+        # the lidar at rest reads the same small scales (the same field, its probes
+        # displaced by the motion alone)
+        rest = None if rest is None else rest + unresolved
+    return UnitRecord(radial, reference, rest, kept, rng.bit_generator.state, resolved)
 
 
 def _unit_key(settings, geometry, n_scans, rng, moving, margin, at_rest):
@@ -820,7 +886,7 @@ def monte_carlo_record(settings, geometry, n_scans, rng, compiled=True, spectra=
         speed, lateral_series(speed, np.real(result["wind_direction"]).reshape(n_scans, -1)),
         np.real(result["vertical_wind"]).reshape(n_scans, -1), reference, unit.kept,
         None if spectra is None else record_spectra_series(
-            settings, scene, errors, unit, scale, n_scans, spectra, compiled))
+            settings, scene, errors, unit, scale, n_scans, spectra, compiled), unit.resolved)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -835,9 +901,13 @@ class RecordSeries:
     reference : ndarray, shape (n_scans, 3)
         The field's (u, v, w) at the reference point, the mean speed in u [m s-1].
     kept : float
-        The u-variance fraction the box keeps [1] (``turbulence_intensity_box_kept``).
+        The u-variance fraction the records' beams keep [1]
+        (``turbulence_intensity_box_kept``).
     spectra : dict or None
         The series the record spectra are taken of (:func:`record_spectra_series`).
+    resolved : float
+        The u-variance fraction the box alone resolves [1]
+        (``turbulence_intensity_box_resolved``).
     """
 
     speed: np.ndarray
@@ -846,6 +916,7 @@ class RecordSeries:
     reference: np.ndarray
     kept: float
     spectra: object = None
+    resolved: float = float("nan")
 
 
 def lateral_series(speed, direction):
@@ -972,7 +1043,9 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral, axis=None, mo
     of that mean (clause 8 in spirit: the spectral path is validated where |z| is within
     Student's t quantile of the records' count, :func:`valid_z`,
     ``turbulence_intensity_spectral_valid``); ``turbulence_intensity_box_kept``: the
-    u-variance the box keeps of the model's (where the two paths part by design).
+    u-variance the records' beams keep of the model's (the box and the scales below its
+    cells; where the two paths part by design), ``turbulence_intensity_box_resolved``:
+    the box's alone.
 
     With `axis` (:func:`spectrum_axis`: the run's scan period [s] and scans per record)
     also the records' mean spectra (:data:`SPECTRA_ATTRIBUTES`) on its frequencies, NaN
@@ -987,6 +1060,7 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral, axis=None, mo
     true_ti = np.full((len(scenes), count, 3), np.nan)
     error = np.full((len(scenes), count, n_gates), np.nan)
     kept = np.full(len(scenes), np.nan)
+    resolved = np.full(len(scenes), np.nan)
     spectra = RecordSpectra(axis, len(scenes), n_gates) if axis else None
     for i, settings in enumerate(scenes):
         if not settings["wind"]["speed"] > 0:
@@ -998,6 +1072,7 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral, axis=None, mo
             found = monte_carlo_record(settings, geometry, n_scans, record_generator(seed, r),
                                        compiled, rest_generator(seed, r) if wanted else None)
             vh, reference, kept[i] = found.speed, found.reference, found.kept
+            resolved[i] = found.resolved
             mean = vh.mean(axis=0)
             apparent[i, r] = vh.std(axis=0, ddof=1) / mean
             components[i, r, :, 0] = found.lateral.std(axis=0, ddof=1) / mean
@@ -1028,6 +1103,7 @@ def monte_carlo_variables(scenes, truth, seed, compiled, spectral, axis=None, mo
         "turbulence_intensity_check_resolution": (("scene", "range"), 0.5 * limit
                                                   * standard_error / squares.mean(axis=1)),
         "turbulence_intensity_box_kept": (("scene",), kept),
+        "turbulence_intensity_box_resolved": (("scene",), resolved),
         "wind_speed_record_bias": (("scene", "range"), error.mean(axis=1)),
         "wind_speed_record_u": (("scene", "range"), error.std(axis=1, ddof=1)),
     }
