@@ -629,6 +629,9 @@ CAMPAIGN_RECORD_SECONDS = 600.0
 #: Records of one chunk of the correction (the fast path's arrays: ~50 MB at 24 motion
 #: components; a dask task each).
 CAMPAIGN_CHUNK_RECORDS = 4096
+#: Most threads ``uq campaign`` runs its tables' nodes and records' chunks on without a
+#: dask client [1] (one per CPU the process may use, up to this).
+CAMPAIGN_THREADS = 8
 
 #: The per-axis rule of the unresolved scales' integral (:mod:`uq.physics.unresolved`):
 #: Gauss-Legendre panels per decade outside the box's Nyquist cube and inside it, down

@@ -149,6 +149,21 @@ def test_a_dask_cluster_gives_the_same_numbers(tmp_path, coarse_tables):
         np.testing.assert_array_equal(one[name].values, two[name].values, err_msg=name)
 
 
+def test_threads_give_the_numbers_of_one_thread(tmp_path, coarse_tables, monkeypatch):
+    """Without a client the tables' nodes and the records' chunks run on threads
+    (analysis.local_threads); with none (one CPU) in order: the same numbers, bit for
+    bit (each task a fixed computation, its result put in its own place)."""
+    from uq.campaign import analysis
+    path = write_campaign(tmp_path, lidar_records(count=8, heights=(60,)))
+    assert analysis.local_threads() is None or analysis.local_threads()._max_workers >= 2
+    command.run_campaign(path, tmp_path / "threads", stream=open("/dev/null", "w"))
+    monkeypatch.setattr(analysis, "local_threads", lambda: None)
+    command.run_campaign(path, tmp_path / "one", stream=open("/dev/null", "w"))
+    one, threads = (xr.open_dataset(tmp_path / name / "mini.nc") for name in ("one", "threads"))
+    for name in one.data_vars:
+        np.testing.assert_array_equal(one[name].values, threads[name].values, err_msg=name)
+
+
 def test_a_folder_uq_did_not_write_is_not_replaced(tmp_path, capsys):
     path = write_campaign(tmp_path)
     (tmp_path / "mine").mkdir()

@@ -202,7 +202,10 @@ def test_a_record_sampled_part_by_part_is_its_whole_box_sampled(monkeypatch):
     # the reference: the box's line, and the scales below its cells drawn after the box
     factor = records.reference_complement(settings, geometry, grid)[0]
     complement = again.standard_normal((n_scans, 3)) @ factor.T
-    whole = (ts.record_radial_velocities(box, geometry, n_scans),
+    # then the scales below the cells at each beam and gate, the same at rest
+    beams = again.standard_normal((n_scans, geometry.n_beams, geometry.n_gates)) \
+        * records.beam_complement(settings, geometry, grid)
+    whole = (ts.record_radial_velocities(box, geometry, n_scans) + beams,
              ts.reference_line_series(box, geometry.speed, ts.scan_times(geometry, n_scans))
              + complement)
     for part_sum, sampled in zip((drawn.radial, drawn.reference, drawn.at_rest),
@@ -451,3 +454,54 @@ def test_each_turbulence_intensity_carries_its_one_name_in_the_file(tmp_path, cf
             assert attrs["comment"] == f"{name}: {meaning}", variable
             used.add(name)
         assert used == names                # each name on the variables it names
+
+
+def _shipped_record_scenarios():
+    from uq.pipeline.shipped import scenario_path, shipped_names
+    from uq.pipeline.yamlfile import read_yaml
+    out = []
+    for name in shipped_names():
+        try:
+            raw = read_yaml(scenario_path(name))
+        except Exception:           # the golden and campaign configurations: not scenarios
+            continue
+        if isinstance(raw, dict) and "record" in raw and "turbulence" in raw:
+            out.append(name)
+    return out
+
+
+@pytest.mark.parametrize("name", _shipped_record_scenarios())
+def test_the_records_field_keeps_the_models_variance_where_the_beams_read_it(name):
+    # every shipped record scenario: the box and the scales below its cells (drawn at
+    # each beam) keep at least 0.98 of the model's u-variance over a record (the rest:
+    # the band of eddies longer than the box along the wind, ~1 % at ten minutes); the
+    # box alone resolves less (the scales below its cells, ~5 % of u's at L / 8), and
+    # each beam and gate reads a positive share of those scales
+    from uq.pipeline import records
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.shipped import scenario_path
+    from uq.pipeline.turbulencesection import scan_geometry
+    settings = load_scenario(scenario_path(name)).settings
+    geometry = scan_geometry(settings)
+    grid = records.record_grid(settings, geometry)
+    _, kept, resolved = records.reference_complement(settings, geometry, grid)
+    assert 0.98 <= kept <= 1.0 + 1e-9
+    assert resolved < kept - 0.02
+    deviation = records.beam_complement(settings, geometry, grid)
+    assert deviation.shape == (geometry.n_beams, geometry.n_gates)
+    assert np.all(deviation > 0)
+
+
+def test_a_kaimal_box_draws_no_beam_complement():
+    # Veers' field is made at the box's nodes across the wind: what it lacks along the
+    # wind is stated (kept = resolved), not drawn at the beams
+    from uq.pipeline import records
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.turbulencesection import scan_geometry
+    raw = {**SMALL, "turbulence": {"model": "kaimal", "intensity": 0.1}}
+    settings = load_scenario(raw).settings
+    geometry = scan_geometry(settings)
+    grid = records.record_grid(settings, geometry)
+    assert records.beam_complement(settings, geometry, grid) is None
+    _, kept, resolved = records.reference_complement(settings, geometry, grid)
+    assert kept == resolved

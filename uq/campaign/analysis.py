@@ -15,8 +15,13 @@ and table out.
 
 Dimensions: ``time`` (the start of each ten-minute period, UTC), ``height`` [m],
 ``bin`` (centre [m s-1]). With a client (dask), the tables' nodes and the chunks run on
-its workers; every number is the same (no randomness; each task a fixed computation).
+its workers; without one, on a pool of threads here, one per CPU the process may use (at
+most :data:`~uq.constants.CAMPAIGN_THREADS`: the spectral path's compiled sums and
+numpy's array loops release Python's lock); every number is the same either way (no
+randomness; each task a fixed computation, its result put in its own place).
 """
+import concurrent.futures
+import os
 import time as clock
 
 import numpy as np
@@ -27,7 +32,8 @@ from uq.campaign import bins, correction, model, motion, surrogate
 from uq.campaign.config import length_scales
 from uq.campaign.motioninput import load_motion
 from uq.campaign.recordsfile import load_records, load_reference
-from uq.constants import CAMPAIGN_CHUNK_RECORDS, CAMPAIGN_RECORD_SECONDS, FULL_CIRCLE_DEG
+from uq.constants import (CAMPAIGN_CHUNK_RECORDS, CAMPAIGN_RECORD_SECONDS, CAMPAIGN_THREADS,
+                          FULL_CIRCLE_DEG)
 from uq.golden import binning, kpi
 
 #: Margin of the tables' speed range beyond the records' fastest [1] (the tables'
@@ -35,9 +41,34 @@ from uq.golden import binning, kpi
 SPEED_MARGIN = 1.05
 
 
+def local_threads():
+    """Threads for the tables' nodes and the records' chunks where no dask client is
+    given: one per CPU this process may use, at most :data:`~uq.constants.
+    CAMPAIGN_THREADS`; None on one CPU (run in order)."""
+    try:
+        cpus = len(os.sched_getaffinity(0))
+    except AttributeError:                      # not on Linux
+        cpus = os.cpu_count() or 1
+    count = min(cpus, CAMPAIGN_THREADS)
+    return concurrent.futures.ThreadPoolExecutor(count) if count > 1 else None
+
+
 def analyse(config, client=None):
     """Every record and table of a :class:`uq.campaign.config.CampaignConfig` as a
-    Dataset (module docstring); `client` a dask client or None."""
+    Dataset (module docstring); `client` a dask client or None (threads here,
+    :func:`local_threads`)."""
+    if client is not None:
+        return _analyse(config, client.submit)
+    pool = local_threads()
+    try:
+        return _analyse(config, None if pool is None else pool.submit)
+    finally:
+        if pool is not None:
+            pool.shutdown(cancel_futures=True)
+
+
+def _analyse(config, submit):
+    """:func:`analyse` with `submit` ``(function, *args) -> future`` or None."""
     started = clock.perf_counter()
     records = load_records(config.records)
     times, heights = records["time"].values, list(config.heights)
@@ -52,7 +83,6 @@ def analyse(config, client=None):
     scales = length_scales(config)
     turbulence = {"model": "mann", "anisotropy": config.anisotropy}
     lidar = config.lidar.settings
-    submit = None if client is None else client.submit
     tables = surrogate.build_tables(lidar, heights, scales, turbulence,
                                     CAMPAIGN_RECORD_SECONDS,
                                     (config.minimum_speed, max(top * SPEED_MARGIN,

@@ -38,7 +38,7 @@ from uq.constants import VON_KARMAN_EXPONENT
 FOUR_PI = 4.0 * math.pi
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _lifetime(kl, anisotropy, table_start, table_step, table_values):
     """beta(kL) from the log-log table and its asymptotes (turbulencebox.eddy_lifetime)."""
     n_nodes = table_values.size
@@ -52,7 +52,7 @@ def _lifetime(kl, anisotropy, table_start, table_step, table_values):
     return anisotropy * math.exp(log_beta)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _transfer(table, g, kappa, step, tail):
     """P_g(kappa) from gate g's table on |kappa| (conjugate for kappa < 0)."""
     a = abs(kappa) / step
@@ -71,7 +71,7 @@ _PAIR_SIGNATURE = ("void(float64[::1], float64[::1], float64[::1], float64, floa
                    "complex128[:, :, ::1], complex128[:, :, ::1], complex128[:, :, ::1])")
 
 
-@njit(_PAIR_SIGNATURE, cache=True)
+@njit(_PAIR_SIGNATURE, cache=True, nogil=True)
 def pair_sums(k1, k2, k3, alpha_epsilon, length_scale, anisotropy, table_start, table_step,
               table_values, directions, first, second, transfer, kappa_step, tail,
               dwell_length, w2, w3, out):
@@ -169,7 +169,7 @@ _VECTOR_SIGNATURE = ("void(float64[::1], float64[::1], float64[::1], float64[::1
                      "complex128[:, ::1], float64, float64, float64[:, ::1])")
 
 
-@njit(_VECTOR_SIGNATURE, cache=True)
+@njit(_VECTOR_SIGNATURE, cache=True, nogil=True)
 def vector_sums(k1, k2, k3, weight, alpha_epsilon, length_scale, anisotropy, table_start,
                 table_step, table_values, directions, centres, times, speed, dwell_length,
                 reconstruction, transfer, kappa_step, tail, out):
