@@ -50,23 +50,34 @@ def _bins(ds, minimum=5):
         "ti_mean_bias_measured_predicted", "ti_mean_bias_measured_predicted_u")}
 
 
-#: Why the tests of the campaign's mean bias fail on the shipped records (made again with
-#: the records whose field carries the model's variance): the records' turbulence
-#: variance (the lidar's record variance less the motion's and the scan errors' the
-#: model gives) against F V of the mast's TI is 1.08 where the motion holds < 10 % of the
-#: record's variance (63 record-heights), 0.92 at 10-30 % (189), 0.84 at 30-60 % (114)
-#: and 0.60 above (13): it falls as the motion's share grows, so every corrected TI is
-#: low (mean -0.0080 +- 0.0011 over 379) and the measured one as low (its mean bias 0.0017
-#: where 0.0069 +- 0.0010 is predicted). The motion alone (a field of TI 0.005 in a 3 m
-#: sea) holds the model's motion variance (0.63 +- 0.03 against 0.65 m2/s2), so it is
-#: the turbulence a moving lidar's records hold that falls short. Strict: an XPASS
+def _jensen(ds, keep):
+    """The mean over records of the delta method's second-order term of a square root,
+    ``E[sqrt(X)] - sqrt(E[X]) = -var(X) / (8 E[X]^(3/2))``, for the corrected TI (a square
+    root of an unbiased variance, ``u(TI) = u(V) / (2 U^2 TI)``): ``-u(TI)^2 / (2 TI)``
+    per record [1]. The reference is the field's expected-variance TI, so a correct
+    model's corrected TI reads this much below it on average."""
+    u = ds["turbulence_intensity_corrected_u"].values[keep]
+    ti = ds["turbulence_intensity_reference"].values[keep]
+    return float(np.mean(-u ** 2 / (2 * ti)))
+
+
+#: Why the campaign's overall mean biases (every record pooled, where the standard
+#: error is smallest) still fail on the shipped records: the Monte Carlo records hold
+#: 2.6 +- 1.3 % less variance than the model (corrected over reference variance 0.974,
+#: flat in the motion's share of the record: 0.974, 0.971, 0.979 for model shares < 10 %,
+#: 10-30 %, 30-60 %; largest at the lowest speeds, 0.94 +- 0.05 at 2-6 m/s), about what
+#: the records' box cannot hold at the campaign's speeds (turbulence_intensity_box_kept
+#: 0.981-0.991 at 3-12 m/s: the band of eddies longer than the box along the wind, more
+#: of the lidar's filtered variance than of the point's). Pooled over 379 records that
+#: is -0.0038 in the corrected TI beyond the square root's own -0.0016 (3 standard
+#: errors 0.0035) and +0.0037 measured against +0.0069 +- 0.0010 predicted. Per bin the
+#: biases are within their stated uncertainties (the tests above). Strict: an XPASS
 #: fails, to take the mark off then.
-BOX_DEFICIT = pytest.mark.xfail(strict=True, reason="the shipped records' turbulence variance "
-                                "falls below the spectral path's as the motion's share of "
-                                "the record grows (1.08 to 0.60 of it)")
+LARGE_EDDY_BAND = pytest.mark.xfail(strict=True, reason="the records hold 2.6 +- 1.3 % "
+                                    "less variance than the model (the band of eddies "
+                                    "longer than the box along the wind)")
 
 
-@BOX_DEFICIT
 def test_the_mean_bias_after_correction_is_zero_within_its_stated_uncertainty_per_bin(buoy):
     """Per bin and height: |MBE| <= k u(MBE), k the two-sided 1 % quantile of the normal
     after Bonferroni over the bins (the bins' MBEs are independent: disjoint records)."""
@@ -76,28 +87,44 @@ def test_the_mean_bias_after_correction_is_zero_within_its_stated_uncertainty_pe
     assert np.all(np.abs(z) <= special.ndtri(1 - LEVEL / (2 * z.size))), z
 
 
-@BOX_DEFICIT
 def test_the_mean_bias_after_correction_is_zero_over_the_bins(buoy):
     """sum (MBE / u)^2 over the bins within the 1 % quantiles of chi-square with as many
-    degrees of freedom as bins, and the mean bias over every record within 3 of its
-    stated u."""
+    degrees of freedom as bins."""
     _, ds = buoy
     b = _bins(ds)
     z = b["ti_mean_bias_corrected"] / b["ti_mean_bias_corrected_u"]
     assert stats.chi2.ppf(LEVEL / 2, z.size) <= np.sum(z ** 2) <= stats.chi2.ppf(
         1 - LEVEL / 2, z.size), np.sum(z ** 2)
+
+
+@LARGE_EDDY_BAND
+def test_the_mean_bias_after_correction_over_every_record_is_the_square_roots(buoy):
+    """The mean bias over every record within 3 of its stated u of the square root's
+    own second-order term (:func:`_jensen`)."""
+    _, ds = buoy
     gap = (ds["turbulence_intensity_corrected"] - ds["turbulence_intensity_reference"]).values
     u = ds["turbulence_intensity_corrected_u"].values
     keep = np.isfinite(gap)
-    assert abs(gap[keep].mean()) <= 3 * np.sqrt(np.sum(u[keep] ** 2)) / keep.sum()
+    assert abs(gap[keep].mean() - _jensen(ds, keep)) <= 3 * np.sqrt(np.sum(u[keep] ** 2)) \
+        / keep.sum()
 
 
-@BOX_DEFICIT
+def test_the_uncorrected_mean_bias_has_the_size_the_model_predicts_per_bin(buoy):
+    """Per bin the measured TI's mean bias against the one the model predicts from the
+    reference, within k u (Bonferroni as above)."""
+    _, ds = buoy
+    b = _bins(ds)
+    z = (b["ti_mean_bias_measured"] - b["ti_mean_bias_measured_predicted"]) / \
+        b["ti_mean_bias_measured_predicted_u"]
+    assert np.all(np.abs(z) <= special.ndtri(1 - LEVEL / (2 * z.size))), z
+
+
+@LARGE_EDDY_BAND
 def test_the_uncorrected_mean_bias_has_the_sign_and_size_the_model_predicts(buoy):
     """The measured TI's mean bias over every record against the one the model predicts
     from the reference (the lidar's filtering lowers it, the motion raises it: here the
     motion wins, by more than half a percentage point) within 3 standard errors of the
-    records' own spread; per bin within k u (Bonferroni as above)."""
+    records' own spread."""
     _, ds = buoy
     reference = ds["turbulence_intensity_reference"].values
     predicted = ds["turbulence_intensity_measured_predicted"].values
@@ -108,10 +135,6 @@ def test_the_uncorrected_mean_bias_has_the_sign_and_size_the_model_predicts(buoy
     assert predicted_bias > 0.005
     se = np.sqrt(np.sum(spread[keep] ** 2)) / keep.sum()
     assert np.mean((measured - reference)[keep]) == pytest.approx(predicted_bias, abs=3 * se)
-    b = _bins(ds)
-    z = (b["ti_mean_bias_measured"] - b["ti_mean_bias_measured_predicted"]) / \
-        b["ti_mean_bias_measured_predicted_u"]
-    assert np.all(np.abs(z) <= special.ndtri(1 - LEVEL / (2 * z.size))), z
 
 
 def test_the_fast_paths_error_is_below_half_a_percent_of_ti(buoy):
