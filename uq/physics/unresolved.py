@@ -83,6 +83,22 @@ def quadrature_power(offsets, weights, kappa):
     return np.abs(np.tensordot(np.asarray(weights, float), phases, axes=1)) ** 2
 
 
+def _planes(spacing, alpha_epsilon, length_scale, anisotropy, rule):
+    """The rule's k1 nodes one at a time, each with its (k2, k3) plane: (k1 [rad m-1],
+    its weight w1 [rad m-1], k2 (n, 1), k3 (1, n) [rad m-1], the plane's weights w2 w3
+    (n, n) [rad2 m-2], Mann's factor C (3, 3, n, n), whether each node lies in the box's
+    Nyquist cube (n, n))."""
+    from uq.physics.turbulencebox import mann1998_spectral_factor
+    nyquist = np.pi / spacing
+    nodes, weights = axis_rule(nyquist) if rule is None else rule
+    k2, k3 = nodes[:, None], nodes[None, :]
+    cross = weights[:, None] * weights[None, :]
+    inside_23 = (np.abs(k2) < nyquist) & (np.abs(k3) < nyquist)
+    for k1, w1 in zip(nodes, weights):
+        factor = mann1998_spectral_factor(k1, k2, k3, alpha_epsilon, length_scale, anisotropy)
+        yield k1, w1, k2, k3, cross, factor, inside_23 & (abs(k1) < nyquist)
+
+
 def unresolved_radial_variances(spacing, geometry, dwell_offsets, probe_transfer,
                                 alpha_epsilon, length_scale, anisotropy, rule=None):
     """Each beam's and gate's radial-velocity variance the interpolated box misses
@@ -105,33 +121,27 @@ def unresolved_radial_variances(spacing, geometry, dwell_offsets, probe_transfer
     rule : (nodes, weights), optional
         The per-axis rule (default :func:`axis_rule` at the box's Nyquist wavenumber).
     """
-    from uq.physics.turbulencebox import mann1998_spectral_factor
     nyquist = np.pi / spacing
-    nodes, weights = axis_rule(nyquist) if rule is None else rule
     directions = np.asarray(geometry.directions, dtype=float)
     offsets = np.asarray(geometry.probe_offsets, dtype=float)
     probe_weights = np.asarray(geometry.probe_weights, dtype=float)
     speed, dwell = geometry.speed, geometry.dwell
     dwell_offsets = np.atleast_1d(np.asarray(dwell_offsets, dtype=float))
-    k2, k3 = nodes[:, None], nodes[None, :]
-    cross = weights[:, None] * weights[None, :]
-    inside_23 = (np.abs(k2) < nyquist) & (np.abs(k3) < nyquist)
-    interp_23 = interpolation_power(k2 * spacing) * interpolation_power(k3 * spacing)
     # the quadrature's power as a table in |kappa| up to the cube's corner (beyond it the
     # box holds nothing): sqrt(3) pi / d
     table_kappa = np.linspace(0.0, np.sqrt(3.0) * nyquist * 1.001,
                               constants.UNRESOLVED_QUADRATURE_TABLE)
     table = quadrature_power(offsets, probe_weights, table_kappa)       # (G, n)
     total = np.zeros((directions.shape[0], probe_weights.shape[0]))
-    for k1, w1 in zip(nodes, weights):
-        factor = mann1998_spectral_factor(k1, k2, k3, alpha_epsilon, length_scale, anisotropy)
+    for k1, w1, k2, k3, cross, factor, inside in _planes(spacing, alpha_epsilon,
+                                                          length_scale, anisotropy, rule):
         full_dwell = np.sinc(k1 * speed * dwell / (2.0 * np.pi)) ** 2
         box_dwell = np.abs(np.mean(np.exp(-1j * k1 * speed * dwell_offsets))) ** 2
-        box = (inside_23 & (abs(k1) < nyquist)) * interp_23 \
+        box = inside * (interpolation_power(k2 * spacing) * interpolation_power(k3 * spacing)) \
             * interpolation_power(k1 * spacing) * box_dwell
         for b, n in enumerate(directions):
             projected = np.einsum("i,ij...->j...", n, factor)
-            phi = np.sum(projected ** 2, axis=0) * cross * w1               # (n, n)
+            phi = np.sum(projected ** 2, axis=0) * cross * w1              # (n, n)
             kappa = k1 * n[0] + k2 * n[1] + k3 * n[2]
             full = (np.ones((probe_weights.shape[0],) + kappa.shape) if probe_transfer is None
                     else np.abs(probe_transfer(kappa)) ** 2) * full_dwell
@@ -144,15 +154,8 @@ def unresolved_radial_variances(spacing, geometry, dwell_offsets, probe_transfer
 def unresolved_point_variances(spacing, alpha_epsilon, length_scale, anisotropy, rule=None):
     """The (u, v, w) variances [m2 s-2] of the wavenumbers outside a box's Nyquist cube
     ``|k_a| < pi / d`` (at a node, where no interpolation is needed), shape (3,)."""
-    from uq.physics.turbulencebox import mann1998_spectral_factor
-    nyquist = np.pi / spacing
-    nodes, weights = axis_rule(nyquist) if rule is None else rule
-    k2, k3 = nodes[:, None], nodes[None, :]
-    cross = weights[:, None] * weights[None, :]
-    inside_23 = (np.abs(k2) < nyquist) & (np.abs(k3) < nyquist)
     total = np.zeros(3)
-    for k1, w1 in zip(nodes, weights):
-        factor = mann1998_spectral_factor(k1, k2, k3, alpha_epsilon, length_scale, anisotropy)
-        outside = ~(inside_23 & (abs(k1) < nyquist))
-        total += np.sum(np.sum(factor ** 2, axis=1) * cross * w1 * outside, axis=(1, 2))
+    for _, w1, _, _, cross, factor, inside in _planes(spacing, alpha_epsilon, length_scale,
+                                                      anisotropy, rule):
+        total += np.sum(np.sum(factor ** 2, axis=1) * cross * w1 * ~inside, axis=(1, 2))
     return total

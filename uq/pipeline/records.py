@@ -598,12 +598,9 @@ def beam_complement(settings, geometry, grid):
     if turbulence["model"] != "mann":
         return None
     lidar = settings["lidar"]
-    digest = hashlib.sha256()
-    for value in (getattr(geometry, f.name) for f in dataclasses.fields(geometry)):
-        digest.update(np.ascontiguousarray(value, dtype=float).tobytes())
     key = (grid, turbulence["length_scale"], turbulence["anisotropy"],
            repr(lidar.get("probe")), repr(lidar["ranges"]), lidar["half_cone"],
-           digest.hexdigest())
+           _arrays_digest(getattr(geometry, f.name) for f in dataclasses.fields(geometry)))
     with _BEAM_COMPLEMENTS_LOCK:
         found = _BEAM_COMPLEMENTS.get(key)
     if found is None:
@@ -729,7 +726,7 @@ def _draw_unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest)
     (:func:`unit_box_parts`: the sampling is linear in the field, so the record is the
     sum of its parts' samples, in the memory of one part)."""
     from uq.physics import turbulencesampling
-    parts, kept = unit_box_parts(settings, geometry, rng, margin)
+    parts, _ = unit_box_parts(settings, geometry, rng, margin)
     times = turbulencesampling.scan_times(geometry, n_scans)
     found = None
     for box in parts:
@@ -747,7 +744,7 @@ def _draw_unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest)
     # the scales below the box's cells at the reference point, once a scan, drawn after
     # the box (reference_complement), then at each beam and gate (beam_complement)
     grid = record_grid(settings, geometry, margin)
-    factor, _, resolved = reference_complement(settings, geometry, grid)
+    factor, kept, resolved = reference_complement(settings, geometry, grid)
     reference = reference + rng.standard_normal((n_scans, 3)) @ factor.T
     deviation = beam_complement(settings, geometry, grid)
     if deviation is not None:
@@ -762,15 +759,20 @@ def _draw_unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest)
 def _unit_key(settings, geometry, n_scans, rng, moving, margin, at_rest):
     """What a unit record depends on, as a hashable key."""
     turbulence = settings["turbulence"]
+    digest = _arrays_digest((*(getattr(geometry, f.name) for f in dataclasses.fields(geometry)),
+                             *(moving[name] for name in sorted(moving))))
+    return (repr(rng.bit_generator.state), turbulence["model"], turbulence["length_scale"],
+            turbulence["anisotropy"], n_scans, float(margin), bool(at_rest), digest)
+
+
+def _arrays_digest(values):
+    """SHA-256 (hex) of numeric values, each as a float array: its shape and bytes."""
     digest = hashlib.sha256()
-    for value in (*(getattr(geometry, f.name) for f in dataclasses.fields(geometry)),
-                  *(moving[name] for name in sorted(moving))):
+    for value in values:
         array = np.ascontiguousarray(value, dtype=float)
         digest.update(repr(array.shape).encode())
         digest.update(array.tobytes())
-    return (repr(rng.bit_generator.state), turbulence["model"], turbulence["length_scale"],
-            turbulence["anisotropy"], n_scans, float(margin), bool(at_rest),
-            digest.hexdigest())
+    return digest.hexdigest()
 
 
 def draw_first_records(scenario, fields, seed, spectra_of=None):
