@@ -13,6 +13,8 @@ import json
 import os
 import platform
 
+from uq.cpus import usable_cpus
+
 #: What each figure with a target measures, and its unit ("1": a ratio).
 DESCRIPTIONS = {
     "floating_lidar_full_mc_over_draw_floor": (
@@ -84,8 +86,7 @@ def machine_description():
         memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") / 2**30
     except (ValueError, OSError, AttributeError):
         memory = float("nan")
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else \
-        os.cpu_count()
+    cores = usable_cpus()
     return {"processor": processor, "logical_cores": os.cpu_count(), "usable_cores": cores,
             "memory_gib": round(memory, 1), "system": platform.platform(),
             "python": platform.python_version(), "numpy": numpy.__version__,

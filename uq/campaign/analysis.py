@@ -21,7 +21,6 @@ numpy's array loops release Python's lock); every number is the same either way 
 randomness; each task a fixed computation, its result put in its own place).
 """
 import concurrent.futures
-import os
 import time as clock
 
 import numpy as np
@@ -34,6 +33,7 @@ from uq.campaign.motioninput import load_motion
 from uq.campaign.recordsfile import load_records, load_reference
 from uq.constants import (CAMPAIGN_CHUNK_RECORDS, CAMPAIGN_RECORD_SECONDS, CAMPAIGN_THREADS,
                           FULL_CIRCLE_DEG)
+from uq.cpus import usable_cpus
 from uq.golden import binning, kpi
 
 #: Margin of the tables' speed range beyond the records' fastest [1] (the tables'
@@ -45,11 +45,7 @@ def local_threads():
     """Threads for the tables' nodes and the records' chunks where no dask client is
     given: one per CPU this process may use, at most :data:`~uq.constants.
     CAMPAIGN_THREADS`; None on one CPU (run in order)."""
-    try:
-        cpus = len(os.sched_getaffinity(0))
-    except AttributeError:                      # not on Linux
-        cpus = os.cpu_count() or 1
-    count = min(cpus, CAMPAIGN_THREADS)
+    count = min(usable_cpus(), CAMPAIGN_THREADS)
     return concurrent.futures.ThreadPoolExecutor(count) if count > 1 else None
 
 

@@ -26,6 +26,8 @@ import sys
 import tempfile
 import time
 
+from uq.cpus import usable_cpus
+
 #: Trials per scene of the child's run: the kernels' types, not their work, matter.
 SIDE_COMPILE_TRIALS = 64
 #: Memory the machine must have free to start the child [MB]: its peak (~390-400 MB,
@@ -39,11 +41,8 @@ LOG = logging.getLogger(__name__)
 
 
 def usable_cores():
-    """The cores this process may run on [1]."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:                   # not on Linux
-        return os.cpu_count() or 1
+    """The cores this process may run on [1] (:func:`uq.cpus.usable_cpus`)."""
+    return usable_cpus()
 
 
 #: The largest kernel of each kind of record-mode run, (module, function): a cache that

@@ -27,13 +27,13 @@ References
    sample variance. The American Statistician 37(3), 242-247.
 """
 import functools
-import os
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
 from uq.constants import (COVERAGE_PROBABILITY, FULL_CIRCLE_DEG, HALF_CIRCLE_DEG,
                           ONE_PASS_MIN_TRIALS, STORED_VALUES)
+from uq.cpus import usable_cpus
 from uq.engine.orderstats import order_statistics
 from uq.engine.statnumpy import unwrap  # noqa: F401 (public here, as before)
 
@@ -213,8 +213,7 @@ class CoMoments:
 
 #: Threads that share the order statistics of the elements (the cores this process may
 #: use, at most 4: the selections are passes over memory).
-STATISTICS_THREADS = min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
-                         else os.cpu_count() or 1)
+STATISTICS_THREADS = min(4, usable_cpus())
 #: Samples per element handed to the tails at once when the store spills (the tails'
 #: copies and masks are then a few MB, not copies of the whole 64 MB store).
 _SPILL_VALUES = 2**18

@@ -11,7 +11,6 @@ a number.
 import contextlib
 import dataclasses
 import logging
-import os
 import threading
 import time
 
@@ -19,6 +18,7 @@ import numpy as np
 import xarray as xr
 
 from uq._version import __version__
+from uq.cpus import usable_cpus
 from uq.pipeline.distributions import error_distribution
 from uq.engine.inputs import Input, moments
 from uq.pipeline import probesection, records
@@ -219,8 +219,7 @@ def _compute(scenario, plan, seed, progress, client, checkpoint, choice,
 #: Threads that evaluate ``auto``'s numpy chunks together (the cores this process may
 #: use, at most 4): the numpy model is 1-4x slower than the compiled one per core, and
 #: its ufuncs release the GIL; the background compile, at a low priority, waits.
-NUMPY_CHUNK_THREADS = min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
-                          else os.cpu_count() or 1)
+NUMPY_CHUNK_THREADS = min(4, usable_cpus())
 
 
 def _local(scenario, plan, chunks, seed, choice, kernels_ready=None):
