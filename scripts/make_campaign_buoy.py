@@ -51,7 +51,7 @@ def main(argv=None):
     missing = [h for h in synthetic.HEIGHTS
                if np.any(table[f"made_{h:g}"] & ~np.isfinite(merged[f"mean_{h:g}"]))]
     if len(parts) == count and not missing:
-        synthetic.write_files(table, merged, folder)
+        synthetic.write_files(table, merged, folder, lidar)
         for i in range(count):
             (folder / f"records.partial.{i}.csv").unlink(missing_ok=True)
         print("wrote the campaign's tables", file=sys.stderr)

@@ -216,3 +216,28 @@ def test_uq_golden_takes_the_campaigns_corrected_ti(small, tmp_path):
             assert float(g["ti_unit_mean"].values[k]) == pytest.approx(
                 100 * corrected[chosen].mean(), rel=1e-4)       # written with 5 digits
     assert "is uq campaign's" in (tmp_path / "golden" / "report.md").read_text()
+
+
+def test_the_scatter_shows_every_record_and_counts_the_intervals_past_its_top():
+    # 200 records of TI ~ 0.1 and one at 0.44 measured: every point inside the axes; an
+    # interval beyond the 99.5 % quantile of their upper ends runs off the top and the
+    # title says so
+    import matplotlib.pyplot as plt
+    import xarray as xr
+    from uq.campaign.figures import plot_scatter
+    rng = np.random.default_rng(3)
+    reference = 0.1 + 0.02 * rng.random((200, 1))
+    measured, corrected = reference * 1.05, reference * 0.98
+    measured[0, 0] = 0.44
+    high = corrected * 1.3
+    high[:1, 0] = 2.0
+    ds = xr.Dataset({name: (("time", "height"), value) for name, value in {
+        "turbulence_intensity_reference": reference, "turbulence_intensity_measured": measured,
+        "turbulence_intensity_corrected": corrected, "turbulence_intensity_corrected_low":
+        corrected * 0.8, "turbulence_intensity_corrected_high": high}.items()},
+        coords={"height": [80.0]})
+    fig = plot_scatter(ds)
+    ax = fig.axes[0]
+    assert ax.get_ylim()[1] >= 44.0 and ax.get_xlim()[1] >= 12.0
+    assert "1 interval runs past the top" in ax.get_title()
+    plt.close(fig)

@@ -117,3 +117,19 @@ def test_a_target_on_any_output_is_answered_over_every_swept_key():
         always = [f"{v:g}" for v, w in zip(u[dim].values, u.max(others).values)
                   if w <= target]
         assert f"{key}: every scene {', '.join(always) or 'none'}" in row[2]
+
+
+def test_the_box_sentence_says_which_bands_the_records_drew():
+    # from the file's stored shares alone: kept at 1 (the band larger than the box drawn
+    # as a trend) says so; a file whose records left that band out (kept 0.99) says the
+    # rest is missing; the box's own share is quoted in both
+    import xarray as xr
+    from uq.outputs.report import _box_sentence
+    whole = _box_sentence(xr.Dataset({"turbulence_intensity_box_kept": 1.0,
+                                      "turbulence_intensity_box_resolved": 0.94}))
+    assert "0.94" in whole and "larger than the box as one slow trend" in whole
+    assert "the rest" not in whole
+    short = _box_sentence(xr.Dataset({"turbulence_intensity_box_kept": 0.991,
+                                      "turbulence_intensity_box_resolved": 0.94}))
+    assert "0.991" in short and "the rest: eddies longer than the box" in short
+    assert "trend" not in short

@@ -32,11 +32,18 @@ def plot_scatter(ds):
                 label="measured")
         ax.plot(reference[keep], corrected[keep], ".", color=CORRECTED, ms=3,
                 label="corrected (95 % interval)")
-        values = np.concatenate([reference[keep], measured[keep], high[keep]])
-        top = float(np.nanquantile(values, 0.995)) * 1.05 if values.size else 1.0
+        # every point inside; the intervals' upper ends up to their 99.5 % quantile (the
+        # few beyond run off the top, counted in the title)
+        points = np.concatenate([reference[keep], measured[keep], corrected[keep]])
+        ends = high[keep][np.isfinite(high[keep])]
+        top = max(float(np.max(points)) if points.size else 1.0,
+                  float(np.quantile(ends, 0.995)) if ends.size else 0.0) * 1.05
+        past = int(np.sum(ends > top))
         ax.plot([0, top], [0, top], "-", color=REFERENCE, lw=0.8, label="1:1")
         ax.set(xlim=(0, top), ylim=(0, top), xlabel="reference TI [%]", ylabel="lidar TI [%]",
-               title=f"{h:g} m ({int(keep.sum())} records)")
+               title=f"{h:g} m ({int(keep.sum())} records)"
+               + (f"\n{past} interval{'s run' if past > 1 else ' runs'} past the top" if past
+                  else ""))
         ax.legend(fontsize=7, loc="upper left")
     return fig
 

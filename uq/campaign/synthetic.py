@@ -4,10 +4,15 @@ made by uq's own Monte Carlo records.
 
 * **Truth**: a stretch of the brightwind demo mast (:func:`uq.data.brightwind_mast`, MIT
   licence): each record's mean speed, its standard deviation and direction at 40, 60 and
-  80 m. The mast's TI (std / speed) is the record's true TI: the field of the record is a
-  Mann field (:data:`TURBULENCE`) whose expected ten-minute TI at the gate, ``sqrt(V N /
-  (N - 1)) / U`` (a point sampled once a scan, the record's high-pass, the variance over
-  N - 1 scans as the lidar's), equals it.
+  80 m. The field of the record is a Mann field (:data:`TURBULENCE`) of mean speed U the
+  mast's and of u-variance at the gate ``V`` with ``sqrt(V N / (N - 1)) / U`` (a point
+  sampled once a scan, the record's high-pass, the variance over N - 1 scans as the
+  lidar's) the mast's TI. The mast's table then holds what an ideal cup anemometer at
+  the gate reads of that field on average (:func:`cup_reading`): like every sensor that
+  averages the horizontal speed, the lidar included, its mean is the mean vector's
+  length plus the lateral turbulence's second-order share ``sigma_v^2 / (2 U)`` (0.2-2 %
+  of U on 90 % of the records, 8 % at TI 0.4). Its TI is the record's true TI (``turbulence_intensity_
+  reference``), on the convention of a mast's and a lidar's ten-minute statistics.
 * **Sea**: the significant wave height follows the wind at 80 m (a swell and the fully
   developed wind sea) with a slowly wandering factor (an AR(1) process of the records,
   :data:`SEA`), the peak period the wave height (``Tp ~ 3.3 sqrt(Hs) + 2`` with noise);
@@ -208,8 +213,9 @@ LIDAR_COLUMNS = {"speed": "Horizontal Wind Speed (m/s) at {h}m",
 LIDAR_TIME = "Date and Time (UTC+01:00, end of period)"
 
 
-def write_files(table, records, folder):
-    """The three tables a user would hold (module docstring) in `folder`."""
+def write_files(table, records, folder, lidar):
+    """The three tables a user would hold (module docstring) in `folder`; `lidar` the
+    lidar's validated settings (its scan period: the mast's cup is read once a scan)."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     lidar = pd.DataFrame(index=table.index)
@@ -230,8 +236,63 @@ def write_files(table, records, folder):
     waves = pd.DataFrame({"time_utc": table.index.strftime("%Y-%m-%dT%H:%M:%SZ"),
                           "Hm0 [m]": table["hs"].round(3), "Tp [s]": table["tp"].round(2)})
     waves.to_csv(folder / "waves.csv", index=False)
+    write_mast(table, folder, adapter.scan_period(lidar))
+
+
+def write_mast(table, folder, scan_period):
+    """The mast's table in `folder`: each record's ideal cup reading (:func:`cup_reading`)
+    at each height (the brightwind columns' names), UTC stamps at the period's start."""
     mast = pd.DataFrame({"Timestamp": table.index.strftime("%Y-%m-%d %H:%M")})
     for h, (speed, std, _) in MAST_COLUMNS.items():
-        mast[speed] = table[f"speed_{h:g}"].to_numpy()
-        mast[std] = table[f"std_{h:g}"].to_numpy()
-    mast.to_csv(folder / "mast.csv", index=False, float_format="%.4g")
+        mean, deviation = cup_reading(table[f"speed_{h:g}"].to_numpy(),
+                                      table[f"ti_{h:g}"].to_numpy(), scan_period)
+        mast[speed], mast[std] = mean, deviation
+    Path(folder).joinpath("mast.csv").write_text(
+        mast.to_csv(index=False, float_format="%.6g"))
+
+
+def cup_reading(speed, truth_ti, scan_period, duration=CAMPAIGN_RECORD_SECONDS):
+    """(mean, standard deviation (ddof 1)) [m s-1] an ideal cup anemometer at a point of
+    a record's field reads on average, sampled once a scan: the field of
+    :func:`record_settings` (mean speed `speed` U along x, expected ten-minute TI
+    `truth_ti` on the lidar's convention), arrays (n,); NaN where either is NaN.
+
+    The cup reads ``c = |(U + u, v)|``, to second order in the fluctuations
+    ``c = U + u + v^2 / (2 U)`` (the next terms dropped: the third-order
+    ``-u v^2 / (2 U^2)`` has no mean for a Gaussian field, and the fourth-order mean,
+    ``(sigma_v^2 sigma_u^2 / 2 - 3 sigma_v^4 / 8) / U^3``, is ~2 % of the share below at
+    TI 0.4, the campaign's largest):
+
+    * its mean ``U + sigma_v^2 / (2 U)``, sigma_v^2 the point v-variance of every scale
+      (the record's slow part included: the cup takes the instantaneous vector's length);
+    * its variance over the record ``V_u + (4 S_v R_v + 2 R_v^2) / (4 U^2)``, R_v the
+      v-variance over the record (its high-pass), ``S_v = sigma_v^2 - R_v`` the slower part,
+      Gaussian v: the record variance of ``v^2 = (v_s + v_r)^2`` is ``4 v_s^2 R_v`` (v_s
+      held over the record) plus that of ``v_r^2``, taken as its whole variance ``2 R_v^2``
+      (its part slower than the record, a small share of it, left in: under 1e-4 of
+      the TI);
+    * both with the records' N / (N - 1) of ``ddof`` 1; V_u = (TI U)^2 by construction.
+    """
+    from uq.physics.lidarspectral import record_filter
+    from uq.physics.spectraltensor import MannTensor, point_spectra
+    speed, truth_ti = (np.asarray(a, dtype=float) for a in (speed, truth_ti))
+    n = int(np.floor(duration / scan_period + 1e-9))
+    convention = n / (n - DDOF)
+    # the spectra's shapes are the field's at any speed (the tensor's level, which the
+    # mast's TI sets, cancels in the ratios below)
+    k1, weights, spectra = point_spectra(MannTensor(TURBULENCE["length_scale"],
+                                                    TURBULENCE["anisotropy"]))
+    whole = weights @ spectra
+    mean, deviation = np.full(speed.shape, np.nan), np.full(speed.shape, np.nan)
+    for i in np.flatnonzero(np.isfinite(speed) & np.isfinite(truth_ti) & (speed > 0)):
+        u_speed = float(speed[i])
+        kept = (weights * record_filter(k1 * u_speed / (2 * np.pi), scan_period,
+                                        duration)) @ spectra
+        scale = (truth_ti[i] * u_speed) ** 2 / (kept[0] * convention)   # V_u's
+        v_whole, v_record = whole[1] * scale, kept[1] * scale
+        mean[i] = u_speed + v_whole / (2.0 * u_speed)
+        slow = v_whole - v_record
+        variance = kept[0] * scale + (4.0 * slow * v_record + 2.0 * v_record ** 2) \
+            / (4.0 * u_speed ** 2)
+        deviation[i] = np.sqrt(variance * convention)
+    return mean, deviation

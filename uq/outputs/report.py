@@ -26,7 +26,7 @@ import numpy as np
 
 from scipy.stats import norm
 
-from uq.constants import COVERAGE_PROBABILITY, NUMERICAL_ZERO
+from uq.constants import BOX_KEPT_WHOLE, COVERAGE_PROBABILITY, NUMERICAL_ZERO
 from uq.files import SIGNATURE, write_text
 from uq.outputs import planning, verdicts
 from uq.outputs.figures import (caption, figure_plan, mark_selection, no_figure_reason,
@@ -162,6 +162,13 @@ def _box_sentence(data):
         return (f"The turbulence box keeps {_number(kept)} of the model's u-variance over "
                 f"a record (its scales below the cells are drawn at the reference point "
                 f"alone): the records' lidar TI^2 may read up to that share low.")
+    if abs(kept - 1.0) <= BOX_KEPT_WHOLE:        # the band larger than the box drawn too
+        return (f"The turbulence box resolves {_number(resolved)} of the model's u-variance "
+                f"over a record; the scales below its cells are drawn at every beam, gate "
+                f"and scan (independent: they decorrelate within a few cells) and at the "
+                f"reference point, and the eddies larger than the box as one slow trend a "
+                f"record that every beam and the reference point share, so the records' "
+                f"field where the beams read it keeps {_number(kept)}.")
     return (f"The turbulence box resolves {_number(resolved)} of the model's u-variance over "
             f"a record; the scales below its cells are drawn at every beam, gate and scan "
             f"(independent: they decorrelate within a few cells) and at the reference "

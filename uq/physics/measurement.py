@@ -290,8 +290,13 @@ def _corrected_radial(measured, believed, unit_vectors):
     the believed earth-frame beams (n, *S, b, 3); `believed`: the correction's rotation
     and ship velocity (:func:`uq.physics.correction.believed_motion`)."""
     rotation, ship = believed
-    beams = (rotation @ unit_vectors[..., None])[..., 0]               # (n, *S, k|b, 3)
-    corrected = measured + np.sum(beams * ship, axis=-1)[..., None]
+    # R u by columns, (n, *S, k|b, 3): the stacked 3 x 3 products of ``R @ u`` written
+    # out (numpy's matmul loops per 3 x 3 matrix: 2x slower on a sweep's numpy model)
+    beams = (rotation[..., 0] * unit_vectors[..., 0:1] + rotation[..., 1] * unit_vectors[..., 1:2]
+             + rotation[..., 2] * unit_vectors[..., 2:3])
+    along_ship = beams[..., 0] * ship[..., 0] + beams[..., 1] * ship[..., 1] \
+        + beams[..., 2] * ship[..., 2]
+    corrected = measured + along_ship[..., None]
     return corrected, np.broadcast_to(beams, corrected.shape[:-1] + (3,))
 
 

@@ -307,14 +307,23 @@ def point_variances(tensor, grid=None, spectral_filter=None):
     spectral_filter : callable, optional
         ``H(k1)`` [1] (e.g. a record's high-pass), of an array of k1 [rad m-1].
     """
+    k1, w1, per_k1 = point_spectra(tensor, grid)
+    h = np.ones_like(k1) if spectral_filter is None else spectral_filter(k1)
+    return np.einsum("ni,n->i", per_k1, w1 * h)
+
+
+def point_spectra(tensor, grid=None):
+    """The (u, v, w) spectra at a point along k1, ``integral Phi_ii(k) dk2 dk3``, on the
+    grid's k1 nodes: (k1 [rad m-1] (n,), their weights [rad m-1] (n,), the spectra
+    [m3 s-2] (n, 3)); :func:`point_variances` is their weighted sum (a filter ``H(k1)``
+    applied node by node)."""
     grid = grid or WavenumberGrid(tensor.length_scale)
     k1, w1 = grid.k1()
     # A few k1 at a time: the (k1, k2, k3, 3, 3) tensor of the whole grid is ~0.2 GB of
     # temporaries (the peak of a ``uq golden`` run); each k1's sum is the same either way.
     per_k1 = np.concatenate([_diagonal_per_k1(tensor, grid, k1[start:start + K1_PER_BLOCK])
                              for start in range(0, len(k1), K1_PER_BLOCK)])
-    h = np.ones_like(k1) if spectral_filter is None else spectral_filter(k1)
-    return np.einsum("ni,n->i", per_k1, w1 * h)
+    return k1, w1, per_k1
 
 
 def _diagonal_per_k1(tensor, grid, k1):

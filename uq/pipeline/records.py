@@ -41,6 +41,7 @@ import json
 import math
 import logging
 import threading
+import typing
 
 import numpy as np
 from scipy import signal
@@ -93,14 +94,15 @@ RECORD_ATTRIBUTES = {
     "turbulence_intensity_box_kept": {
         "units": "1", "long_name": "u-variance the records' field keeps of the model's "
         "over a record (the record's high-pass) where the lidar's beams read it: the box's "
-        "resolved scales plus the scales below its cells, drawn at each beam and gate once "
-        "a scan; what is missing is the band of the largest eddies below the box's lowest "
-        "wavenumber along the wind (the records' truth at the reference point carries "
-        "it too)"},
+        "resolved scales, the scales below its cells (drawn at each beam and gate once a "
+        "scan) and the band of the largest eddies the box cannot hold (longer than it "
+        "along the wind, wider across it; drawn as one linear trend a record, the same at "
+        "every beam and at the reference point): 1 where every band is drawn"},
     "turbulence_intensity_box_resolved": {
         "units": "1", "long_name": "u-variance the turbulence box alone resolves of the "
         "model's over a record (the record's high-pass): the rest, the scales below its "
-        "cells, is drawn at the beams and the reference point"},
+        "cells and the band of eddies larger than the box, is drawn at the beams and the "
+        "reference point"},
     "wind_speed_record_bias": {
         "units": "m s-1", "long_name": "Monte Carlo mean over records of the record's mean "
         "horizontal wind speed minus the field's true mean"},
@@ -459,7 +461,7 @@ def unit_box(settings, geometry, rng, motion_margin=0.0, window=True):
     turbulence = settings["turbulence"]
     if turbulence["model"] == "mann" and not window:
         grid = record_grid(settings, geometry, motion_margin)
-        kept = reference_complement(settings, geometry, grid)[1]
+        kept = reference_complement(settings, geometry, grid).kept
         return turbulencebox.mann_box(grid, 1.0, turbulence["length_scale"],
                                       turbulence["anisotropy"], rng,
                                       slab_cells=RECORD_BOX_SLAB_CELLS), kept
@@ -476,7 +478,7 @@ def unit_box_parts(settings, geometry, rng, motion_margin=0.0):
     from uq.physics import turbulencebox
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
     grid = record_grid(settings, geometry, motion_margin)
-    kept = reference_complement(settings, geometry, grid)[1]   # (first: not beside the box)
+    kept = reference_complement(settings, geometry, grid).kept   # (first: not beside the box)
     if turbulence["model"] == "mann":
         points = record_points(geometry)
         nx, ny, nz = grid.shape
@@ -490,24 +492,57 @@ def unit_box_parts(settings, geometry, rng, motion_margin=0.0):
     return [turbulencebox.kaimal_box(grid, 1.0, speed, scale, rng, nodes=nodes)], kept
 
 
-def reference_complement(settings, geometry, grid):
-    """What the records' field at the reference point adds to the box's: the field's
-    (u, v, w) record covariance [m2 s-2 per unit field_scale^2] minus the box's, on its
-    line of nodes (:func:`uq.physics.turbulencebox.box_variance` with the record's
-    high-pass; Kaimal: the box's spectra at its discrete k1), i.e. the scales below the
-    box's cells (5 % of u's variance, 10 % of v's, 17 % of w's at L / 8 for IEC Mann)
-    and the few it misses at the largest scales across the wind (1 %).
+class Complement(typing.NamedTuple):
+    """What the records draw beside the box (:func:`reference_complement`).
 
-    Those scales decorrelate within a few cells (~1/k at k above the Nyquist
-    wavenumber pi / dx across the wind), far less than a scan's advection apart, so the
-    records draw them as independent values once a scan (:func:`_draw_unit_record`;
-    their record variance about its mean is (1 - 1/N) of theirs). Returns the lower
-    Cholesky factor of that covariance (3, 3), negative eigenvalues (the box holding
-    more than the field: rounding) set to zero, the u-variance share of the field's at
-    the record's scales that the lidar's beams read [1] (``turbulence_intensity_box_
-    kept``: the box and the scales below its cells, which :func:`beam_complement` draws
-    at each beam; the rest is the band of eddies longer than the box along the wind),
-    and the box's alone [1] (``turbulence_intensity_box_resolved``)."""
+    Attributes
+    ----------
+    factor : ndarray, shape (3, 3)
+        Lower Cholesky factor of the covariance drawn at the reference point once a scan,
+        white [m s-1 per unit field scale].
+    kept : float
+        u-variance share of the field's at the record's scales the beams read [1]
+        (``turbulence_intensity_box_kept``).
+    resolved : float
+        The box's alone [1] (``turbulence_intensity_box_resolved``).
+    band : ndarray, shape (3, 3), or None
+        Lower Cholesky factor of the record covariance of the band of eddies larger than
+        the box [m s-1 per unit field scale], drawn as one trend a record
+        (:func:`band_trend`); None where none is drawn (a Kaimal box).
+    band_share : float
+        The band's share of the field's u-variance over a record [1] (0 where none is
+        drawn).
+    """
+
+    factor: np.ndarray
+    kept: float
+    resolved: float
+    band: object = None
+    band_share: float = 0.0
+
+
+def reference_complement(settings, geometry, grid):
+    """What the records' field adds to the box's (:class:`Complement`), per unit
+    field_scale^2: the field's (u, v, w) record covariance [m2 s-2] minus the box's on its
+    line of nodes (:func:`uq.physics.turbulencebox.box_variance` with the record's
+    high-pass; Kaimal: the box's spectra at its discrete k1), in two parts.
+
+    - The scales below the box's cells (5 % of u's variance, 10 % of v's, 17 % of w's at
+      L / 8 for IEC Mann; :func:`uq.physics.unresolved.unresolved_point_covariance`).
+      They decorrelate within a few cells (~1/k at k above the Nyquist wavenumber
+      pi / dx), far less than a scan's advection apart, so the records draw them at the
+      reference point as independent values once a scan (their record variance about its
+      mean is (1 - 1/N) of theirs) and at each beam and gate (:func:`beam_complement`).
+    - The band of eddies larger than the box (longer than it along the wind, wider
+      across it: 0.3-1.9 % of u's variance over ten minutes, the most at low speeds):
+      scales far above the scan's size and a record's slowest, so every beam and the
+      reference point read them together as one slow change over the record, drawn as
+      a linear trend of that record covariance (:func:`band_trend`).
+
+    Negative eigenvalues of either (the box holding more than the field: rounding) are
+    set to zero. A Kaimal box (made on its nodes across the wind) draws its whole
+    complement at the reference point, white, and nothing at the beams
+    (kept = resolved)."""
     turbulence, speed = settings["turbulence"], settings["wind"]["speed"]
     if turbulence["model"] == "mann":
         return _mann_complement(grid, turbulence["length_scale"], turbulence["anisotropy"],
@@ -516,17 +551,50 @@ def reference_complement(settings, geometry, grid):
                               geometry.record_duration)
 
 
-def _complement_factor(field, box, scans, unresolved_u=0.0):
-    """(Cholesky factor of the white complement's covariance, the u-variance share the
-    records' beams keep (the box and `unresolved_u`, the scales below its cells that
-    :func:`beam_complement` draws at the beams), the share the box alone resolves)."""
-    missing = field - box
-    values, vectors = np.linalg.eigh(missing)
-    missing = (vectors * np.maximum(values, 0.0)) @ vectors.T
-    factor = np.linalg.cholesky(missing / max(1.0 - 1.0 / scans, 1e-12)
-                                + 1e-300 * np.eye(3))
-    return (factor, float((box[0, 0] + unresolved_u) / field[0, 0]),
-            float(box[0, 0] / field[0, 0]))
+def _nonnegative(covariance):
+    """A symmetric matrix with its negative eigenvalues set to zero."""
+    values, vectors = np.linalg.eigh(covariance)
+    return (vectors * np.maximum(values, 0.0)) @ vectors.T
+
+
+def _cholesky(covariance):
+    """A factor L of a nonnegative covariance (3, 3), ``L L^T`` = it: the lower Cholesky
+    factor (a vanishing ridge for one that is singular), or where rounding leaves it
+    indefinite (a band of a short record, near zero in some direction) its eigenvectors
+    times the roots of its eigenvalues, negative ones set to zero."""
+    try:
+        return np.linalg.cholesky(covariance + 1e-300 * np.eye(3))
+    except np.linalg.LinAlgError:
+        values, vectors = np.linalg.eigh(covariance)
+        return vectors * np.sqrt(np.maximum(values, 0.0))
+
+
+def _complement_factor(field, box, scans, unresolved=None):
+    """:class:`Complement` of a field's and a box's record covariances (3, 3); with
+    `unresolved` (the covariance of the scales below the box's cells) the band of eddies
+    larger than the box is ``field - box - unresolved``, drawn as a trend."""
+    missing = _nonnegative(field - box)
+    white_share = max(1.0 - 1.0 / scans, 1e-12)
+    resolved = float(box[0, 0] / field[0, 0])
+    if unresolved is None:
+        return Complement(_cholesky(missing / white_share), resolved, resolved)
+    band = _nonnegative(missing - unresolved)
+    white = _nonnegative(missing - band)
+    return Complement(_cholesky(white / white_share),
+                      float((box[0, 0] + unresolved[0, 0] + band[0, 0]) / field[0, 0]),
+                      resolved, _cholesky(band), float(band[0, 0] / field[0, 0]))
+
+
+def band_trend(n_scans):
+    """The shape of the band of eddies larger than the box over a record: a linear trend
+    in the scan index, of zero mean and unit variance over the record's N scans
+    (``(i - (N - 1) / 2) sqrt(12 / (N^2 - 1))``; zeros for one scan), shape (N,). A
+    band's draw ``a = L z`` (L its factor, z three standard normals) times it has the
+    band's record covariance exactly in expectation: ``E[a a^T] = L L^T``."""
+    if n_scans < 2:
+        return np.zeros(max(int(n_scans), 0))
+    index = np.arange(n_scans, dtype=float) - (n_scans - 1) / 2.0
+    return index * math.sqrt(12.0 / (n_scans ** 2 - 1.0))
 
 
 @functools.lru_cache(maxsize=8)
@@ -538,7 +606,7 @@ def _mann_complement(grid, length_scale, anisotropy, speed, scan_period, duratio
     from uq.physics.scangeometry import ScanGeometry
     from uq.physics.spectraltensor import MannTensor
     from uq.physics.spectralquadrature import record_scans
-    from uq.physics.unresolved import unresolved_point_variances
+    from uq.physics.unresolved import unresolved_point_covariance
     point = ScanGeometry(np.array([[1.0, 0, 0]]), np.zeros((1, 1, 3)), np.zeros(1), 0.0,
                          scan_period, np.zeros(1), np.ones((1, 1)), np.ones((1, 3, 1)),
                          speed, duration)
@@ -549,10 +617,10 @@ def _mann_complement(grid, length_scale, anisotropy, speed, scan_period, duratio
                                                  duration))
     box = np.array([[u, 0.0, uw], [0.0, v, 0.0], [uw, 0.0, w]])
     # the scales below the box's cells, which the beams get too (beam_complement); the
-    # record's high-pass is 1 there (their wavenumbers are far above 1 / (U T))
-    unresolved_u = unresolved_point_variances(grid.spacing[0], 1.0, length_scale,
-                                              anisotropy)[0]
-    return _complement_factor(field, box, record_scans(scan_period, duration), unresolved_u)
+    # record's high-pass is 1 there (their wavenumbers are far above 1 / (U T)); the rest
+    # of field - box is the band of eddies larger than the box
+    unresolved = unresolved_point_covariance(grid.spacing[0], 1.0, length_scale, anisotropy)
+    return _complement_factor(field, box, record_scans(scan_period, duration), unresolved)
 
 
 @functools.lru_cache(maxsize=8)
@@ -744,8 +812,8 @@ def _draw_unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest)
     # the scales below the box's cells at the reference point, once a scan, drawn after
     # the box (reference_complement), then at each beam and gate (beam_complement)
     grid = record_grid(settings, geometry, margin)
-    factor, kept, resolved = reference_complement(settings, geometry, grid)
-    reference = reference + rng.standard_normal((n_scans, 3)) @ factor.T
+    complement = reference_complement(settings, geometry, grid)
+    reference = reference + rng.standard_normal((n_scans, 3)) @ complement.factor.T
     deviation = beam_complement(settings, geometry, grid)
     if deviation is not None:
         unresolved = rng.standard_normal(radial.shape) * deviation
@@ -753,7 +821,18 @@ def _draw_unit_record(settings, geometry, n_scans, rng, moving, margin, at_rest)
         # the lidar at rest reads the same small scales (the same field, its probes
         # displaced by the motion alone)
         rest = None if rest is None else rest + unresolved
-    return UnitRecord(radial, reference, rest, kept, rng.bit_generator.state, resolved)
+    if complement.band is not None:
+        # the band of eddies larger than the box: one trend a record, the same (u, v, w)
+        # at the reference point and at every beam and gate, each reading it along its
+        # nominal direction (a tilt of a few degrees changes that by under 0.5 % of a
+        # band of 1-2 % of the variance)
+        trend = np.outer(band_trend(n_scans), complement.band @ rng.standard_normal(3))
+        reference = reference + trend
+        along = (trend @ np.asarray(geometry.directions, dtype=float).T)[:, :, None]
+        radial = radial + along
+        rest = None if rest is None else rest + along
+    return UnitRecord(radial, reference, rest, complement.kept, rng.bit_generator.state,
+                      complement.resolved)
 
 
 def _unit_key(settings, geometry, n_scans, rng, moving, margin, at_rest):
