@@ -46,9 +46,14 @@ import numpy as np
 
 
 def _matrix(rows):
-    """Stack nested lists of broadcastable arrays into shape (..., 3, 3)."""
-    arrays = np.broadcast_arrays(*[np.asarray(e) for row in rows for e in row])
-    return np.stack(arrays, axis=-1).reshape(arrays[0].shape + (3, 3))
+    """Nested lists of broadcastable arrays (or numbers) as one array (..., 3, 3): each
+    element written into its slot (no broadcast copies of constant entries)."""
+    elements = [np.asarray(e) for row in rows for e in row]
+    out = np.empty(np.broadcast_shapes(*(e.shape for e in elements)) + (3, 3),
+                   dtype=np.result_type(*elements, 0.0))
+    for index, element in enumerate(elements):
+        out[..., index // 3, index % 3] = element
+    return out
 
 
 def rotation_about_vertical(angle):
@@ -61,8 +66,7 @@ def rotation_about_vertical(angle):
     ndarray, shape (..., 3, 3)
     """
     c, s = np.cos(angle), np.sin(angle)
-    zero, one = np.zeros_like(c), np.ones_like(c)
-    return _matrix([[c, -s, zero], [s, c, zero], [zero, zero, one]])
+    return _matrix([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def rotation_pitch(pitch):
@@ -71,8 +75,7 @@ def rotation_pitch(pitch):
     The bow unit vector (1, 0, 0) becomes (cos p, 0, sin p).
     """
     c, s = np.cos(pitch), np.sin(pitch)
-    zero, one = np.zeros_like(c), np.ones_like(c)
-    return _matrix([[c, zero, -s], [zero, one, zero], [s, zero, c]])
+    return _matrix([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
 
 
 def rotation_roll(roll):
@@ -81,8 +84,7 @@ def rotation_roll(roll):
     The starboard unit vector (0, 1, 0) becomes (0, cos r, -sin r).
     """
     c, s = np.cos(roll), np.sin(roll)
-    zero, one = np.zeros_like(c), np.ones_like(c)
-    return _matrix([[one, zero, zero], [zero, c, s], [zero, -s, c]])
+    return _matrix([[1.0, 0.0, 0.0], [0.0, c, s], [0.0, -s, c]])
 
 
 def attitude_matrix(heading, pitch, roll):
