@@ -318,6 +318,10 @@ class StreamingStatistics:
         values = np.asarray(values, dtype=float)
         m = len(values)
         flat = values.reshape(m, self.size)          # (a view where the layout allows)
+        if self._stored and max(self._count + m, self._expected) * self.size > self._budget:
+            # a run that will outgrow the store: the tails from now on (from its first
+            # values where it says so), not a store grown past its budget and then spilled
+            self._spill()
         if kind == "symmetric" and self._stored and self._expected >= ONE_PASS_MIN_TRIALS \
                 and self.compiled:
             return self._add_in_one_pass(flat, batch_size, summarize,
