@@ -159,3 +159,39 @@ def test_a_lidar_that_is_a_point_does_not_filter():
     settings = adapter.gate_settings(raw, [80.0], TURBULENCE, 600.0, 0.01, 30.0)
     assert spectra.filtering_factor(adapter.spectral_terms(settings).gate(0)) == \
         pytest.approx(1.0, abs=1e-4)
+
+
+def test_the_scenes_quiet_warnings_are_their_threads_alone():
+    # the campaign builds its gate scenes on several threads at once: their quieting of
+    # the scenario's warnings must neither leave the logger's level raised for the whole
+    # process (it did: save, raise, restore from threads at once) nor silence another
+    # thread's warning while it runs
+    import logging
+    import threading
+    from uq.campaign import adapter
+    logger = logging.getLogger("uq.pipeline.scenario")
+    level = logger.level
+    inside, release = threading.Barrier(5), threading.Event()
+
+    def quiet_scene():
+        adapter._quiet(lambda: (inside.wait(), release.wait(), logger.warning("hidden")))
+    records = []
+
+    class Keep(logging.Handler):
+        def emit(self, record):
+            records.append(record.getMessage())
+    handler = Keep(level=logging.WARNING)
+    logger.addHandler(handler)
+    try:
+        threads = [threading.Thread(target=quiet_scene) for _ in range(4)]
+        for thread in threads:
+            thread.start()
+        inside.wait()                       # all four inside _quiet: this thread is not
+        logger.warning("shown")
+        release.set()
+        for thread in threads:
+            thread.join()
+    finally:
+        logger.removeHandler(handler)
+    assert records == ["shown"]
+    assert logger.level == level

@@ -42,6 +42,8 @@ variance ``|sum_d z_d conj(a_d)|^2 / 2 = z^H M z`` with ``M = a a^H / 2``.
 import copy
 import dataclasses
 import functools
+import logging
+import threading
 
 import numpy as np
 
@@ -112,17 +114,34 @@ def gate_settings(lidar, heights, turbulence, record_duration, speed=10.0, direc
     return _quiet(load_scenario, raw).settings
 
 
+#: Threads inside :func:`_quiet` (a thread-local flag: the campaign builds its scenes on
+#: several threads at once, and a logger's level is the whole process's).
+_QUIET = threading.local()
+
+
+class _QuietFilter(logging.Filter):
+    """Drops the scenario's warnings logged by a thread inside :func:`_quiet` (errors
+    pass); other threads' are untouched."""
+
+    def filter(self, record):
+        return getattr(_QUIET, "depth", 0) == 0 or record.levelno >= logging.ERROR
+
+
+_SCENARIO_LOGGER = logging.getLogger("uq.pipeline.scenario")
+if not any(isinstance(f, _QuietFilter) for f in _SCENARIO_LOGGER.filters):
+    _SCENARIO_LOGGER.addFilter(_QuietFilter())
+
+
 def _quiet(function, *args):
     """`function(*args)` without the scenario's warnings about keys that have no effect
-    in this reduced scene (an INS rate without motion: the campaign gives the motion)."""
-    import logging
-    logger = logging.getLogger("uq.pipeline.scenario")
-    level = logger.level
-    logger.setLevel(logging.ERROR)
+    in this reduced scene (an INS rate without motion: the campaign gives the motion),
+    in this thread alone: the logger's level is left as it is (setting it, then putting
+    it back, from threads at once could leave it raised for the whole process)."""
+    _QUIET.depth = getattr(_QUIET, "depth", 0) + 1
     try:
         return function(*args)
     finally:
-        logger.setLevel(level)
+        _QUIET.depth -= 1
 
 
 def default_length_scale(height):
