@@ -171,6 +171,7 @@ def test_the_scenes_quiet_warnings_are_their_threads_alone():
     from uq.campaign import adapter
     logger = logging.getLogger("uq.pipeline.scenario")
     level = logger.level
+    logger.setLevel(logging.WARNING)        # (an earlier `uq ... -q` may have raised "uq")
     inside, release = threading.Barrier(5), threading.Event()
 
     def quiet_scene():
@@ -191,7 +192,8 @@ def test_the_scenes_quiet_warnings_are_their_threads_alone():
         release.set()
         for thread in threads:
             thread.join()
+        assert logger.level == logging.WARNING          # the quiet threads left it alone
     finally:
         logger.removeHandler(handler)
+        logger.setLevel(level)
     assert records == ["shown"]
-    assert logger.level == level
