@@ -292,22 +292,20 @@ def _corrected_radial(measured, believed, unit_vectors, beams_wanted=True):
     the correction's rotation and ship velocity
     (:func:`uq.physics.correction.believed_motion`)."""
     rotation, ship = believed
+    # the ship velocity along each beam, (R u) . s = sum_j u_j (R^T s)_j: R^T s once per
+    # reading (n, *S, k), component by component, then a product per beam
+    along_ship = 0.0
+    for j in range(3):
+        turned = rotation[..., 0, j] * ship[..., 0] + rotation[..., 1, j] * ship[..., 1] \
+            + rotation[..., 2, j] * ship[..., 2]
+        along_ship = along_ship + turned * unit_vectors[..., j]
+    corrected = measured + along_ship[..., None]
     if not beams_wanted:
-        # the ship velocity along each beam, (R u) . s = sum_j u_j (R^T s)_j: R^T s once
-        # per reading (n, *S, k), component by component, then a product per beam
-        along_ship = 0.0
-        for j in range(3):
-            turned = rotation[..., 0, j] * ship[..., 0] + rotation[..., 1, j] * ship[..., 1] \
-                + rotation[..., 2, j] * ship[..., 2]
-            along_ship = along_ship + turned * unit_vectors[..., j]
-        return measured + along_ship[..., None], None
+        return corrected, None
     # R u by columns, (n, *S, k|b, 3): the stacked 3 x 3 products of ``R @ u`` written
     # out (numpy's matmul loops per 3 x 3 matrix: 2x slower on a sweep's numpy model)
     beams = (rotation[..., 0] * unit_vectors[..., 0:1] + rotation[..., 1] * unit_vectors[..., 1:2]
              + rotation[..., 2] * unit_vectors[..., 2:3])
-    along_ship = beams[..., 0] * ship[..., 0] + beams[..., 1] * ship[..., 1] \
-        + beams[..., 2] * ship[..., 2]
-    corrected = measured + along_ship[..., None]
     return corrected, np.broadcast_to(beams, corrected.shape[:-1] + (3,))
 
 
