@@ -14,18 +14,36 @@ index (wrong source stamp, numba version, CPU or signature) and before it compil
 listener raises there, which ends that compile before it starts. A kernel found in the
 cache loads as usual. Imports numba only when entered.
 
+The same guard serves the kernels a record-mode run calls outside its chunks' model
+(the colouring of its turbulence boxes, their sampling along the beams, the spectral
+path's sums): within :func:`numpy_while_uncached` (``uq run --model auto``),
+:func:`cached_kernels` hands their module to the caller only where numba's cache holds
+its kernels, else None and the caller takes its numpy equivalent (the same numbers to
+rounding); it looks again, at most every :data:`RETRY_SECONDS`, so that a run takes
+the compiled kernels once the background compile has written them.
+
 The lock of the background compile of a numba cache (:func:`lock_path`, one per cache
 folder and user; :mod:`uq.cli.firstrun` takes it) is here too, so that whatever waits
 for that compile (``uq bench``, CI) needs no command-line module.
 """
 import contextlib
+import importlib
+import sys
 import threading
+import time
 
 #: The numba event that precedes a compile (and never a load from the cache).
 COMPILE_EVENT = "numba:compile"
 
+#: Seconds between two looks for a kernel module found missing from numba's cache
+#: (:func:`cached_kernels`): a look that fails costs the module's import (~10 ms); the
+#: background compile of a record's kernels takes seconds.
+RETRY_SECONDS = 1.0
+
 _LOCK = threading.Lock()
 _ACTIVE = [0]                    # guards entered and not left (any thread)
+_NUMPY_WHILE_UNCACHED = [0]      # numpy_while_uncached entered and not left
+_MISSED = {}                     # module name -> time of the last look that failed
 
 
 class KernelNotCached(RuntimeError):
@@ -60,6 +78,40 @@ def cached_only():
         event.unregister(COMPILE_EVENT, listener)
         with _LOCK:
             _ACTIVE[0] -= 1
+
+
+@contextlib.contextmanager
+def numpy_while_uncached():
+    """Within (process-wide, any thread): :func:`cached_kernels` returns None for a
+    kernel module that numba would have to compile, and nothing compiles."""
+    with _LOCK:
+        _NUMPY_WHILE_UNCACHED[0] += 1
+    try:
+        yield
+    finally:
+        with _LOCK:
+            _NUMPY_WHILE_UNCACHED[0] -= 1
+
+
+def cached_kernels(name):
+    """The kernel module `name` (e.g. ``"uq.physics.turbulencekernels"``, whose kernels
+    compile on import): imported as usual (compiling what numba's cache lacks); within
+    :func:`numpy_while_uncached`, None where its kernels are not all in the cache (the
+    caller then runs its numpy equivalent), looked for again at most every
+    :data:`RETRY_SECONDS`."""
+    module = sys.modules.get(name)
+    if module is not None or not _NUMPY_WHILE_UNCACHED[0]:
+        return module if module is not None else importlib.import_module(name)
+    with _LOCK:
+        if time.monotonic() - _MISSED.get(name, -float("inf")) < RETRY_SECONDS:
+            return None
+    try:
+        with cached_only():
+            return importlib.import_module(name)
+    except KernelNotCached:
+        with _LOCK:
+            _MISSED[name] = time.monotonic()
+        return None
 
 
 def _kernel_name(data):

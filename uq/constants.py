@@ -567,8 +567,15 @@ RECORD_SPECTRA_BYTES = 2**28
 #: Threads of scipy's FFTs of a record's box [1] (records.unit_box_parts): they share out
 #: independent 1-D transforms, so the box is the same bits on any number; 2 halve the
 #: transforms' wall time on an idle 2-core machine (the x transforms of a ten-minute box
-#: 0.19 -> 0.10 s), where a record-mode run's first run is measured (issue 26).
+#: 0.19 -> 0.10 s), where a record-mode run's first run is measured.
 RECORD_FFT_WORKERS = 2
+
+#: Usable CPUs from which a first run's background compile runs beside the run
+#: (uq.cli.firstrun.compile_beside) [1]: a run's numpy chunks take up to 4 threads
+#: (uq.pipeline.runner.NUMPY_CHUNK_THREADS), so from the fifth a core is left to the
+#: compile; with fewer it waits for the run to end (beside it, it slowed the run by
+#: 20-30 % on 2 cores and ended after it).
+BACKGROUND_BESIDE_MIN_CPUS = 5
 
 #: Cell averaging of the Mann tensor near the k1 axis (turbulencebox.cell_averaged_factors)
 #: [1]: cells with |k1| <= CELL_AVERAGE_K1 max(dk2, dk3), beyond which the tensor varies

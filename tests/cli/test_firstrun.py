@@ -60,15 +60,74 @@ def test_one_compile_at_a_time_per_cache(tmp_path, monkeypatch):
     assert first.ended() and second.ended() and not firstrun.compile_running()
 
 
+def _child_calls(monkeypatch, calls):
+    """firstrun.main's compiles, priority and waits recorded in `calls`, not done."""
+    monkeypatch.setattr("uq.cli.warmup.compile_for", lambda path: calls.append(path))
+    monkeypatch.setattr("uq.cli.warmup.compile_record_kernels",
+                        lambda: calls.append("record kernels"))
+    monkeypatch.setattr(firstrun, "lower_priority", lambda: calls.append("lowered"))
+    monkeypatch.setattr(firstrun, "_wait_for_exit", lambda pid: calls.append(("wait", pid)))
+
+
 def test_the_child_compiles_each_scenario_and_removes_its_file(tmp_path, monkeypatch):
     settings = tmp_path / "s.yaml"
     settings.write_text("name: x\n---\nname: y\n")
     compiled = []
-    monkeypatch.setattr("uq.cli.warmup.compile_for", lambda path: compiled.append(path))
-    monkeypatch.setattr(firstrun.os, "nice", lambda value: compiled.append(value))
+    _child_calls(monkeypatch, compiled)
     assert firstrun.main([str(settings), "3"]) == 0
-    assert compiled == [firstrun.BACKGROUND_NICE, {"name": "x"}, {"name": "y"}]
+    assert compiled == ["lowered", {"name": "x"}, {"name": "y"}]
     assert not settings.exists()
+
+
+def test_the_child_compiles_a_records_kernels_first_then_waits_for_the_run(tmp_path,
+                                                                           monkeypatch):
+    # a record-mode scenario's boxes and spectral path first (the run takes them as soon
+    # as they are cached), then, given the run's process, the rest once it has ended
+    settings = tmp_path / "s.yaml"
+    settings.write_text("name: x\nturbulence: {model: mann}\n")
+    calls = []
+    _child_calls(monkeypatch, calls)
+    assert firstrun.main([str(settings), "3", "1234"]) == 0
+    assert calls == ["lowered", "record kernels", ("wait", 1234),
+                     {"name": "x", "turbulence": {"model": "mann"}}]
+
+
+def test_the_priority_is_the_idle_class_where_linux_has_it():
+    # in a child process: this one's priority is the suite's
+    code = ("import os; from uq.cli.firstrun import lower_priority, BACKGROUND_NICE; "
+            "lower_priority(); print(os.sched_getscheduler(0) == os.SCHED_IDLE, "
+            "os.nice(0) >= BACKGROUND_NICE)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert done.returncode == 0, child_failure(done)
+    assert done.stdout.split() == ["True", "True"]
+
+
+def test_the_child_waits_for_its_parent_to_end(tmp_path):
+    # a parent starts a child that waits for it, then ends after writing its mark: the
+    # child's mark comes after the parent's (an order, not a duration)
+    marks = tmp_path / "marks"
+    child = ("import os, sys; from uq.cli.firstrun import _wait_for_exit; "
+             "_wait_for_exit(int(sys.argv[1])); open(sys.argv[2], 'a').write('child\\n')")
+    parent = (f"import os, subprocess, sys; subprocess.Popen([sys.executable, '-c', {child!r}, "
+              "str(os.getpid()), sys.argv[1]]); import time; time.sleep(1.0); "
+              "open(sys.argv[1], 'a').write('parent\\n')")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    done = subprocess.run([sys.executable, "-c", parent, str(marks)], env=env,
+                          capture_output=True, text=True)
+    assert done.returncode == 0, child_failure(done)
+    for _ in range(600):                 # the child polls every WAIT_POLL_SECONDS
+        if marks.exists() and "child" in marks.read_text():
+            break
+        time.sleep(0.1)
+    assert marks.read_text().split() == ["parent", "child"]
+
+
+@pytest.mark.parametrize("cpus, beside", [(2, False), (4, False), (5, True), (16, True)])
+def test_the_compile_runs_beside_the_run_only_with_a_core_to_spare(monkeypatch, cpus,
+                                                                   beside):
+    monkeypatch.setattr("uq.cpus.usable_cpus", lambda: cpus)
+    assert firstrun.compile_beside() is beside
 
 
 def test_turned_off_the_run_compiles_itself(tmp_path, monkeypatch):

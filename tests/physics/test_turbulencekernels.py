@@ -146,3 +146,57 @@ def test_a_windowed_box_is_the_same_bits_on_several_fft_threads():
              for workers in (None, RECORD_FFT_WORKERS, 3)]
     for box in boxes[1:]:
         np.testing.assert_array_equal(box.velocity, boxes[0].velocity)
+
+
+@pytest.fixture
+def numpy_kernels(monkeypatch):
+    """The records' kernels taken as missing from numba's cache (a first run after an
+    install, uq.compileguard.cached_kernels): their numpy equivalents run."""
+    import uq.compileguard
+    monkeypatch.setattr(uq.compileguard, "cached_kernels", lambda name: None)
+
+
+def test_numpy_colouring_is_the_kernels(numpy_kernels):
+    # the host box (whole and windowed, in parts) coloured by numpy a few rows at a time
+    # equals the reference box (the same factor, by slabs) and the compiled kernel's box
+    grid = tb.BoxGrid(shape=(30, 9, 11), spacing=(4.2, 4.2, 4.2))
+    reference = tb.mann_box_reference(grid, ALPHA_EPSILON, LENGTH, GAMMA,
+                                      np.random.default_rng(5)).velocity
+    numpy_box = tb.mann_box(grid, ALPHA_EPSILON, LENGTH, GAMMA, np.random.default_rng(5),
+                            slab_cells=100).velocity
+    assert np.max(np.abs(numpy_box - reference)) <= RTOL * np.max(np.abs(reference))
+    window = tb.mann_box_window(grid, ALPHA_EPSILON, LENGTH, GAMMA, np.random.default_rng(5),
+                                ((2, 8), (3, 9)), 2, slab_cells=100).velocity
+    part = reference[:, :, 2:8, 3:9]
+    assert np.max(np.abs(window - part)) <= RTOL * np.max(np.abs(part))
+
+
+def test_compiled_colouring_is_the_numpy_colouring(monkeypatch):
+    grid = tb.BoxGrid(shape=(30, 9, 11), spacing=(4.2, 4.2, 4.2))
+    compiled = tb.mann_box(grid, ALPHA_EPSILON, LENGTH, GAMMA, np.random.default_rng(5),
+                           slab_cells=100).velocity
+    import uq.compileguard
+    monkeypatch.setattr(uq.compileguard, "cached_kernels", lambda name: None)
+    numpy_box = tb.mann_box(grid, ALPHA_EPSILON, LENGTH, GAMMA, np.random.default_rng(5),
+                            slab_cells=100).velocity
+    assert np.max(np.abs(numpy_box - compiled)) <= RTOL * np.max(np.abs(compiled))
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_numpy_sampling_is_the_kernels(periodic, monkeypatch):
+    # the records' sampling along the beams with its kernel missing (numpy's array code)
+    # equals the compiled kernel's, nominal and moving beams
+    geometry, box = _scan_and_box(periodic)
+    rng = np.random.default_rng(4)
+    n = 5
+    moved = rng.normal(0.0, 0.5, (n, geometry.n_beams, 3))
+    turned = geometry.directions + rng.normal(0.0, 0.01, (n, geometry.n_beams, 3))
+    turned /= np.linalg.norm(turned, axis=-1, keepdims=True)
+    cases = ({}, {"displacements": moved, "directions": turned,
+                  "position": np.array([0.0, 0.0, -60.0])})
+    compiled = [ts.record_radial_velocities(box, geometry, n, **kwargs) for kwargs in cases]
+    import uq.compileguard
+    monkeypatch.setattr(uq.compileguard, "cached_kernels", lambda name: None)
+    for kwargs, expected in zip(cases, compiled):
+        numpy_scans = ts.record_radial_velocities(box, geometry, n, **kwargs)
+        assert np.max(np.abs(numpy_scans - expected)) <= RTOL * np.max(np.abs(expected))

@@ -109,10 +109,15 @@ result.to_netcdf(sys.argv[2])
 @pytest.mark.parametrize("name, changes", [
     ("rubio2022_case_i", SMALL),
     ("floating_lidar_waves", {"sampling.n": 500}),
+    # record mode: the boxes' colouring and sampling and the spectral path by numpy too
+    ("sathe2011_ti", {"sampling.n": 500, "record.duration": 120, "record.count": 2}),
 ])
 def test_a_cold_cache_runs_numpy_compiles_nothing_and_agrees(tmp_path, name, changes):
     """In a new process with an empty cache, auto runs every chunk with numpy and leaves
-    the cache empty (nothing compiled); its numbers are the compiled run's to 1e-12."""
+    the cache empty (nothing compiled); its numbers are the compiled run's to 1e-12 (the
+    wind outputs, m s-1) and every other variable's to 1e-9 of its largest value (the
+    spectral path's sums may differ by 3e-10, tests/physics/test_spectralsums.py) plus
+    1e-12 (a value that is zero but for rounding)."""
     cache = tmp_path / "numba"
     env = {**os.environ, "NUMBA_CACHE_DIR": str(cache), "PYTHONPATH": str(ROOT)}
     out = tmp_path / "auto.nc"
@@ -129,6 +134,11 @@ def test_a_cold_cache_runs_numpy_compiles_nothing_and_agrees(tmp_path, name, cha
     _assert_agree(warm, cold, scenario.settings["wind"]["speed"])
     for variable in ("wind_speed_mc_mean", "wind_speed_mc_u"):    # not only NaN-free
         assert np.all(np.isfinite(cold[variable].values))
+    for variable in warm.data_vars:
+        values = warm[variable].values
+        if values.dtype.kind == "f" and np.isfinite(values).any():
+            gap = np.nanmax(np.abs(cold[variable].values - values))
+            assert gap <= 1e-9 * np.nanmax(np.abs(values)) + 1e-12, (variable, gap)
 
 
 def test_numpy_chunks_on_threads_are_the_sequential_ones_bit_for_bit(tmp_path):

@@ -283,8 +283,8 @@ def _pair_level(geometry, tensor, transfer, level, coarse=False):
     """The beam-pair path's terms per k1 node on the rules of `level`
     (:class:`~uq.physics.lidarspectral.PairResolution`; `coarse`: two nodes fewer a
     panel, the path's error estimate)."""
-    from uq.physics import spectralkernels, turbulencebox
-    from uq.physics.lidarspectral import _pair_separations
+    from uq.physics import turbulencebox
+    from uq.physics.lidarspectral import _pair_separations, spectral_sums
     from uq.physics.spectralquadrature import PanelRule, geometric_edges, record_weights
     length = tensor.length_scale
     first, second, delta = _pair_separations(geometry)
@@ -308,7 +308,7 @@ def _pair_level(geometry, tensor, transfer, level, coarse=False):
     if colocated is None or not colocated.all():
         sums = np.zeros((geometry.n_gates, first.size, rule1.size), dtype=complex)
         table = turbulencebox._TABLE
-        spectralkernels.pair_sums(
+        spectral_sums().pair_sums(
             rule1.nodes, rule2.nodes, rule3.nodes, tensor.alpha_epsilon, length,
             tensor.anisotropy, float(table[0][0]), float(table[0][1] - table[0][0]),
             np.ascontiguousarray(table[1]),

@@ -143,7 +143,8 @@ def load_kernels(args, scenario, background=None):
     (:mod:`uq.cli.sidecompile`). With ``--model auto`` nothing compiles here: the
     kernels are loaded where numba's cache holds them (a record-mode run's too: loading
     keeps far less than compiling), else their compile starts in the background
-    (:mod:`uq.cli.firstrun`)."""
+    (:mod:`uq.cli.firstrun`; a record's boxes and spectral path take numpy meanwhile,
+    :func:`uq.compileguard.cached_kernels`)."""
     model = getattr(args, "model", "compiled")
     if model == "numpy":
         return                                    # no kernel is called
@@ -151,6 +152,9 @@ def load_kernels(args, scenario, background=None):
         from uq.compileguard import KernelNotCached, cached_only
         try:                             # (the run finds it missing too: numpy)
             with cached_only():
+                if draws_records(scenario):  # the boxes' and the spectral path's
+                    from uq.cli.warmup import compile_record_kernels
+                    compile_record_kernels()
                 _load_kernels(scenario)
         except KernelNotCached as error:
             background.start(error)

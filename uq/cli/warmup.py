@@ -35,7 +35,7 @@ def command(args):
     import uq.engine.statkernels  # noqa: F401  (explicit signatures: compiled on import)
     import uq.engine.passkernels  # noqa: F401  (the same: long runs' one-pass batches)
     from uq.physics import fusedmotionkernels  # (the same)
-    from uq.physics import turbulencekernels  # noqa: F401  (record mode's: the same)
+    compile_record_kernels()                          # record mode's (the same)
     from uq.physics import fusedkernels
     for number in (float, complex):
         for name in fusedkernels.KERNEL_NAMES:
@@ -63,7 +63,8 @@ def compile_for(scenario, overrides=()):
     results discarded: numba compiles (or loads) every kernel of its per-scan Monte
     Carlo, the GUM's and the statistics' (those of runs of 2^17 trials or more too,
     which a run of a few trials does not call). A record-mode run's own records then
-    call the same kernels (:mod:`uq.cli.sidecompile`)."""
+    call the same kernels (:mod:`uq.cli.sidecompile`); its boxes' and spectral path's
+    kernels are compiled first (:func:`compile_record_kernels`)."""
     import copy
     import logging
     from uq.cli.common import parse_overrides
@@ -74,6 +75,8 @@ def compile_for(scenario, overrides=()):
     if not isinstance(scenario, dict):
         scenario = scenario_path(scenario)
     settings = copy.deepcopy(load_scenario(scenario, parse_overrides(overrides)).settings)
+    if any(section in settings for section in RECORD_SECTIONS):
+        compile_record_kernels()             # first: a first run waits on numpy for them
     for section in RECORD_SECTIONS:
         settings.pop(section, None)
     sweep = {key: values for key, values in (settings.pop("sweep", None) or {}).items()
@@ -86,6 +89,14 @@ def compile_for(scenario, overrides=()):
     finally:
         logging.disable(logging.NOTSET)
     import uq.engine.passkernels  # noqa: F401  (long runs' statistics: compiled on import)
+
+
+def compile_record_kernels():
+    """Compile (or load) the kernels a record-mode run calls outside its chunks' model:
+    its boxes' colouring and sampling, the spectral path's sums (explicit signatures:
+    compiled on import)."""
+    import uq.physics.turbulencekernels  # noqa: F401
+    import uq.physics.spectralkernels  # noqa: F401
 
 
 #: The sections of record mode (:mod:`uq.pipeline.records`), left out by :func:`compile_for`.

@@ -590,17 +590,27 @@ def _pair_sum(geometry, tensor, transfer, rules, colocated=None, coarse=False):
     return np.einsum("gcb,gbd,gcd->gc", reconstruction, matrix, reconstruction)
 
 
+def spectral_sums():
+    """The module whose ``pair_sums`` and ``vector_sums`` the spectral path calls: the
+    compiled :mod:`uq.physics.spectralkernels`, or, while a first run after an install
+    finds them missing from numba's cache (:func:`uq.compileguard.cached_kernels`), their
+    numpy equivalents :mod:`uq.physics.spectralsums` (the same numbers to rounding)."""
+    from uq.compileguard import cached_kernels
+    from uq.physics import spectralsums
+    return cached_kernels("uq.physics.spectralkernels") or spectralsums
+
+
 def _filon_pairs(geometry, tensor, transfer, rules, first, second, delta):
     """``C_bd`` (n_gates, n_pairs) [m2 s-2]: the kernel's (k2, k3) sums
     (:func:`uq.physics.spectralkernels.pair_sums`) with the record's Filon weights in k1,
     doubled (k1 > 0)."""
-    from uq.physics import spectralkernels, turbulencebox
+    from uq.physics import turbulencebox
     rule1, rule2, rule3 = rules
     w2 = np.ascontiguousarray(rule2.filon(delta[..., 1]))
     w3 = np.ascontiguousarray(rule3.filon(delta[..., 2]))
     sums = np.zeros((geometry.n_gates, first.size, rule1.size), dtype=complex)
     table = turbulencebox._TABLE
-    spectralkernels.pair_sums(
+    spectral_sums().pair_sums(
         rule1.nodes, rule2.nodes, rule3.nodes, tensor.alpha_epsilon, tensor.length_scale,
         tensor.anisotropy, float(table[0][0]), float(table[0][1] - table[0][0]),
         np.ascontiguousarray(table[1]), np.ascontiguousarray(geometry.directions, dtype=float),
@@ -640,7 +650,8 @@ def _vector_variances(geometry, tensor, transfer, grid):
 def _vector_sum(geometry, tensor, transfer, grid):
     """Eq. (2)-(3) on the log-polar grid: ``var_c = int G_c Phi G_c^H`` with the phases
     at the nodes (:func:`uq.physics.spectralkernels.vector_sums`), a few k1 at a time."""
-    from uq.physics import spectralkernels, turbulencebox
+    from uq.physics import turbulencebox
+    sums = spectral_sums()
     k1_all, w1_all = grid.k1()
     highpass = record_filter(k1_all * geometry.speed / (2 * np.pi), geometry.scan_period,
                              geometry.record_duration)
@@ -651,7 +662,7 @@ def _vector_sum(geometry, tensor, transfer, grid):
         k1 = k1_all[start:start + _K1_CHUNK]
         k2, k3, w23 = grid.cross_section(k1)
         weight = (w23 * (w1_all * highpass)[start:start + _K1_CHUNK, None]).ravel()
-        spectralkernels.vector_sums(
+        sums.vector_sums(
             np.ascontiguousarray(np.broadcast_to(k1[:, None], k2.shape).ravel()),
             np.ascontiguousarray(k2.ravel()), np.ascontiguousarray(k3.ravel()), weight,
             tensor.alpha_epsilon, tensor.length_scale, tensor.anisotropy, float(table[0][0]),

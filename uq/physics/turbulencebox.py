@@ -484,7 +484,6 @@ def _mann_box_host(grid, alpha_epsilon, length_scale, anisotropy, rng, slab_cell
     holds, after the inverse transform, that component's real field (nx, ny, nz) at its
     start (slab i's output goes where slabs <= i were read from).
     """
-    from uq.physics.turbulencekernels import mann_colour
     (nx, ny, nz), half = grid.shape, grid.shape[2] // 2 + 1
     spectra = np.empty((3, nx, ny, half), dtype=complex)
     slabs = _x_slabs(grid, slab_cells)
@@ -499,8 +498,7 @@ def _mann_box_host(grid, alpha_epsilon, length_scale, anisotropy, rng, slab_cell
     index = (slice(None),) + tuple(cells.T)
     noise_cells = spectra[index]                                    # (3, n): a copy
     mann_colour(spectra[0], spectra[1], spectra[2], k1, k2, k3, alpha_epsilon, length_scale,
-                anisotropy, scale, float(_TABLE[0][0]), float(_TABLE[0][1] - _TABLE[0][0]),
-                np.ascontiguousarray(_TABLE[1]))                    # u_k = i C n
+                anisotropy, scale, slab_cells)                      # u_k = i C n
     # near the k1 axis: u_k = C_avg n, C_avg even, so u_-k = u_k^* (module docstring)
     spectra[index] = scale * np.einsum("ijn,jn->in", factors, noise_cells)
     size = nx * ny * nz
@@ -571,7 +569,6 @@ def mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy, rng, wi
     the memory of one part's spectra alone. `rng` is left where one draw of the box
     leaves it once the last part has been taken.
     """
-    from uq.physics.turbulencekernels import mann_colour
     (nx, ny, nz), half = grid.shape, grid.shape[2] // 2 + 1
     (j0, j1), (m0, m1) = window
     wy, wz = j1 - j0, m1 - m0
@@ -579,8 +576,6 @@ def mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy, rng, wi
     k1, k2, k3 = (np.ascontiguousarray(k.ravel()) for k in box_wavenumbers(grid))
     scale = np.sqrt((2.0 * np.pi) ** 3 / np.prod(grid.spacing))    # sqrt(N dk)
     cells, factors = cell_averaged_factors(grid, alpha_epsilon, length_scale, anisotropy)
-    table = (float(_TABLE[0][0]), float(_TABLE[0][1] - _TABLE[0][0]),
-             np.ascontiguousarray(_TABLE[1]))
     (dx, dy, dz), origin = grid.spacing, grid.origin
     window_grid = BoxGrid(shape=(nx, wy, wz), spacing=grid.spacing,
                           origin=(origin[0], origin[1] + j0 * dy, origin[2] + m0 * dz),
@@ -599,7 +594,7 @@ def mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy, rng, wi
         index = (slice(None), cells[here, 0], cells[here, 1], cells[here, 2] - a)
         noise_cells = spectra[index]                                # (3, n): a copy
         mann_colour(spectra[0], spectra[1], spectra[2], k1, k2, np.ascontiguousarray(k3[a:b]),
-                    alpha_epsilon, length_scale, anisotropy, scale, *table)   # u_k = i C n
+                    alpha_epsilon, length_scale, anisotropy, scale, slab_cells)  # u_k = i C n
         # near the k1 axis: u_k = C_avg n, C_avg even, so u_-k = u_k^* (module docstring)
         spectra[index] = scale * np.einsum("ijn,jn->in", factors[:, :, here], noise_cells)
         velocity = _part_field(spectra, (nx, wy, wz))
@@ -613,6 +608,44 @@ def mann_box_window_parts(grid, alpha_epsilon, length_scale, anisotropy, rng, wi
                                                     workers=workers)[..., m0:m1]
         yield TurbulenceBox(grid=window_grid, velocity=velocity)
         del spectra, velocity
+
+
+def mann_colour(n0, n1, n2, k1, k2, k3, alpha_epsilon, length_scale, anisotropy, scale,
+                slab_cells=constants.BOX_SLAB_CELLS):
+    """Colour the noise spectra of a slab in place: ``n <- i scale C(k) n`` (Mann 1998,
+    Sec. 3 [2]), ``C`` of :func:`mann1998_spectral_factor`.
+
+    By the compiled :func:`uq.physics.turbulencekernels.mann_colour` where it may be
+    used (:func:`uq.compileguard.cached_kernels`: a first run after an install takes
+    numpy while it compiles in the background), else by :func:`mann1998_spectral_factor`
+    a few x rows at a time (at most `slab_cells` cells: nine float64 arrays of that
+    size): the same numbers to rounding (``tests/physics/test_turbulencekernels.py``).
+
+    Parameters
+    ----------
+    n0, n1, n2, k1, k2, k3, alpha_epsilon, length_scale, anisotropy, scale
+        As :func:`uq.physics.turbulencekernels.mann_colour` (the slab's three complex128
+        noise spectra (n1, n2, n3) in C order, its wavenumbers [rad m-1], alpha
+        eps^(2/3) [m4/3 s-2], L [m], Gamma [1], sqrt(N dk) [m-3/2]).
+    slab_cells : int
+        Cells coloured at a time by numpy.
+    """
+    from uq.compileguard import cached_kernels
+    kernels = cached_kernels("uq.physics.turbulencekernels")
+    if kernels is not None:
+        kernels.mann_colour(n0, n1, n2, k1, k2, k3, alpha_epsilon, length_scale, anisotropy,
+                            scale, float(_TABLE[0][0]), float(_TABLE[0][1] - _TABLE[0][0]),
+                            np.ascontiguousarray(_TABLE[1]))
+        return
+    rows = max(1, slab_cells // max(1, n0.shape[1] * n0.shape[2]))
+    for start in range(0, n0.shape[0], rows):
+        s = slice(start, start + rows)
+        c = mann1998_spectral_factor(k1[s, None, None], k2[None, :, None], k3[None, None, :],
+                                     alpha_epsilon, length_scale, anisotropy)
+        noise = (n0[s].copy(), n1[s].copy(), n2[s].copy())
+        for row, out in enumerate((n0, n1, n2)):              # u_k = i C n, Sec. 3 [2]
+            out[s] = (1j * scale) * (c[row, 0] * noise[0] + c[row, 1] * noise[1]
+                                     + c[row, 2] * noise[2])
 
 
 def _part_field(spectra, shape):

@@ -164,9 +164,12 @@ def record_radial_velocities(box, geometry, n_scans, displacements=None, directi
         lidar = lidar_position(geometry) if position is None else np.asarray(position, float)
         ranges = gate_ranges(geometry, lidar)
     dwell = dwell_offsets(geometry, min(box.grid.spacing))
-    if xp is np:
-        return _compiled_scans(box, geometry, n_scans, true_dirs, moved, lidar, ranges,
-                               dwell, start_time)
+    if xp is np:                    # compiled, unless a first run leaves it to numpy
+        from uq.compileguard import cached_kernels
+        kernels = cached_kernels("uq.physics.turbulencekernels")
+        if kernels is not None:
+            return _compiled_scans(box, geometry, n_scans, true_dirs, moved, lidar, ranges,
+                                   dwell, start_time, kernels.radial_samples)
     per_scan = geometry.n_beams * geometry.n_gates * np.size(geometry.probe_offsets) * dwell.size
     step = max(1, SAMPLING_CHUNK_POINTS // per_scan)
     parts = [_scans(box, geometry, s, min(s + step, n_scans), true_dirs, moved, lidar, ranges,
@@ -174,11 +177,11 @@ def record_radial_velocities(box, geometry, n_scans, displacements=None, directi
     return xp.concatenate(parts, axis=0)
 
 
-def _compiled_scans(box, geometry, n_scans, directions, moved, lidar, ranges, dwell, start):
+def _compiled_scans(box, geometry, n_scans, directions, moved, lidar, ranges, dwell, start,
+                    radial_samples):
     """:func:`record_radial_velocities` on the host by the compiled
     :func:`uq.physics.turbulencekernels.radial_samples` (the same points, times and
     sums as :func:`_scans`, without its temporaries; nodes of zero weight skipped)."""
-    from uq.physics.turbulencekernels import radial_samples
     grid, offsets = box.grid, np.asarray(geometry.probe_offsets, dtype=float)
     shape = (geometry.n_beams, geometry.n_gates, offsets.size)
     if ranges is None:                  # nominal directions: move the nominal points

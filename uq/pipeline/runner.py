@@ -19,6 +19,7 @@ import xarray as xr
 
 from uq._version import __version__
 from uq.cpus import usable_cpus
+from uq.compileguard import numpy_while_uncached
 from uq.pipeline.distributions import error_distribution
 from uq.engine.inputs import Input, moments
 from uq.pipeline import probesection, records
@@ -67,8 +68,9 @@ def run(scenario, progress=None, *, client=None, checkpoint=None, model="compile
         at ``-v``), compiling what numba's cache does not hold; ``numpy``: the numpy
         reference model and statistics throughout, nothing compiled; ``auto``: each
         chunk the compiled model where numba's cache holds every kernel it calls, else
-        the numpy model (nothing compiles in this process but a record's turbulence
-        kernels, :mod:`uq.compileguard`; on a cluster: ``compiled``). They give the
+        the numpy model (nothing compiles in this process: a record's turbulence
+        kernels too are numpy's until the cache holds them, :mod:`uq.compileguard`; on a
+        cluster: ``compiled``). They give the
         same numbers to 1e-12 m/s (``tests/pipeline/test_model_switch.py``).
     kernels_ready : callable, optional
         Called with no argument before a chunk's model first runs, after its turbulence
@@ -100,8 +102,11 @@ def run(scenario, progress=None, *, client=None, checkpoint=None, model="compile
                              "compiled" if model == "auto" else model)
         choice = ModelChoice(model if client is None or model != "auto" else "compiled",
                              kernels_missing)
-        results = _compute(scenario, plan, seed, progress, client, checkpoint, choice,
-                           kernels_ready)
+        # auto: a record's turbulence kernels too are numpy's until numba's cache holds
+        # them (uq.compileguard.cached_kernels)
+        with (numpy_while_uncached() if choice.model == "auto" else contextlib.nullcontext()):
+            results = _compute(scenario, plan, seed, progress, client, checkpoint, choice,
+                               kernels_ready)
     dataset = _assemble(scenario, plan, results)
     dataset.attrs.update(_global_attributes(scenario, seed, dataset, started, choice))
     said = {}                                 # one line for the outputs said alike
