@@ -52,3 +52,21 @@ def test_a_module_in_the_cache_is_loaded(tmp_path):
                           text=True, preexec_fn=cpu_limited())
     assert done.returncode == 0, child_failure(done)
     assert done.stdout.split() == ["True"]
+
+
+def test_threads_asking_at_once_each_get_the_whole_module(tmp_path):
+    # several threads ask for a module none has imported yet (a campaign's threads): each
+    # gets it whole, not the half-made module another thread is importing
+    code = ("import threading, uq.compileguard as guard\n"
+            "got = []\n"
+            "def ask():\n"
+            "    got.append(hasattr(guard.cached_kernels('uq.physics.spectralkernels'),"
+            " 'vector_sums'))\n"
+            "threads = [threading.Thread(target=ask) for _ in range(4)]\n"
+            "[t.start() for t in threads]; [t.join() for t in threads]\n"
+            "print(got)\n")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}     # the suite's cache: compiled there
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                          text=True, preexec_fn=cpu_limited())
+    assert done.returncode == 0, child_failure(done)
+    assert done.stdout.split() == ["[True,", "True,", "True,", "True]"]

@@ -99,9 +99,9 @@ def cached_kernels(name):
     :func:`numpy_while_uncached`, None where its kernels are not all in the cache (the
     caller then runs its numpy equivalent), looked for again at most every
     :data:`RETRY_SECONDS`."""
-    module = sys.modules.get(name)
-    if module is not None or not _NUMPY_WHILE_UNCACHED[0]:
-        return module if module is not None else importlib.import_module(name)
+    # (importlib, not sys.modules: a module another thread is importing is waited for)
+    if not _NUMPY_WHILE_UNCACHED[0] or name in sys.modules:
+        return importlib.import_module(name)
     with _LOCK:
         if time.monotonic() - _MISSED.get(name, -float("inf")) < RETRY_SECONDS:
             return None

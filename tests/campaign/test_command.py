@@ -241,3 +241,62 @@ def test_the_scatter_shows_every_record_and_counts_the_intervals_past_its_top():
     assert ax.get_ylim()[1] >= 44.0 and ax.get_xlim()[1] >= 12.0
     assert "1 interval runs past the top" in ax.get_title()
     plt.close(fig)
+
+
+def test_a_first_campaign_runs_the_numpy_motion_model_with_the_same_numbers(
+        tmp_path, coarse_tables, monkeypatch):
+    """Where numba's cache lacks the motion model's kernels (a first campaign after an
+    install, here made so), ``uq campaign`` asks once for their compile elsewhere and
+    runs the numpy model: the compiled model's numbers to rounding. Tolerance: the
+    motion's bias is a second difference of the model at a phase step of 1e-3
+    (adapter.CURVATURE_SCALE), which magnifies the models' last-bit differences
+    (~1e-15 of 10 m s-1) by 1e6: 1e-6 of each variable's largest value (measured on
+    campaign_buoy: 1.8e-7 for the bias, 1e-10 of the corrected TI)."""
+    from uq.campaign import adapter
+    from uq.compileguard import KernelNotCached
+    path = write_campaign(tmp_path, lidar_records(count=8, heights=(60,)))
+    command.run_campaign(path, tmp_path / "compiled", stream=open("/dev/null", "w"))
+    asked, used = [], []
+    monkeypatch.setattr(adapter, "motion_kernels_missing",
+                        lambda settings: KernelNotCached("uq.physics.fusedmotionkernels.x"))
+    real = adapter.scan_speeds
+
+    def scan_speeds(*args):
+        used.append(adapter._NUMPY_MOTION[0])
+        return real(*args)
+    monkeypatch.setattr(adapter, "scan_speeds", scan_speeds)
+    command.run_campaign(path, tmp_path / "numpy", stream=open("/dev/null", "w"),
+                         kernels_missing=lambda error, settings: asked.append(
+                             (str(error), settings[0]["name"])))
+    assert asked == [("uq.physics.fusedmotionkernels.x", "campaign_buoy_lidar")]
+    assert used and all(used)                       # every scan by the numpy model
+    compiled, numpy = (xr.open_dataset(tmp_path / name / "mini.nc") for name in
+                       ("compiled", "numpy"))
+    for name in compiled.data_vars:
+        values = compiled[name].values
+        if values.dtype.kind == "f" and np.isfinite(values).any():
+            gap = np.nanmax(np.abs(numpy[name].values - values))
+            assert gap <= 1e-6 * np.nanmax(np.abs(values)) + 1e-12, (name, gap)
+        else:
+            np.testing.assert_array_equal(numpy[name].values, values, err_msg=name)
+    assert not adapter._NUMPY_MOTION[0]             # left as it was
+
+
+def test_the_motion_kernels_missing_from_a_new_cache_are_named_and_not_compiled(tmp_path):
+    import os
+    import subprocess
+    import sys
+    from tests.conftest import child_failure, cpu_limited
+    code = ("from uq.campaign import adapter\n"
+            "from uq.pipeline.scenario import load_scenario\n"
+            f"lidar = load_scenario({str(LIDAR)!r}).settings\n"
+            "settings = adapter.gate_settings(lidar, [60.0], {'model': 'mann', "
+            "'anisotropy': 3.9, 'length_scale': 42.0}, 600.0)\n"
+            "print(adapter.motion_kernels_missing(settings))\n")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba"),
+           "PYTHONPATH": str(LIDAR.parents[1])}
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                          text=True, preexec_fn=cpu_limited())
+    assert done.returncode == 0, child_failure(done)
+    assert done.stdout.strip().startswith("uq.physics.fused")
+    assert not list((tmp_path / "numba").rglob("*.nbi"))

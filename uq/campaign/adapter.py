@@ -39,6 +39,7 @@ dVh/dc_2`` for ``a = e_d`` (unit amplitude, lag 0); for any a the two derivative
 ``dVh/dc_1 + i dVh/dc_2 = sum_d z_d conj(a_d)`` (linearity), so the component adds the
 variance ``|sum_d z_d conj(a_d)|^2 / 2 = z^H M z`` with ``M = a a^H / 2``.
 """
+import contextlib
 import copy
 import dataclasses
 import functools
@@ -477,12 +478,43 @@ def components_of(frequency, amplitude):
 
 def scan_speeds(settings, components, phases):
     """Vh [m s-1] of the gate's scan under `components` with the unit phase vectors
-    `phases` (n, K, 2) (the compiled model), every other input at its mean."""
+    `phases` (n, K, 2) (the compiled model; the numpy model within
+    :func:`numpy_motion_model`), every other input at its mean."""
     from uq.physics.measurement import measurement_model
     scene = motion_scene(settings, components)
     fixed = _mean_errors(settings, scene)
     return np.real(measurement_model(scene, ("wind_speed",), motion_phases=phases,
+                                     compiled=not _NUMPY_MOTION[0],
                                      **fixed)["wind_speed"])[:, 0]
+
+
+_NUMPY_MOTION = [0]                      # numpy_motion_model entered and not left
+
+
+@contextlib.contextmanager
+def numpy_motion_model():
+    """Within (process-wide, every thread): :func:`scan_speeds` evaluates the numpy
+    model (the compiled model's numbers to rounding; a first campaign after an install,
+    while the compiled one's kernels are not in numba's cache)."""
+    _NUMPY_MOTION[0] += 1
+    try:
+        yield
+    finally:
+        _NUMPY_MOTION[0] -= 1
+
+
+def motion_kernels_missing(settings):
+    """The :class:`~uq.compileguard.KernelNotCached` of the first kernel of the compiled
+    motion model that numba's cache lacks (one scan of gate `settings` evaluated with
+    nothing compiled), else None."""
+    from uq.compileguard import KernelNotCached, cached_only
+    try:
+        with cached_only():
+            scan_speeds(settings, components_of([0.1], [[1.0, 0, 0, 0, 0, 0]]),
+                        np.zeros((1, 1, 2)))
+    except KernelNotCached as error:
+        return error
+    return None
 
 
 #: The motion's own inputs: the phases the derivatives are taken in (every other input,
@@ -569,7 +601,8 @@ def scan_noise_variance(settings):
     if layout.dimension == 0:
         return 0.0
     _, jacobian = complex_step_jacobian(
-        lambda **errors: measurement_model(scene, ("wind_speed",), **errors), layout)
+        lambda **errors: measurement_model(scene, ("wind_speed",),
+                                           compiled=not _NUMPY_MOTION[0], **errors), layout)
     return float(combined_uncertainty(jacobian["wind_speed"], layout)[0] ** 2)
 
 

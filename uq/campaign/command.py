@@ -21,14 +21,15 @@ from .analysis import analyse
 from .config import load_campaign_config
 
 
-def run_campaign(config_path, output=None, stream=None, client=None):
+def run_campaign(config_path, output=None, stream=None, client=None, kernels_missing=None):
     """Correct the campaign of `config_path` and write the folder; returns its path.
-    `client`: a dask client (the tables' nodes and the records' chunks on its workers)."""
+    `client`: a dask client (the tables' nodes and the records' chunks on its workers);
+    `kernels_missing`: as :func:`uq.campaign.analysis.analyse`'s."""
     stream = stream or sys.stdout
     config = load_campaign_config(config_path)
     folder = Path(output) if output else Path("results") / config.name
     check_folder_target(folder)                 # before any work
-    ds = analyse(config, client)
+    ds = analyse(config, client, kernels_missing)
     partial = new_partial_folder(folder)
     try:
         write_folder(ds, partial, config)

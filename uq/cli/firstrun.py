@@ -86,10 +86,13 @@ class Background:
         The command's (``-q``: nothing said).
     settings : list of dict
         The validated settings of the scenarios whose kernels to compile.
+    agreement : str
+        How the numpy model's numbers compare with the compiled one's (said).
     """
 
-    def __init__(self, args, settings):
+    def __init__(self, args, settings, agreement="the same numbers to 1e-12"):
         self.args, self.settings, self.compile = args, settings, None
+        self.agreement = agreement
 
     def start(self, missing=None):
         """Start the compile (once) and say so on stderr; returns its ``ended``
@@ -101,8 +104,8 @@ class Background:
             if not getattr(self.args, "quiet", False):     # a notice, as "compiling"
                 print(f"uq: numba's cache does not hold this run's compiled kernels "
                       f"({missing}): they compile in the background ({whose}, low "
-                      "priority) for later runs; this run uses the numpy model meanwhile "
-                      "(the same numbers to 1e-12)", file=sys.stderr, flush=True)
+                      f"priority) for later runs; this run uses the numpy model meanwhile "
+                      f"({self.agreement})", file=sys.stderr, flush=True)
         return self.compile.ended
 
 
