@@ -54,6 +54,46 @@ def test_same_seed_same_result_whatever_the_chunk_size():
     assert model is not None
 
 
+@pytest.mark.parametrize("cpus", [1, 2])
+def test_statistics_on_their_own_thread_are_the_same_bits(monkeypatch, cpus):
+    # a fixed-n run of several chunks accumulates on a thread of its own where the
+    # process may use more than one CPU: the same merges in the same order as in one
+    # thread (usable_cpus 1), and the same as one chunk (no second thread at all)
+    import uq.cpus
+    from uq.engine import propagate
+    threads = []
+    real = propagate._Runner._accumulate
+
+    def accumulate(self, outputs, linear):
+        import threading
+        threads.append(threading.current_thread().name)
+        return real(self, outputs, linear)
+    monkeypatch.setattr(propagate._Runner, "_accumulate", accumulate)
+    inputs = {"a": st.uniform(0, 1), "b": Input(st.norm(0, 1), (3,))}
+
+    def model(a, b):
+        return {"s": a * b[:, 0], "t": np.stack([a - b[:, 2], a + b[:, 1]], axis=1)}
+    whole = uq.propagate(model, inputs, n=300_001, seed=5, chunk_size=10**6)
+    monkeypatch.setattr(uq.cpus, "usable_cpus", lambda: cpus)
+    threads.clear()
+    chunked = uq.propagate(model, inputs, n=300_001, seed=5, chunk_size=2**16)
+    assert len(threads) > 1 and all(name.startswith("uq-statistics") == (cpus > 1)
+                                    for name in threads)
+    for name in whole.data_vars:
+        np.testing.assert_array_equal(whole[name].values, chunked[name].values, err_msg=name)
+
+
+def test_a_failure_in_the_statistics_thread_reaches_the_caller(monkeypatch):
+    from uq.engine import propagate
+
+    def accumulate(self, outputs, linear):
+        raise FloatingPointError("in the statistics")
+    monkeypatch.setattr(propagate._Runner, "_accumulate", accumulate)
+    monkeypatch.setattr("uq.cpus.usable_cpus", lambda: 2)
+    with pytest.raises(FloatingPointError, match="in the statistics"):
+        uq.propagate(lambda a: a, {"a": st.norm(0, 1)}, n=200_000, seed=1, chunk_size=2**16)
+
+
 def test_different_seeds_differ_and_generator_is_accepted():
     inputs = {"a": st.norm(0, 1)}
     one = uq.propagate(lambda a: a, inputs, n=5000, seed=1)

@@ -271,6 +271,48 @@ def _joined(pieces):
     return {q: np.concatenate([p[q] for p in pieces]) for q in pieces[0]}
 
 
+class _Accumulator:
+    """A fixed-n run's statistics accumulated on a thread of their own, piece after
+    piece in the order given, while the model evaluates the next piece (the statistics'
+    compiled kernels and numpy's loops run without the GIL): the same merges in the same
+    order as in the run's own thread, so the same bits. At most one piece waits (its
+    outputs are the model's, made anew each call). Where this process may use one CPU,
+    the pieces are accumulated in the caller's thread."""
+
+    def __init__(self, runner):
+        self.runner, self.pool, self.pending = runner, None, None
+
+    def __enter__(self):
+        from uq.cpus import usable_cpus
+        if usable_cpus() > 1:
+            self.pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="uq-statistics")
+        return self
+
+    def add(self, outputs, linear):
+        """Accumulate a piece (after the previous one)."""
+        if self.pool is None:
+            self.runner._accumulate(outputs, linear)
+            return
+        submitted = self.pool.submit(self.runner._accumulate, outputs, linear)
+        self.wait()                          # the one before: one piece waits at most
+        self.pending = submitted
+
+    def wait(self):
+        """Until every piece given is accumulated (its error raised here)."""
+        if self.pending is not None:
+            pending, self.pending = self.pending, None
+            pending.result()
+
+    def __exit__(self, kind, error, trace):
+        try:
+            if kind is None:
+                self.wait()
+        finally:
+            if self.pool is not None:
+                self.pool.shutdown(wait=True, cancel_futures=True)
+        return False
+
+
 class _Runner:
     """Draws blocks, evaluates the model chunk by chunk, accumulates statistics."""
 
@@ -424,22 +466,27 @@ class _Runner:
         if len(chunks) == 1:                 # nothing to draw ahead: no second thread
             self._fixed_chunk(chunks[0], n)
             return
-        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="uq-draws") as drawer:
+        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="uq-draws") as drawer, \
+                _Accumulator(self) as accumulator:
             pending = drawer.submit(self._drawn, *chunks[0])
             for index, chunk in enumerate(chunks):
                 drawn = pending.result()
                 if index + 1 < len(chunks):
                     pending = drawer.submit(self._drawn, *chunks[index + 1])
-                self._fixed_chunk(chunk, n, drawn)
+                self._fixed_chunk(chunk, n, drawn, accumulator)
 
-    def _fixed_chunk(self, chunk, n, drawn=None):
+    def _fixed_chunk(self, chunk, n, drawn=None, accumulator=None):
         """Evaluate and accumulate one chunk of a run of n trials (`drawn`: its inputs,
-        made ahead, else made here)."""
+        made ahead, else made here; `accumulator`: an :class:`_Accumulator` that
+        accumulates each piece on its thread, else here)."""
         for outputs, linear in self._pieces(*chunk, drawn):
             if self.stats is None:
                 self._start(tail_capacity(n, kind=self.interval) + 1,
                             {q: v.shape[1:] for q, v in outputs.items()}, expected=n)
-            self._accumulate(outputs, linear)
+            if accumulator is None:
+                self._accumulate(outputs, linear)
+            else:
+                accumulator.add(outputs, linear)
 
     def run_adaptive(self, digits, stopping="jcgm101", gum_targets=None):
         """JCGM 101:2008, 7.9.4: batches of M >= 10^4 trials, one RNG block per step, until
