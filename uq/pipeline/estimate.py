@@ -112,8 +112,8 @@ class RunSize:
                           if seconds >= 0.05 * max(s for _, s in self.parts))
         return (f"from calibrated per-trial costs, not by running the model ({parts}; "
                 f"2-core machine; a busy machine takes longer, and the first run after an "
-                f"install up to {NUMPY_FACTOR[1]}x longer: the numpy model runs while the "
-                "kernels compile in the background)")
+                f"install up to {NUMPY_FACTOR[1]}x longer: the numpy model runs until a background "
+                "process has compiled the kernels)")
 
 
 def _duration(seconds):
