@@ -354,7 +354,7 @@ class StreamingStatistics:
             if self._count * self.size > self._budget:
                 self._spill()
         else:
-            self._add_to_tails(columns[:, :m].T)
+            self._add_to_tails(columns[:, :m])
         return summaries
 
     def _add_in_one_pass(self, flat, batch_size, summarize, size):
@@ -501,7 +501,7 @@ class StreamingStatistics:
         self._run = None                            # the tails decide from now on
         for start in range(0, self._count, _SPILL_VALUES):   # bounded temporaries
             self._add_to_tails(self._columns[:, start:min(self._count,
-                                                          start + _SPILL_VALUES)].T)
+                                                          start + _SPILL_VALUES)])
         self._columns = np.empty((self.size, 0))
 
     def _symmetric(self, j, m, probability):
@@ -521,15 +521,19 @@ class StreamingStatistics:
         """(smallest, largest) kept values of element j from the tails, each ascending."""
         return np.sort(self._low[j].values()), np.sort(-self._high[j].values())
 
-    def _add_to_tails(self, flat):
-        low_bound = np.array([tail.threshold for tail in self._low])
-        high_bound = np.array([-tail.threshold for tail in self._high])
-        finite = np.isfinite(flat)                  # as in the moments: no NaN, no +-inf
-        below, above = (flat < low_bound) & finite, (flat > high_bound) & finite
-        for j in np.flatnonzero(below.any(axis=0)):
-            self._low[j].add(flat[below[:, j], j])
-        for j in np.flatnonzero(above.any(axis=0)):
-            self._high[j].add(-flat[above[:, j], j])
+    def _add_to_tails(self, columns):
+        """Hand the values of `columns` (size, m), element by element in trial order,
+        to the tails they pass; as in the moments, no NaN and no +-inf (NaN passes no
+        comparison: only the few values that do are checked for an infinity)."""
+        for j, column in enumerate(columns):
+            below = column[column < self._low[j].threshold]
+            below = below[np.isfinite(below)]
+            if below.size:
+                self._low[j].add(below)
+            above = column[column > -self._high[j].threshold]
+            above = above[np.isfinite(above)]
+            if above.size:
+                self._high[j].add(-above)
 
     def result(self, probability=COVERAGE_PROBABILITY, kind="symmetric"):
         """dict of arrays of `shape`: mean, u, low, high, n_valid (and circular_std)."""
