@@ -70,7 +70,7 @@ def test_ctrl_c_with_two_workers_is_one_message(tmp_path, after):
     assert status == 130, err
     assert err.strip().splitlines() == ["uq: interrupted; finished chunks are kept in "
                                         "out.nc.partial; run the same command with --resume "
-                                        "to continue"]
+                                        "to continue"], err
     assert not (tmp_path / "out.nc").exists() and any(partial.glob("chunk-*.nc"))
 
 

@@ -83,6 +83,20 @@ def test_statistics_on_their_own_thread_are_the_same_bits(monkeypatch, cpus):
         np.testing.assert_array_equal(whole[name].values, chunked[name].values, err_msg=name)
 
 
+def test_a_dask_workers_statistics_stay_in_its_thread(monkeypatch):
+    # one thread a worker: the cluster's cores are its workers'
+    import sys
+    import types
+    from uq.engine import propagate
+    monkeypatch.setattr("uq.cpus.usable_cpus", lambda: 4)
+    assert not propagate._in_dask_worker() or "distributed" in sys.modules
+    monkeypatch.setitem(sys.modules, "distributed",
+                        types.SimpleNamespace(get_worker=lambda: object()))
+    assert propagate._in_dask_worker()
+    with propagate._Accumulator(None) as accumulator:
+        assert accumulator.pool is None
+
+
 def test_a_failure_in_the_statistics_thread_reaches_the_caller(monkeypatch):
     from uq.engine import propagate
 

@@ -10,6 +10,7 @@ References
    (validation of the GUM framework).
 """
 import logging
+import sys
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -271,20 +272,33 @@ def _joined(pieces):
     return {q: np.concatenate([p[q] for p in pieces]) for q in pieces[0]}
 
 
+def _in_dask_worker():
+    """Whether this code runs in a task of a dask worker."""
+    distributed = sys.modules.get("distributed")
+    if distributed is None:
+        return False
+    try:
+        distributed.get_worker()
+    except ValueError:
+        return False
+    return True
+
+
 class _Accumulator:
     """A fixed-n run's statistics accumulated on a thread of their own, piece after
     piece in the order given, while the model evaluates the next piece (the statistics'
     compiled kernels and numpy's loops run without the GIL): the same merges in the same
     order as in the run's own thread, so the same bits. At most one piece waits (its
     outputs are the model's, made anew each call). Where this process may use one CPU,
-    the pieces are accumulated in the caller's thread."""
+    or is a dask worker (one thread a worker: a cluster's cores are its workers'), the
+    pieces are accumulated in the caller's thread."""
 
     def __init__(self, runner):
         self.runner, self.pool, self.pending = runner, None, None
 
     def __enter__(self):
         from uq.cpus import usable_cpus
-        if usable_cpus() > 1:
+        if usable_cpus() > 1 and not _in_dask_worker():
             self.pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="uq-statistics")
         return self
 
