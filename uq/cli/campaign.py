@@ -26,13 +26,11 @@ def command(args):
     from uq.campaign.command import run_campaign
     from uq.cli.run import check_scale_out, dask_client
     from uq.pipeline.shipped import scenario_path
-    from uq.cli import firstrun
     config = scenario_path(args.config)
     check_scale_out(args)
     with dask_client(args) as client:
         run_campaign(config, args.output, stream=io.StringIO() if args.quiet else sys.stdout,
-                     client=client, kernels_missing=_background(args) if
-                     firstrun.wanted(args) else None)
+                     client=client, kernels_missing=_background(args))
     return EXIT_OK
 
 
@@ -45,8 +43,11 @@ CAMPAIGN_AGREEMENT = ("the same numbers to rounding: corrected speeds within 1e-
 
 def _background(args):
     """The campaign's `kernels_missing`: the compile of its lidar's kernels in the
-    background (:mod:`uq.cli.firstrun`), said on stderr as ``uq run`` says it."""
+    background (:mod:`uq.cli.firstrun`), said on stderr as ``uq run`` says it; None
+    where no background compile is wanted (the campaign then compiles what it calls)."""
     from uq.cli import firstrun
+    if not firstrun.wanted(args):
+        return None
 
     def start(error, settings):
         firstrun.Background(args, settings, CAMPAIGN_AGREEMENT).start(error)

@@ -212,10 +212,10 @@ def main(argv=None):
     lower_priority()
     import yaml
     try:
-        from uq.cli.warmup import RECORD_SECTIONS, compile_for, compile_record_kernels
+        from uq.cli.warmup import compile_for, compile_record_kernels, record_mode
         with open(path, encoding="utf-8") as file:
             documents = list(yaml.safe_load_all(file))
-        if any(section in settings for settings in documents for section in RECORD_SECTIONS):
+        if any(record_mode(settings) for settings in documents):
             compile_record_kernels()         # the run takes them as soon as they are in
         if after:
             _wait_for_exit(int(after[0]))

@@ -75,7 +75,7 @@ def compile_for(scenario, overrides=()):
     if not isinstance(scenario, dict):
         scenario = scenario_path(scenario)
     settings = copy.deepcopy(load_scenario(scenario, parse_overrides(overrides)).settings)
-    if any(section in settings for section in RECORD_SECTIONS):
+    if record_mode(settings):
         compile_record_kernels()             # first: a first run waits on numpy for them
     for section in RECORD_SECTIONS:
         settings.pop(section, None)
@@ -101,3 +101,8 @@ def compile_record_kernels():
 
 #: The sections of record mode (:mod:`uq.pipeline.records`), left out by :func:`compile_for`.
 RECORD_SECTIONS = ("turbulence", "record")
+
+
+def record_mode(settings):
+    """Whether scenario `settings` (a mapping) has a section of record mode."""
+    return any(section in settings for section in RECORD_SECTIONS)

@@ -1,7 +1,8 @@
 """The spectral path's sums in numpy: :func:`pair_sums` and :func:`vector_sums` with the
 arguments and the arithmetic of the compiled kernels of :mod:`uq.physics.spectralkernels`
-(the eddy lifetime from the same table, the transfer interpolated on the same nodes),
-array by array instead of point by point.
+(the eddy lifetime from the same table and the zetas by the array code of
+:mod:`uq.physics.turbulencebox`, the transfer interpolated on the same nodes), array by
+array instead of point by point.
 
 They stand in for the kernels while these are not in numba's cache (a first run after an
 install, ``uq run --model auto``: :func:`uq.compileguard.cached_kernels`), so that the
@@ -18,25 +19,13 @@ References
 import numpy as np
 
 from uq.constants import VON_KARMAN_EXPONENT
+from uq.physics import turbulencebox
 
 #: 4 pi [1] (the von Karman spectrum's normalisation).
 FOUR_PI = 4.0 * np.pi
 #: Elements of the largest temporary of :func:`pair_sums` and :func:`vector_sums` [1]
 #: (2^20 complex: 16 MB; the pairs, or the points, are taken that many at a time).
 PAIR_SUM_ELEMENTS = 2**20
-
-
-def _lifetime(kl, anisotropy, table_start, table_step, table_values):
-    """beta(kL) [1] from the log-log table and its asymptotes (the kernels' own)."""
-    n_nodes = table_values.size
-    position = (np.log(kl) - table_start) / table_step
-    inside = np.clip(position, 0.0, n_nodes - 1.0)
-    index = np.clip(np.floor(inside).astype(np.int64), 0, n_nodes - 2)
-    frac = inside - index
-    log_beta = (1.0 - frac) * table_values[index] + frac * table_values[index + 1]
-    log_beta = log_beta - np.minimum(position, 0.0) * table_step
-    log_beta = log_beta - (2.0 / 3.0) * np.maximum(position - (n_nodes - 1.0), 0.0) * table_step
-    return anisotropy * np.exp(log_beta)
 
 
 def _transfer(table, kappa, step, tail):
@@ -57,15 +46,10 @@ def _mann_scalars(a, b, c, alpha_epsilon, length_scale, anisotropy, table):
     [rad m-1] (arrays; k1^2 + k2^2 > 0): Mann (1994) Sec. 3.2-3.3 [1]."""
     energy_scale = alpha_epsilon * length_scale ** (5.0 / 3.0)
     ksq = a * a + b * b + c * c
-    beta = _lifetime(np.sqrt(ksq) * length_scale, anisotropy, *table)
+    beta = turbulencebox.eddy_lifetime(np.sqrt(ksq) * length_scale, anisotropy, table=table)
     k30 = c + beta * a                                # Eq. 3.14 [1]
     k0sq = a * a + b * b + k30 * k30
-    khsq = a * a + b * b
-    kh = np.sqrt(khsq)
-    c1 = beta * a * a * (k0sq - 2.0 * k30 * k30 + beta * a * k30) / (ksq * khsq)
-    c2 = b * k0sq / (khsq * kh) * (np.arctan(k30 / kh) - np.arctan(c / kh))
-    z1 = c1 - b / a * c2
-    z2 = b / a * c1 + c2
+    z1, z2 = turbulencebox._mann1994_zetas(a, b, c, k30, k0sq, ksq, beta, np)
     kl = np.sqrt(k0sq) * length_scale
     energy = energy_scale * kl ** 4 / (1.0 + kl * kl) ** VON_KARMAN_EXPONENT
     return k0sq, k30, z1, z2, k0sq / ksq, energy / (FOUR_PI * k0sq * k0sq)

@@ -213,18 +213,21 @@ def _lifetime_table():
 _TABLE = _lifetime_table()
 
 
-def eddy_lifetime(kl, anisotropy, xp=np):
+def eddy_lifetime(kl, anisotropy, xp=np, table=None):
     """Mann's eddy lifetime by log-log interpolation of a table, on any array namespace.
 
     Outside the table's kL range the asymptotes ``beta ~ (kL)^-1`` (kL -> 0) and ``beta ~
     (kL)^(-2/3)`` (kL -> inf) continue it. Same parameters as
     :func:`uq.physics.spectraltensor.mann_eddy_lifetime`; ``kl`` is an array of ``xp``.
+    `table`: (first node, step, values) of log(kL) and log(beta / Gamma), as the
+    compiled kernels take it; default this module's.
     """
-    log_nodes, log_values = (xp.asarray(a) for a in _TABLE)
-    step = float(_TABLE[0][1] - _TABLE[0][0])
-    n = _TABLE[0].size
+    if table is None:
+        table = (float(_TABLE[0][0]), float(_TABLE[0][1] - _TABLE[0][0]), _TABLE[1])
+    start, step, log_values = table[0], table[1], xp.asarray(table[2])
+    n = log_values.size
     x = xp.log(kl)
-    position = (x - float(_TABLE[0][0])) / step
+    position = (x - start) / step
     inside = xp.clip(position, 0.0, n - 1.0)
     index = xp.clip(xp.floor(inside).astype(xp.int64), 0, n - 2)
     frac = inside - index
