@@ -193,6 +193,15 @@ ONE_PASS_MIN_TRIALS = 2**17
 #: and geometry errors). [1] Abramowitz and Stegun (1964), 4.3.65-66.
 SMALL_ANGLE = 0.25
 
+#: Largest |a| for which the compiled model takes x^a of a power-law profile (a: the shear
+#: exponent) from x0^a times the binomial series of (1 + d)^a, d = x / x0 - 1, |d| <= 1/129
+#: (:func:`uq.physics.fusedkernels.power_near`). For |a| <= 1 the coefficients'
+#: magnitudes do not grow after C(a, 1), so the remainder after the d^(K-1) term is at
+#: most |C(a, K)| d^K / (1 - d) [1]; the kernel takes terms until that bound, over the
+#: least the sum can be (1 - d), is below half an ulp (1.1e-16): 8 terms or fewer. Larger
+#: exponents take libm's log and exp. [1] Abramowitz and Stegun (1964), 3.6.8.
+POWER_SERIES_MAX_EXPONENT = 1.0
+
 #: Trials per block of the compiled model (:func:`uq.fused.measurement_model`) [1]:
 #: its scratch arrays (beams, gate heights; ~8 x 15 doubles per trial) stay in the L2
 #: cache between the compiled loops and numpy's SIMD log and exp; the per-block Python

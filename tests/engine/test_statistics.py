@@ -262,6 +262,17 @@ def test_an_element_with_nan_gives_up_its_brackets(rng, one_pass):
         assert (result["low"][j], result["high"][j]) == direct_interval(finite)
 
 
+def _assert_same_runs(first, second):
+    """The (summaries, result) of runs `first` equal those of `second`, bit for bit."""
+    for (one, result_one), (two, result_two) in zip(first, second):
+        assert [start for start, _ in one] == [start for start, _ in two]
+        for (_, a), (_, b) in zip(one, two):
+            for key in a:
+                np.testing.assert_array_equal(a[key], b[key])
+        for key in result_one:
+            np.testing.assert_array_equal(result_one[key], result_two[key])
+
+
 def test_short_and_long_runs_give_the_same_numbers(rng, monkeypatch):
     """The one-pass batches of long runs (from ONE_PASS_MIN_TRIALS) and the kernels of
     short runs: the same summaries and results, bit for bit (exact order statistics, the
@@ -277,10 +288,36 @@ def test_short_and_long_runs_give_the_same_numbers(rng, monkeypatch):
                                         expected=len(values))
             summaries = stats.add(values, 4096, summarize=True, summary_size=2048)
             outputs.append((summaries, stats.result()))
-    for (one, result_one), (two, result_two) in zip(outputs[:2], outputs[2:]):
-        assert [start for start, _ in one] == [start for start, _ in two]
-        for (_, a), (_, b) in zip(one, two):
-            for key in a:
-                np.testing.assert_array_equal(a[key], b[key])
-        for key in result_one:
-            np.testing.assert_array_equal(result_one[key], result_two[key])
+    _assert_same_runs(outputs[:2], outputs[2:])
+
+
+@pytest.mark.parametrize("stored_values, expected", [(1, True), (6 * 9000, False)])
+def test_long_runs_in_the_tails_give_the_numbers_of_short_runs(stored_values, expected, rng,
+                                                               monkeypatch):
+    """Past the store's budget (from the first values, or spilled in the middle of the
+    run) a long run's batches take the one-pass kernel and the compiled candidates of
+    the tails: the same summaries and results, bit for bit, as the short runs' numpy
+    tails, a direction, NaN and infinities included, over several chunks."""
+    from uq.engine import statistics
+    n = 6 * 4096 + 77
+    values = rng.standard_normal((n, 2, 3)) * [1.0, 2.0, 3.0]
+    values[:, 1] = np.mod(350.0 + 8.0 * values[:, 1], 360.0)   # about north
+    values[[5, 9000, 20000], 0, 0] = [np.nan, np.inf, -np.inf]
+    outputs = []
+    for threshold in (2**40, 0):
+        monkeypatch.setattr(statistics, "ONE_PASS_MIN_TRIALS", threshold)
+        for reference in (None, np.full((2, 3), 355.0)):
+            stats = StreamingStatistics((2, 3), tail_capacity(n) + 1, reference,
+                                        stored_values=stored_values,
+                                        expected=n if expected else None)
+            summaries = []
+            for start in range(0, n, 8192):
+                assert stats._stored == (start == 0 or (not expected and start < 9000))
+                summaries += stats.add(values[start:start + 8192], 4096, summarize=True,
+                                       summary_size=2048)
+            assert not stats._stored
+            outputs.append((summaries, stats.result()))
+    _assert_same_runs(outputs[:2], outputs[2:])
+    finite = values[:, 0, 0][np.isfinite(values[:, 0, 0])]
+    assert (outputs[2][1]["low"][0, 0], outputs[2][1]["high"][0, 0]) == \
+        direct_interval(finite)

@@ -472,3 +472,88 @@ def test_a_nacelle_lidar_declines_what_it_does_not_compute():
     two = nacelle_scene(TWO, "full")
     assert "upper and a lower" in fused.declined(two, ("shear_exponent",), {})
     assert "yaw_misalignment" in fused.declined(make_scene(), ("yaw_misalignment",), {})
+
+
+# x^a by the binomial series against numpy's exp(a log x): the series is within half an
+# ulp of (1 + d)^a; Horner's roundings (the sum is dominated by its first term, 1), x0^a
+# and the product add ~3 more, numpy's own result is within ~1: 8 ulp of the result.
+POWER_RTOL = 8 * 2.2e-16
+
+
+def _numpy_power(values, exponent):
+    with np.errstate(all="ignore"):
+        return np.exp(np.reshape(exponent, (-1, 1)) * np.log(values))
+
+
+def _power_near(values, exponent):
+    from uq.physics import fusedkernels as kernels
+    out = np.array(values, dtype=float)
+    kernels.compiled(float)["power_near"](out, np.broadcast_to(
+        np.asarray(exponent, dtype=float), (len(out),)).copy())
+    return out
+
+
+@pytest.mark.parametrize("exponent", [-1.0, -0.3, 0.0, 0.12, 0.5, 1.0, 1.5, -2.0])
+@pytest.mark.parametrize("spread", [0.0, 1e-6, 1e-3, 0.3, 30.0])
+def test_power_near_equals_numpy_log_and_exp(exponent, spread, rng):
+    """Ratios close together (a block of one scene's trials) and far apart (a sweep's
+    scenes, over several binary exponents), the series (|a| <= 1) and libm (|a| > 1)."""
+    values = rng.uniform(0.2, 3.0, 15) * (1 + spread * rng.uniform(0, 1, (2048, 15)))
+    np.testing.assert_allclose(_power_near(values, exponent), _numpy_power(values, exponent),
+                               rtol=POWER_RTOL, atol=0)
+
+
+def test_power_near_with_an_exponent_per_row(rng):
+    """Runs of rows of one exponent (a batch of scenes, each its own shear) and rows
+    that change it every row."""
+    values = rng.uniform(0.5, 2.0, (300, 4))
+    exponent = np.repeat([0.1, 0.2, -0.4, 0.1], 75)
+    exponent[-20:] = rng.uniform(-1, 1, 20)
+    np.testing.assert_allclose(_power_near(values, exponent), _numpy_power(values, exponent),
+                               rtol=POWER_RTOL, atol=0)
+
+
+def test_power_near_depends_on_the_value_alone(rng):
+    """A value's result does not depend on the rest of its block (each takes its
+    reference from its own bits): the bits of a block equal those of its rows one by
+    one, and of its rows in another order (a scene alone gives its bits in a batch)."""
+    values = 1.3 + 1e-3 * rng.standard_normal((64, 5))
+    whole = _power_near(values, 0.14)
+    one_by_one = np.concatenate([_power_near(row[None], 0.14) for row in values])
+    order = rng.permutation(64)
+    np.testing.assert_array_equal(whole, one_by_one)
+    np.testing.assert_array_equal(whole[order], _power_near(values[order], 0.14))
+
+
+def test_power_near_special_values_as_numpy(rng):
+    """NaN (out of domain), +-inf, 0, negative and subnormal ratios anywhere in the
+    block, also first: the same NaN, infinities and zeros as numpy's log and exp."""
+    for row in (0, 7):
+        values = 1.2 + 1e-3 * rng.standard_normal((64, 7))
+        values[row] = [np.nan, np.inf, -np.inf, 0.0, -1.0, 5e-320, -0.0]
+        for exponent in (0.14, -0.5):
+            np.testing.assert_allclose(_power_near(values, exponent),
+                                       _numpy_power(values, exponent), rtol=POWER_RTOL,
+                                       atol=0)     # (NaN where numpy's is NaN, inf, 0)
+
+
+@pytest.mark.parametrize("exponent", [-1.0, -0.7, 0.12, 0.5, 1.0 - 1e-9])
+@pytest.mark.parametrize("deviation", [1e-6, 1e-3, 0.05, 0.25])
+def test_binomial_terms_are_the_fewest_within_half_an_ulp(exponent, deviation):
+    """The coefficients are scipy's C(a, k) (C(-1, k) = (-1)^k, where scipy's gamma
+    ratio has a pole); with K terms the remainder's bound |C(a, K)| d^K / (1 - d)^2 is
+    within half an ulp and with K - 1 it is not."""
+    from scipy.special import binom
+    from uq.physics import fusedkernels as kernels
+
+    def exact(k):
+        return (-1.0) ** k if exponent == -1.0 else binom(exponent, k)
+    coefficients = np.empty(64)
+    terms = kernels.binomial_terms(exponent, deviation, coefficients)
+    np.testing.assert_allclose(coefficients[:terms], exact(np.arange(terms)), rtol=1e-13)
+    # ^ the recurrence's roundings, ~k ulps; scipy's beta-function route a few ulps more
+
+    def bound(count):
+        return abs(exact(count)) * deviation ** count / (1 - deviation) ** 2
+    assert bound(terms) <= 2.0 ** -53 < bound(terms - 1)
+    assert terms <= 30                      # 27 at d = 0.25, a = -1

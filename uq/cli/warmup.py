@@ -39,7 +39,7 @@ def command(args):
     from uq.physics import fusedkernels
     for number in (float, complex):
         for name in fusedkernels.KERNEL_NAMES:
-            if number is float or name not in fusedkernels.MOUNTED_KERNEL_NAMES:
+            if number is float or name not in fusedkernels.REAL_KERNEL_NAMES:
                 fusedkernels.compiled(number)[name]
     fusedmotionkernels.compiled_mounted_wind()        # a tilted mount's, on first use
     return _said(args, started)

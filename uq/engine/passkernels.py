@@ -263,6 +263,29 @@ def batch_pass(values, start, stop, reference, circular, copy, columns, offset, 
                     global_kept[e], global_values[e])
 
 
+@njit("void(float64[:, ::1], int64, float64[::1], float64[::1], float64[:, ::1], "
+      "float64[:, ::1], int64[::1], int64[::1])", cache=True, nogil=True)
+def tail_candidates(columns, m, low_threshold, high_threshold, low, high, low_count,
+                    high_count):
+    """The values of columns[e, :m] that pass element e's tails
+    (:class:`uq.engine.statistics._Tail`), in trial order: those below
+    low_threshold[e] into low[e, :low_count[e]], the negated values of those above
+    -high_threshold[e] (the high tail keeps -values) into high[e, :high_count[e]]. As in
+    the moments, no NaN (it passes no comparison) and no +-inf."""
+    for e in range(columns.shape[0]):
+        below, above = low_threshold[e], -high_threshold[e]
+        a = b = 0
+        for j in range(m):
+            value = columns[e, j]
+            if value < below and value != -np.inf:
+                low[e, a] = value
+                a += 1
+            if value > above and value != np.inf:
+                high[e, b] = -value
+                b += 1
+        low_count[e], high_count[e] = a, b
+
+
 @njit("void(float64[:, :, ::1], int64[:, ::1], int64[:, ::1], int64[::1], int64[::1], "
       "float64[::1], float64[::1], boolean[::1])", cache=True, nogil=True)
 def global_pairs(global_values, global_below, global_kept, low_rank, high_rank, low,

@@ -292,6 +292,8 @@ class StreamingStatistics:
         self._scratch = []                         # per part of the elements
         self._expected = int(expected) if expected else 0
         self._run = None                           # the run's brackets (_RunBrackets)
+        self._off = None                           # brackets off (the tails decide)
+        self._candidates = None                    # the tails' candidates (2, size, m)
 
     @property
     def _loops(self):
@@ -322,8 +324,7 @@ class StreamingStatistics:
             # a run that will outgrow the store: the tails from now on (from its first
             # values where it says so), not a store grown past its budget and then spilled
             self._spill()
-        if kind == "symmetric" and self._stored and self._expected >= ONE_PASS_MIN_TRIALS \
-                and self.compiled:
+        if kind == "symmetric" and self._expected >= ONE_PASS_MIN_TRIALS and self.compiled:
             return self._add_in_one_pass(flat, batch_size, summarize,
                                          min(summary_size or batch_size, batch_size))
         if self._run is not None:
@@ -358,23 +359,27 @@ class StreamingStatistics:
         return summaries
 
     def _add_in_one_pass(self, flat, batch_size, summarize, size):
-        """:meth:`add` while every value is stored and the interval is probabilistically
-        symmetric: one compiled pass per batch and element (:func:`statkernels.batch_pass`)
-        stores the column, takes its moments and the endpoints of its sub-batches, and
-        counts the values around the run's endpoints (:class:`_RunBrackets`), so that
-        :meth:`result` selects among a few per cent of the values."""
+        """:meth:`add` of a long run whose interval is probabilistically symmetric: one
+        compiled pass per batch and element (:func:`passkernels.batch_pass`) stores the
+        column, takes its moments and the endpoints of its sub-batches. While every
+        value is stored, the same pass counts the values around the run's endpoints
+        (:class:`_RunBrackets`), so that :meth:`result` selects among a few per cent of
+        the values; once only the tails are kept, the column goes to a scratch block and
+        a second compiled pass hands the tails the values that pass them
+        (:meth:`_add_to_tails`)."""
         m = len(flat)
+        stored = self._stored
         columns, offset = self._room(m)
         circular = self.reference is not None
         reference = self.reference if circular else _NO_REFERENCE
         copy = flat.strides[0] == flat.itemsize      # element-major: copied in the pass
         if not copy:                                 # trial-major: tiles of trials
             self._loops.transpose(flat, reference, circular, columns, offset)
-        if self._run is None:
+        if stored and self._run is None:
             # (the values stored at most: the room is a fraction of the store's)
             self._run = _RunBrackets(self.size, min(self._expected or m,
                                                     self._budget // max(self.size, 1)))
-        run = self._run
+        run = self._run if stored else self._no_brackets()
         size = size if summarize else 0
         count, mean, m2 = (np.empty(self.size, dtype=np.int64), np.empty(self.size),
                            np.empty(self.size))
@@ -399,10 +404,21 @@ class StreamingStatistics:
                                m2.reshape(self.shape))
             summaries.extend((start + k * size, self._sub_summary(*sub, low, high, k))
                              for k in range(parts))
+        if not stored:
+            self._add_candidates(columns, m)
+            return summaries
         self._count += m
         if self._count * self.size > self._budget:
             self._spill()
         return summaries
+
+    def _no_brackets(self):
+        """Run brackets that are off for every element (:func:`passkernels.batch_pass`
+        then selects each sub-batch's endpoints alone): the tails decide the run's."""
+        if self._off is None:
+            self._off = _RunBrackets(self.size, 0)
+            self._off.state[:] = _pass_kernels().GLOBAL_OFF
+        return self._off
 
     def _sub_summary(self, count, mean, m2, low, high, k):
         """Mean, u, low and high of sub-batch k (rows k of the arrays), of `shape`."""
@@ -534,6 +550,25 @@ class StreamingStatistics:
             above = above[np.isfinite(above)]
             if above.size:
                 self._high[j].add(-above)
+
+    def _add_candidates(self, columns, m):
+        """:meth:`_add_to_tails` of columns[:, :m] (`columns` C-contiguous) by one
+        compiled pass (:func:`passkernels.tail_candidates`, without the GIL): the same
+        values handed to the same tails in the same order."""
+        size = columns.shape[0]
+        if self._candidates is None or self._candidates.shape[2] < m:
+            self._candidates = np.empty((2, size, m))
+        low_threshold = np.array([tail.threshold for tail in self._low])
+        high_threshold = np.array([tail.threshold for tail in self._high])
+        low_count, high_count = np.empty(size, dtype=np.int64), np.empty(size, dtype=np.int64)
+        _pass_kernels().tail_candidates(columns, m, low_threshold, high_threshold,
+                                        self._candidates[0], self._candidates[1],
+                                        low_count, high_count)
+        for j in range(size):
+            if low_count[j]:
+                self._low[j].add(self._candidates[0, j, :low_count[j]])
+            if high_count[j]:
+                self._high[j].add(self._candidates[1, j, :high_count[j]])
 
     def result(self, probability=COVERAGE_PROBABILITY, kind="symmetric"):
         """dict of arrays of `shape`: mean, u, low, high, n_valid (and circular_std)."""

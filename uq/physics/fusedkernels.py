@@ -1,7 +1,7 @@
 """Compiled (numba) loops of :mod:`uq.physics.fused`: the measurement model trial by trial.
 
 The loops run over a *rectangle* of scenes x trials (scenes ``[s0, s1)``, trials
-``[t0, t1)``); numpy's SIMD ``log`` and ``exp`` evaluate the power law between them
+``[t0, t1)``); :func:`power_near` evaluates the power law between them
 (:func:`uq.physics.fused.measurement_model`):
 
 1. :func:`ins_trig`: cos and sin of each INS angle *error* (heading, pitch, roll, course),
@@ -39,7 +39,8 @@ import math
 import numpy as np
 from numba import njit, types
 
-from uq.constants import HYPOT_SAFE_MAX, HYPOT_SAFE_MIN, SMALL_ANGLE
+from uq.constants import (HYPOT_SAFE_MAX, HYPOT_SAFE_MIN, POWER_SERIES_MAX_EXPONENT,
+                          SMALL_ANGLE)
 from uq.physics.kernelbase import (DEG as _DEG, FULL, NONE, TILT2D, YAW, hypot as _hypot,
                                    inverse2 as _inverse2, taylor_cos_sin)
 
@@ -80,7 +81,7 @@ GEO_ORDER = ("half_cone", "misalignment", "height")
 #: into the kernel (the small ones: the same machine code, the same numbers), not numba's
 #: ``inline="always"``, which re-runs numba's front end on the helper at every call site
 #: and made the first compile 2-3x longer (wind_scan: 19.7 s of CPU time against 7-9 s,
-#: a whole cold ``uq run rubio2022_case_i`` 115 s against 34 s; numba 0.68, issue 26).
+#: a whole cold ``uq run rubio2022_case_i`` 115 s against 34 s; numba 0.68).
 #: The two helpers called once per trial with arrays (the true radial velocities and gate
 #: heights) stay inlined by numba: as calls they cost ~4 % on floating_lidar_full.
 _helper = njit(nogil=True)
@@ -98,6 +99,9 @@ def _signature(kind, dtype):
     i8, b1 = types.int64, types.boolean
     if kind == "trig":
         return types.void(ins, table, i8, i8, i8, i8, b1, c3, c3, c1)
+    if kind == "power":
+        return types.void(types.Array(types.float64, 2, "C"),
+                          types.Array(types.float64, 1, "A"))
     if kind == "geometry":
         return types.void(table, table, ints, geo, i8, i8, i8, i8, b1, a3, a3,
                           types.Array(types.float64, 1, "C"))
@@ -424,7 +428,7 @@ def _pointwise_solve(gram, matrix, rhs):
     :func:`_normal_matrix` and this are the upward and the tilted mounts' point-wise
     kernels' one least squares, inlined by numba (``B^T c`` summed by the caller, with c
     in registers: through an array, or a helper called per gate, the upward kernel took
-    4-50 % more CPU time; issue 25)."""
+    4-50 % more CPU time)."""
     for k in range(3):
         for m in range(3):
             matrix[k, m] = gram[k, m]
@@ -1097,17 +1101,131 @@ def wind_mounted_pointwise(table, shapes, structure, ins, noise, cos_trig, sin_t
                   from_north, from_east, radial, gate_height, shear_out, True)
 
 
+#: Half an ulp of 1.0: the series' truncation bound of :func:`power_near`, and room for
+#: its terms.
+_HALF_ULP, _MAX_TERMS = 2.0 ** -53, 64
+#: Leading mantissa bits that pick a value's reference x0 in :func:`power_near`: x0 is the
+#: midpoint of the 2^-6-wide interval of mantissas the value is in, so |x / x0 - 1| <=
+#: 2^-7 / (1 + 2^-7) = 1 / 129.
+_GRID_BITS = 6
+_POWER_DEVIATION = 1.0 / (2 ** (_GRID_BITS + 1) + 1)
+_MANTISSA_BITS, _EXPONENT_MASK, _INFINITE_EXPONENT = 52, 0x7FF, 0x7FF
+#: Slots of a call's table of references (their x0^a and 1 / x0).
+_POWER_SLOTS = 1024
+
+
+def power_near(values, exponent):
+    """values[i, :] ** exponent[i] in place: x^a = exp(a log x), as numpy's log and exp
+    give it (NaN for NaN or x < 0, 0 or inf at x = 0), for the ratios z / z_ref of a
+    power-law profile, in ~4 ns a value instead of libm's ~12. Each x takes its
+    reference x0 from its own bits (its binary exponent and its leading
+    :data:`_GRID_BITS` mantissa bits, then the midpoint of that interval), so the
+    result depends on x and a alone (not on the other rows: a scene in a batch gives
+    the bits of the scene alone). x^a = x0^a (libm, once per reference and exponent in
+    a call) times the binomial series of (1 + d)^a, d = x / x0 - 1, |d| <= 1/129,
+    summed to within half an ulp (:func:`binomial_terms`) in a loop without calls
+    (SIMD). Zero, negative and non-finite values, and exponents with |a| > 1
+    (:data:`~uq.constants.POWER_SERIES_MAX_EXPONENT`), take libm's log and exp.
+
+    values : (rows, k) float64, C-contiguous; exponent : (rows,) [1]."""
+    rows, k = values.shape
+    flat = values.reshape(rows * k)
+    bits = flat.view(np.int64)
+    deviation, scale, total = np.empty(rows * k), np.empty(rows * k), np.empty(rows * k)
+    reference = np.empty(1)
+    reference_bits = reference.view(np.int64)
+    # x0^a and 1 / x0 by reference, in slots of the reference's key (a collision,
+    # exponents 2^10 apart, recomputes); stamped with the run of rows they belong to
+    powers, inverses = np.empty(_POWER_SLOTS), np.empty(_POWER_SLOTS)
+    references = np.empty(_POWER_SLOTS)
+    keys, stamps = np.full(_POWER_SLOTS, -1, np.int64), np.zeros(_POWER_SLOTS, np.int64)
+    coefficients = np.empty(_MAX_TERMS)
+    shift = _MANTISSA_BITS - _GRID_BITS
+    midpoint = 1 << (shift - 1)
+    generation = 0
+    first = 0
+    while first < rows:                               # runs of rows of one exponent
+        a = exponent[first]
+        last = first + 1
+        while last < rows and exponent[last] == a:
+            last += 1
+        generation += 1
+        usable = abs(a) <= POWER_SERIES_MAX_EXPONENT
+        # (views indexed from 0: numba then knows no index is negative, and the loops
+        # over them compile to SIMD code)
+        run_flat, run_bits = flat[first * k:last * k], bits[first * k:last * k]
+        run_deviation, run_scale = deviation[first * k:last * k], scale[first * k:last * k]
+        run_total = total[first * k:last * k]
+        for index in range(run_flat.shape[0]):
+            word = run_bits[index]
+            biased = (word >> _MANTISSA_BITS) & _EXPONENT_MASK
+            if not usable or word <= 0 or biased == 0 or biased == _INFINITE_EXPONENT:
+                run_deviation[index] = 0.0            # x <= 0, subnormal, inf, NaN: libm
+                run_scale[index] = _exact_power(run_flat[index], a)
+                continue
+            key = word >> shift                       # the exponent and the grid bits
+            slot = key & (_POWER_SLOTS - 1)
+            if keys[slot] != key or stamps[slot] != generation:
+                reference_bits[0] = (key << shift) | midpoint
+                powers[slot] = math.exp(a * math.log(reference[0]))
+                inverses[slot] = 1.0 / reference[0]
+                references[slot] = reference[0]
+                keys[slot], stamps[slot] = key, generation
+            run_deviation[index] = (run_flat[index] - references[slot]) * inverses[slot]
+            run_scale[index] = powers[slot]
+        terms = binomial_terms(a, _POWER_DEVIATION, coefficients)
+        run_total[:] = coefficients[terms - 1]
+        for term in range(terms - 2, -1, -1):         # Horner, value by value
+            c = coefficients[term]
+            for index in range(run_total.shape[0]):
+                run_total[index] = run_total[index] * run_deviation[index] + c
+        for index in range(run_total.shape[0]):
+            run_flat[index] = run_scale[index] * run_total[index]
+        first = last
+
+
+@_helper
+def binomial_terms(exponent, deviation, coefficients):
+    """The binomial coefficients C(a, 0 .. K-1) of (1 + d)^a into coefficients[:K] and
+    K: the fewest terms after which the remainder's bound, |C(a, K)| d^K / (1 - d) (for
+    |a| <= 1 the coefficients' magnitudes do not grow after C(a, 1)), over the least
+    value of the sum, 1 - d, is within half an ulp. |d| <= deviation < 1."""
+    coefficients[0] = 1.0
+    terms = 1
+    bound = abs(exponent) * deviation / (1.0 - deviation) ** 2
+    while bound > _HALF_ULP and terms < coefficients.shape[0]:
+        coefficients[terms] = coefficients[terms - 1] * (exponent - terms + 1) / terms
+        terms += 1
+        bound = abs(coefficients[terms - 1] * (exponent - terms + 1) / terms) * \
+            deviation ** terms / (1.0 - deviation) ** 2
+    return terms
+
+
+@njit(inline="always")
+def _exact_power(x, exponent):
+    """x ** exponent as numpy's exp(a log x) gives it (log 0 = -inf, log x<0 = NaN)."""
+    if x > 0:
+        return math.exp(exponent * math.log(x))
+    if x == 0:
+        return math.exp(exponent * -math.inf)
+    return math.nan
+
+
 #: The kernels, each with its kind of signature.
 _KERNELS = {"ins_trig": (ins_trig, "trig"), "geometry": (geometry, "geometry"),
             "wind_scan": (wind_scan, "wind"), "wind_pointwise": (wind_pointwise, "wind"),
             "geometry_mounted": (geometry_mounted, "geometry"),
             "wind_mounted_scan": (wind_mounted_scan, "wind_mounted"),
-            "wind_mounted_pointwise": (wind_mounted_pointwise, "wind_mounted")}
+            "wind_mounted_pointwise": (wind_mounted_pointwise, "wind_mounted"),
+            "power_near": (power_near, "power")}
 #: The kernels' names (each compiled for float64 and complex128 by :func:`compiled`).
 KERNEL_NAMES = tuple(_KERNELS)
 #: Those of a tilted mount, which runs them in float64 alone (its complex step, the
 #: GUM, is the numpy model's: :func:`uq.physics.fused.declined`).
 MOUNTED_KERNEL_NAMES = ("geometry_mounted", "wind_mounted_scan", "wind_mounted_pointwise")
+#: The kernels compiled for float64 alone (:func:`power_near` is not called with complex
+#: numbers: a complex step's profile takes numpy's log and exp).
+REAL_KERNEL_NAMES = MOUNTED_KERNEL_NAMES + ("power_near",)
 
 
 @functools.cache
