@@ -94,7 +94,7 @@ COMPLEX_STEP_COMPILED_MIN_SCENES = 2**14
 #: Meteorol. 78, 215-246 (0.40 +- 0.01 from his review of surface-layer experiments).
 VON_KARMAN = 0.40
 
-#: Fewest emcee walkers of a profile fit [1]: issue 5 asks for at least 32; the
+#: Fewest emcee walkers of a profile fit [1]: at least 32 by the project's own rule; the
 #: affine-invariant ensemble needs more than twice the parameters (here <= 3).
 MIN_WALKERS = 32
 
@@ -121,10 +121,10 @@ MAX_FIT_DRAWS = 10_000_000
 GOLDEN_BIN_WIDTH = 0.5
 
 #: Reference-speed range whose bins must each hold enough records [m s-1] (bin centres,
-#: inclusive). IEC 61400-12-1:2017 Annex L calibration range, as asked in issue 6.
+#: inclusive). IEC 61400-12-1:2017 Annex L calibration range.
 GOLDEN_REQUIRED_RANGE = (4.0, 16.0)
 
-#: Fewest 10-min records a bin in the required range needs [1] (issue 6).
+#: Fewest 10-min records a bin in the required range needs [1].
 GOLDEN_MIN_RECORDS = 6
 
 #: Largest plausible 10-min mean wind speed [m s-1]: above the strongest recorded 10-min
@@ -141,7 +141,7 @@ GOLDEN_MAX_BINS = 1000
 GOLDEN_SIGNIFICANCE = 0.05
 
 #: Floating-lidar acceptance KPIs, (best practice, minimum), Carbon Trust OWA roadmap as
-#: reproduced in IEA Wind RP 18 (issue 6). Slopes are bands around 1, R^2 lower bounds,
+#: reproduced in IEA Wind RP 18. Slopes are bands around 1, R^2 lower bounds,
 #: the direction offset an upper bound on |offset| [deg].
 KPI_SPEED_SLOPE = ((0.98, 1.02), (0.97, 1.03))
 KPI_SPEED_R2 = (0.98, 0.97)
@@ -213,7 +213,7 @@ FUSED_BLOCK_TRIALS = 2**12
 #: the values around each wanted rank. [1] Floyd and Rivest (1975), sample selection.
 ORDER_SAMPLE = 1024
 
-# --- bounds on what an input may cost (issue 14) ---------------------------------------
+# --- bounds on what an input may cost --------------------------------------------------
 
 #: Largest configuration (scenario, golden, fit) file read [bytes]: the shipped ones are
 #: 1-3 KiB; a larger file (or an endless stream such as /dev/zero) is refused unread.
@@ -254,7 +254,7 @@ MAX_BEAMS = 1000
 #: temporaries; 2^24 trials of a 23-input scene are ~3 GB of draws.
 MAX_CHUNK_SIZE = 2**22
 
-# --- time-resolved motion (issue 17) ---------------------------------------------------
+# --- time-resolved motion --------------------------------------------------------------
 
 #: Error bound of the dwell average per unit amplitude of the fastest motion component
 #: [1] (:func:`uq.physics.timing.dwell_node_count`): 1e-9 of a 10 deg roll is 2e-10 rad,
@@ -318,7 +318,7 @@ MAX_RECORD_BYTES = 256 << 20
 #: Most rows of a table of 10-min records [1], counted before it is parsed: 19 years.
 MAX_RECORD_ROWS = 1_000_000
 
-# --- probe volume (issue 19) -------------------------------------------------------------
+# --- probe volume ------------------------------------------------------------------------
 
 #: Relative error allowed in a probe-weighted wind speed by the quadrature along the beam
 #: [1] (:func:`uq.physics.probe.node_count`): 1e-6 of 10 m s-1 is 1e-5 m s-1, four orders
@@ -361,7 +361,7 @@ ZEPHIR_WAVELENGTH_UM = 1.565
 ZEPHIR_BEAM_RADIUS_MM = 28.0
 ZEPHIR_TRUNCATION = 0.02
 
-# --- compiled time-resolved model (issue 17, item 8: uq.physics.fusedmotion) -------------
+# --- compiled time-resolved model (uq.physics.fusedmotion) -------------------------------
 
 #: pi / 2 in three parts [rad] for the Cody-Waite argument reduction of the compiled
 #: sine and cosine (:func:`uq.physics.fusedmotionkernels.sincos`): the first two carry
@@ -412,7 +412,7 @@ MOTION_BLOCK_TRIALS = (64, 2**11)
 #: with rows of 256 values, 0.0297-0.0299 s with this pad (2026-11-25).
 MOTION_BLOCK_ROW_PAD = 8
 
-# --- Turbulence defaults (issue 24) ------------------------------------------------------
+# --- Turbulence defaults -----------------------------------------------------------------
 # IEC 61400-1 Ed. 3 (2005), Sec. 6.3 and Annex B: the turbulence scale parameter
 # Lambda_1 = 0.7 z below 60 m above ground and 42 m above; the Mann (1994) uniform-shear
 # model with L = 0.8 Lambda_1 and Gamma = 3.9 (Annex B.2); the Kaimal spectra with the
@@ -508,7 +508,7 @@ TURBULENCE_PROBE_REACH = {"pulsed": 70.0, "cw": 50.0}
 #: moved them by up to 1.1 % and the per-scan truncation of 2 % by 4-9 %.
 CW_RECORD_FAR_CUT = 2.0
 CW_RECORD_PROBE_NODES = 96
-# --- Turbulence (issue 24) ------------------------------------------------------------
+# --- Turbulence -----------------------------------------------------------------------
 
 #: Von Karman energy spectrum's exponent 17/6 [1], also the second parameter of Mann's
 #: eddy lifetime 2F1(1/3, 17/6; 4/3; -(kL)^-2): Mann (1994), Sec. 3 (a property of the
@@ -596,7 +596,7 @@ CELL_AVERAGE_K1 = 4.0
 CELL_AVERAGE_K1_NODES = 3
 CELL_AVERAGE_GRADING = (0.25, 6)
 
-# --- Turbulence spectra (issue 24) ----------------------------------------------------------
+# --- Turbulence spectra -------------------------------------------------------------------
 
 #: Quadrature of the spectral path (:class:`uq.physics.spectraltensor.WavenumberGrid`),
 #: tested for convergence in tests/physics/test_spectraltensor.py: k1 L from 1e-6 to 1e6
@@ -622,7 +622,7 @@ SPECTRAL_TOLERANCE = 1e-2
 #: converged [1] (each costs ~2.4 times the one before).
 SPECTRAL_REFINEMENTS = 2
 
-#: Golden TI (issue 24, item 5): a record is 10 min [s] (IEC 61400-12-1); the
+#: Golden TI: a record is 10 min [s] (IEC 61400-12-1); the
 #: representative TI is the mean plus 1.28 standard deviations (IEC 61400-1:2005 Sec.
 #: 6.3.1: the 90 % quantile of a normal distribution of the 10-min TI).
 GOLDEN_RECORD_SECONDS = 600.0

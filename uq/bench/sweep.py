@@ -71,7 +71,7 @@ def draw_floor(repeats=200, draws=MC_DRAWS):
     return seconds / repeats
 
 
-#: Draws per scene of the serial-fraction benchmark: the user's run of issue 26.
+#: Draws per scene of the serial-fraction benchmark: a user's sweep.
 SERIAL_DRAWS = 100_000
 #: Workers whose Amdahl bound is reported [1].
 AMDAHL_WORKERS = (2, 4, 8, 16)
@@ -102,7 +102,7 @@ def serial_fraction(workers=2, quick=False, draws=SERIAL_DRAWS):
 
     ``amdahl_speedup_N = 1 / (f + (1 - f) / N)`` is Amdahl's bound with N workers and
     ``amdahl_efficiency_N`` that over N (the target, 0.6 up to 8 workers, needs f <=
-    0.095; issue 26 asks for f < 0.05).
+    0.095; the project asks for f < 0.05).
     Two more figures say what else could limit it: ``driver_cpu_over_single`` =
     C_driver / C_single (the fraction if all the driver's work were serial: a bound
     from above on f), and ``driver_throughput_speedup`` = C_single / C_window, the

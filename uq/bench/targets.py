@@ -1,4 +1,4 @@
-"""The speed targets (issues 17 and 18), each a ratio of two times measured in the same
+"""The speed targets, each a ratio of two times measured in the same
 run on the same machine, so that a busy or slow host moves both alike.
 
 =====================================  ==========================================  ======
@@ -31,18 +31,18 @@ time to 1e-3 on ``rubio2022_case_i``,   plain ``mc``'s (:mod:`uq.bench.methods`)
 the fastest method                                                                  faster
 =====================================  ==========================================  ======
 
-The probe's figure (issue 26) is a whole ``uq.run`` of ``floating_lidar_full`` with a
+The probe's figure is a whole ``uq.run`` of ``floating_lidar_full`` with a
 WindCube-like pulsed probe against the same run at a point, n trials each; the model's
 own ratio (the measurement model alone, the same draws) is reported beside it.
 
-The nacelle figures (issue 25) are whole ``uq.run`` calls; the measurement model's own
+The nacelle figures are whole ``uq.run`` calls; the measurement model's own
 ratios (``nacelle_static_model_over_dbs``, ``nacelle_motion_model_over_dbs``: the model
 alone on the same draws, :func:`nacelle_models`) are reported beside them.
 
 The draw floor of a run is measured by replaying the engine's own draws: the run is
 made once with :func:`uq.engine.propagate.normal_scores` recorded (the shape of every
 block it draws), then the same blocks are drawn again with numpy's Generator alone.
-The serial fraction (issue 26) is :func:`uq.bench.sweep.serial_fraction`:
+The serial fraction is :func:`uq.bench.sweep.serial_fraction`:
 ``rubio2022_misalignment`` at 10^5 draws per scene on 2 local workers, from the CPU
 times of the driving process and of the workers (the whole grid; ``--quick``: a ninth).
 

@@ -1,10 +1,10 @@
-"""Benchmark of the Monte Carlo turbulence path (issue 24): one ten-minute record.
+"""Benchmark of the Monte Carlo turbulence path: one ten-minute record.
 
 A record of a 5-beam DBS at 100 m (half-cone 30 deg, pulsed probe of gate 18.75 m and
 pulse 24.75 m, 1 s per beam, U = 10 m/s, Mann field with IEC parameters) costs one box
 (:func:`uq.physics.turbulencebox.mann_box`, sized by ``box_for``) plus the sampling of every
 beam of every scan and the reconstruction of each scan with the nominal operator. The
-target (issue 24) is a record in at most 5x the time of its box alone. Times are CPU times
+target is a record in at most 5x the time of its box alone. Times are CPU times
 (``time.process_time``) and ratios from the same run; records per second on the machine's
 cores are measured with one record per process, all processes at once (wall time). Run:
 ``python -m uq.bench.turbulence`` (prints JSON); ``--device gpu`` times the CuPy path,

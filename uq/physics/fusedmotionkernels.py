@@ -117,7 +117,7 @@ WORK, WORK_ROWS = row_layout(WORK_BLOCKS)
 
 
 _helper = njit(cache=True, nogil=True, error_model="numpy")
-#: Compile-time notes (issue 26, cold first runs), kept by every kernel here:
+#: Compile-time notes (cold first runs), kept by every kernel here:
 #: - numba compiles a jitted callee once per distinct *literal* argument (a module-level
 #:   int or a True/False written at the call), so row numbers and flags are passed as
 #:   values (np.int64(...), a comparison), one compile per helper;
@@ -132,7 +132,7 @@ _helper = njit(cache=True, nogil=True, error_model="numpy")
 #: reading) stay inlined by numba, whose constant arguments then prune their branches.
 #: Cold compile of the motion kernels: 33 s of CPU time before, 23 s after; the kernels'
 #: CPU time unchanged (2^18 point-wise scans 0.19-0.20 s both ways, floating_lidar_full
-#: 0.16 s, floating_lidar_waves 0.89-0.93 s; numba 0.68, issue 26).
+#: 0.16 s, floating_lidar_waves 0.89-0.93 s; numba 0.68).
 _called = njit(nogil=True, error_model="numpy")
 _inline = njit(inline="always", error_model="numpy")
 
@@ -748,7 +748,7 @@ def _pointwise_from_state(head, state, work, nx, ny, nz, count):
     """:func:`_pointwise_at` from the truth's state without a lever arm, written out in
     one loop of locals (the same operations in the same order: bit for bit its result),
     which LLVM makes SIMD code where the inlined helper stayed scalar: the bench's
-    point-wise scan 93 -> 40 ns per trial in :func:`reconstruct` (issue 26)."""
+    point-wise scan 93 -> 40 ns per trial in :func:`reconstruct`."""
     level_c, level_s = head[_LEVEL_COS], head[_LEVEL_SIN]
     ship_n, ship_e, ship_u = head[_SHIP_NORTH], head[_SHIP_EAST], head[_SHIP_UP]
     course_c, course_s = head[_COURSE_COS], head[_COURSE_SIN]
@@ -1035,7 +1035,7 @@ def _level_wind(consts, model, beams, work, normal, stored, measured, n_gates, c
     (:mod:`uq.physics.nacelle`); other layouts keep `out`. Inside :func:`reconstruct`
     and on as few rows as it can (the inverse of each 2 x 2 system made again per gate,
     not kept): a pass of its own per block read its rows back from beyond the cache
-    (issue 25's speed line). Loops over the trials innermost (SIMD)."""
+    (a speed target of the bench). Loops over the trials innermost (SIMD)."""
     n_beams = int(consts[_N_BEAMS])
     level_a, level_b = int(consts[_LEVEL_FIRST]), int(consts[_LEVEL_SECOND])
     keep_all = consts[_MOUNTED] > 1         # the shear's beams too, and their lift

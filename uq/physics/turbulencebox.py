@@ -1,6 +1,6 @@
 """Turbulent wind fields in a box: Mann (1994, 1998) by FFT, and Kaimal with IEC coherence.
 
-The Monte Carlo path of issue 24 samples a generated field along each beam
+The Monte Carlo path of turbulent records samples a generated field along each beam
 (:mod:`uq.physics.turbulencesampling`); this module generates the field.
 
 Conventions
@@ -22,8 +22,8 @@ IEC parameters): hipersim 0.1.22 (MIT, pure numpy): 4.0 s CPU per box, 835 MB pe
 the same field for a seed, but its random numbers depend on its ``n_cpu`` (a sequential and
 a parallel generator), no CuPy path, and it pulls in wetb, netCDF4, tqdm; mannrs 2.0.0 (MIT,
 Rust): 7.3 s CPU to build its stencil then ~3 s CPU per box, 1.05 GB peak, the same field
-for a seed, no CuPy path, needs pydantic and toml. Neither runs on a GPU, which issue 24
-item 7 asks for, so the generator is written here in ~100 lines against the numpy API that
+for a seed, no CuPy path, needs pydantic and toml. Neither runs on a GPU, which this project
+needs, so the generator is written here in ~100 lines against the numpy API that
 CuPy mirrors (``xp``): the same algorithm as both (Mann 1998 [2], Sec. 3), and its
 spectral factor is written from the paper, independently of the spectral path's tensor, so
 that ``C C^T = Phi`` cross-checks the two (only the exact eddy lifetime, which the table

@@ -1,6 +1,6 @@
 """A lidar's sampling of a turbulent field over a record, and the record's statistics.
 
-The Monte Carlo path of issue 24: a box of :mod:`uq.physics.turbulencebox` holds the
+The Monte Carlo path of turbulent records: a box of :mod:`uq.physics.turbulencebox` holds the
 frozen field ``u'_0``; each beam of each scan sees, at its true (possibly moving) probe
 points and times, the radial velocity ``v_r = sum_n W_n d . u'_0(p_n - U t e_x)``, averaged
 over the beam's dwell (Taylor's hypothesis, :mod:`uq.physics.scangeometry`). The pipeline

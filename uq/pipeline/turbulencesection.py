@@ -16,7 +16,7 @@ settings unless given).
     record: {duration: 600, count: 20}   # s: a record is the scans lidar.scan times in
                                  # that long; count: Monte Carlo records per scene
 
-Defaults (:mod:`uq.constants`, block "Turbulence defaults (issue 24)"): the length scale
+Defaults (:mod:`uq.constants`, block "Turbulence defaults"): the length scale
 follows IEC 61400-1 Ed. 3 from the reference height z through the turbulence scale
 parameter ``Lambda_1 = 0.7 min(z, 60 m)`` (42 m above 60 m); ``anisotropy`` 3.9.
 ``intensity`` has no default: it is what a site is measured for (offshore 4-8 %, the IEC
