@@ -259,3 +259,22 @@ def test_every_shipped_file_is_timed_with_the_command_that_runs_it(tmp_path):
     for name, kind in kinds.items():
         if kind != "run":
             assert main(["check", name, "-q"]) == 0, name
+
+
+def test_the_worst_end_to_end_ratio_leaves_out_the_files_that_work_on_records():
+    """Record mode, campaigns and golden campaigns are the files whose time is their
+    records' (their normals are a few of their random numbers): left out of the worst
+    ratio to the draws, named; the worst is that of the files of Monte Carlo trials."""
+    from uq.bench.targets import shipped_worst, works_on_records
+    from uq.pipeline.shipped import shipped_folder
+    names = sorted(p.stem for p in shipped_folder().glob("*.yaml"))
+    on_records = [name for name in names if works_on_records(name)]
+    assert on_records == ["campaign_buoy", "floating_lidar_ti", "golden_campaign",
+                          "sathe2011_ti", "sathe2011_ti_cw"]
+    figures = {f"shipped_{name}_over_floor_and_start": 1.0 + i for i, name in
+               enumerate(names)}
+    worst = shipped_worst(figures, names)
+    trials = [name for name in names if name not in on_records]
+    assert worst["shipped_worst_name"] == trials[-1]
+    assert worst["shipped_worst_over_floor_and_start"] == 1.0 + names.index(trials[-1])
+    assert worst["shipped_on_records"] == ", ".join(on_records)

@@ -22,8 +22,9 @@ DESCRIPTIONS = {
         "plain mc) over the time to draw its standard normals alone, at "
         "floating_lidar_full_mc_n trials"),
     "shipped_worst_over_floor_and_start": (
-        "1", "worst over the shipped scenarios: wall time of the user's command in a new "
-        "process over its draws plus the process start"),
+        "1", "worst over the shipped scenarios of Monte Carlo trials (not those that work "
+        "on ten-minute records: shipped_on_records): wall time of the user's command in a "
+        "new process over its draws plus the process start"),
     "sweep_mc_over_draw_floor": (
         "1", "Monte Carlo sweep at 10^4 draws per scene (rubio2022_misalignment): time "
         "per scene over drawing one scene's normals"),
