@@ -14,7 +14,8 @@ from what they give, and checks each README figure against the record.
 
 ``--bench`` runs ``uq bench --quick`` (or ``--bench-full``: ``uq bench``) and keeps its
 result file as ``docs/data/bench.nc`` with the machine, the load average before and after
-and the time it ran: the guide's performance page is generated from it.
+and the time it ran: the guide's performance page is generated from it, and the README's
+speed table (``--only speed``: that table alone, from the file as it is).
 """
 import argparse
 import hashlib
@@ -216,6 +217,58 @@ def table_campaign(folder):
     return "\n".join(lines)
 
 
+#: The benchmark result the guide's performance page and the README's speed table read.
+BENCH_FILE = DOCS / "data" / "bench.nc"
+
+
+def _verdict(figures, name, unit="x"):
+    """``<= 3x: met`` of a figure with a target (:data:`uq.bench.targets.TARGETS`)."""
+    from uq.bench.targets import TARGETS
+    limit, sense = TARGETS[name]
+    met = figures[name] <= limit if sense == "max" else figures[name] >= limit
+    return f"{'<=' if sense == 'max' else '>='} {limit:g}{unit}: {'met' if met else 'NOT met'}"
+
+
+def table_speed(path=BENCH_FILE):
+    """The speed targets a user notices, from one ``uq bench`` result file: each figure a
+    ratio of two wall times from the same run (or a difference), with its target."""
+    import xarray
+    with xarray.open_dataset(path) as dataset:
+        figures = dict(dataset.attrs)
+    methods = ("lhs", "sobol", "mc_cv", "sobol_cv")
+    best = min(methods, key=lambda m: figures[f"rubio2022_case_i_{m}_time_to_1e_3_s"])
+    records = " / ".join(f"{figures[f'records_per_second_{name}']:.3g}" for name in
+                         ("sathe2011_ti", "sathe2011_ti_cw", "floating_lidar_ti"))
+    loads = [float(value) for value in re.findall(r"\d+\.\d+", figures["load_average"])]
+    ended = figures["history"].split()[0]
+    machine = ", ".join(figures["machine"].split(", ")[:3])      # processor, cores, memory
+    lines = [_row("what a user runs", "against", "measured", "target"),
+             _row("---", "---", "---", "---"),
+             _row(f"`floating_lidar_full` as shipped, {figures['floating_lidar_full_mc_n']:,}"
+                  " trials", "drawing its normals alone",
+                  f"{figures['floating_lidar_full_mc_over_draw_floor']:.2f}x "
+                  f"({figures['floating_lidar_full_mc_s']:.2f} s, "
+                  f"{figures['floating_lidar_full_draw_floor_s']:.2f} s)",
+                  _verdict(figures, "floating_lidar_full_mc_over_draw_floor")),
+             _row("10^6 point-wise corrected scans in roll and pitch", "10^6 static scans",
+                  f"{figures['pointwise_motion_over_static']:.2f}x",
+                  _verdict(figures, "pointwise_motion_over_static")),
+             _row("time to 1e-3 in u(Vh), `rubio2022_case_i`, fastest method "
+                  f"({best.replace('_', '+')})", "plain Monte Carlo's",
+                  f"{figures['rubio2022_case_i_best_speedup']:.1f}x faster",
+                  _verdict(figures, "rubio2022_case_i_best_speedup")),
+             _row("first run of every shipped file, numba's cache empty (worst: "
+                  f"`{figures['first_run_worst_name']}`)", "the same once the cache is filled",
+                  f"{figures['first_run_worst_over_warm_s']:+.1f} s",
+                  _verdict(figures, "first_run_worst_over_warm_s", " s")),
+             _row("record mode: `sathe2011_ti` / `sathe2011_ti_cw` / `floating_lidar_ti`",
+                  "", f"{records} records/s", "stated"), "",
+             f"(`{figures['bench_command']}`, {figures['measured_at'][:16].replace('T', ' ')} to "
+             f"{ended[11:16]} UTC; {machine}; load average at most {max(loads):.1f}; every "
+             "figure on the [performance](docs/performance.md) page)"]
+    return "\n".join(lines)
+
+
 #: README table name -> (runs it needs, the function that renders it)
 TABLES = {
     "rubio2022_case_i": (["case_i", "case_i_beam"], table_case_i),
@@ -296,7 +349,8 @@ def main(argv=None):
                         help="also run uq bench --quick for the performance page")
     parser.add_argument("--bench-full", action="store_true",
                         help="also run the full uq bench for the performance page")
-    parser.add_argument("--only", action="append", choices=sorted(PLOTTED) + sorted(TABLES),
+    parser.add_argument("--only", action="append",
+                        choices=sorted(PLOTTED) + sorted(TABLES) + ["speed"],
                         metavar="NAME", help="make only this figure or table (repeatable)")
     args = parser.parse_args(argv)
     manifest = json.loads(MANIFEST.read_text()) if MANIFEST.exists() else {}
@@ -323,6 +377,9 @@ def main(argv=None):
             print(f"README.md table {name}")
         if args.bench or args.bench_full:
             bench(folder, full=args.bench_full)
+        if args.bench or args.bench_full or (args.only and "speed" in args.only):
+            tables["speed"] = table_speed()
+            print("README.md table speed")
     MANIFEST.write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
     if tables:
         README.write_text(replace_tables(README.read_text(), tables))

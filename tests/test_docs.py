@@ -152,7 +152,7 @@ def test_every_readme_table_is_generated():
     numeric_rows = [line for line in outside.splitlines()
                     if line.startswith("|") and re.search(r"\d\.\d", line)]
     assert numeric_rows == []
-    assert set(figures.readme_tables(text)) == set(figures.TABLES)
+    assert set(figures.readme_tables(text)) == set(figures.TABLES) | {"speed"}
 
 
 #: A time or a memory size: a number with its unit.
@@ -203,6 +203,14 @@ def test_readme_table_is_what_its_commands_give(name, tmp_path):
     except AssertionError as error:
         raise AssertionError(f"README table {name} is not what its commands give now: "
                              f"python scripts/docs_figures.py --only {name}\n{error}") from None
+
+
+def test_readme_speed_table_is_the_shipped_bench_result():
+    """The README's speed table is what the guide's benchmark file (one ``uq bench``
+    run) gives, exactly: python scripts/docs_figures.py --only speed."""
+    written = figures.readme_tables(README.read_text())["speed"].strip()
+    assert written == figures.table_speed().strip(), \
+        "python scripts/docs_figures.py --only speed"
 
 
 def test_the_number_comparison_fails_on_a_changed_number():
