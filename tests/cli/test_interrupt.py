@@ -142,6 +142,10 @@ def test_dask_is_silenced_before_the_stop_is_raised():
     before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
     for name in DASK_LOGGERS:
         logging.getLogger(name).setLevel(logging.NOTSET)
+    # the earlier handler is Python's own (a test runner's worker may have inherited
+    # SIGINT ignored, and then no stop is raised, rightly)
+    inherited = signal.signal(signal.SIGINT, signal.default_int_handler)
+    before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
     try:
         with pytest.raises(KeyboardInterrupt):
             with _quiet_at_stop():
@@ -152,6 +156,7 @@ def test_dask_is_silenced_before_the_stop_is_raised():
                    for name in DASK_LOGGERS)
         assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
     finally:
+        signal.signal(signal.SIGINT, inherited)
         for name, level in levels.items():
             logging.getLogger(name).setLevel(level)
 

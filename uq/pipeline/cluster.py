@@ -35,14 +35,22 @@ def local_cluster(workers, starting=contextlib.nullcontext, **options):
         with starting():
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
                                    processes=True, dashboard_address=":0", **options)
-        with cluster:
-            client = Client(cluster, set_as_default=False)
-            try:
-                yield client
-            except BaseException:
-                _close_after_stop(client)
-                raise
-            client.close()
+        client = None
+        try:
+            with cluster:
+                client = Client(cluster, set_as_default=False)
+                try:
+                    yield client
+                except BaseException:
+                    _close_after_stop(client)
+                    raise
+                client.close()
+        finally:
+            # the cluster and its event loop are gone: a client not marked closed (a stop
+            # that came during its close) would close again at garbage collection and
+            # print "Exception ignored in: Client.__del__ ... IOLoop is closed"
+            if client is not None and client.status != "closed":
+                client.status = "closed"
 
 
 def _close_after_stop(client):
