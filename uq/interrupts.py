@@ -141,8 +141,12 @@ def _unraisable_hook(previous_hook):
     """An unraisable-exception hook that keeps a stop quiet: a stop's exception dropped
     in a finaliser or weakref callback is not printed as "Exception ignored in ..." with
     a traceback; it stays pending and its watcher sends it again. Other exceptions go to
-    `previous_hook`."""
+    `previous_hook`. Neither is a dask client's failed close at garbage collection once
+    its event loop is gone ("IOLoop is closed", :func:`_closed_loop_client`): a run
+    stopped during the client's close, and there is nothing left to close."""
     def hook(unraisable):
+        if _closed_loop_client(unraisable):
+            return
         if not issubclass(unraisable.exc_type, KeyboardInterrupt):
             previous_hook(unraisable)
             return
@@ -151,6 +155,16 @@ def _unraisable_hook(previous_hook):
         if _pending["number"] != number:     # not raised by stop(): watch it here
             _note(number)
     return hook
+
+
+def _closed_loop_client(unraisable):
+    """Whether `unraisable` is ``distributed.Client.__del__``'s RuntimeError "IOLoop is
+    closed": the client's second close, after its cluster and loop have stopped."""
+    function = unraisable.object
+    return (unraisable.exc_type is RuntimeError
+            and "IOLoop is closed" in str(unraisable.exc_value)
+            and getattr(function, "__qualname__", "") == "Client.__del__"
+            and getattr(function, "__module__", "").startswith("distributed"))
 
 
 @contextlib.contextmanager

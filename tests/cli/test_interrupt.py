@@ -205,3 +205,23 @@ def test_the_held_stop_only_for_the_command():
     from uq.interrupts import hold_while_starting
     assert hold_while_starting(["python", "notebook.py"]) is False
     assert signal.getsignal(signal.SIGINT) is not __import__("uq").interrupts.hold
+
+
+def test_a_dask_client_closed_again_after_its_loop_is_quiet():
+    """A dask client's close at garbage collection after its loop has gone (a stop during
+    its close) prints nothing; any other unraisable exception reaches the earlier hook."""
+    from types import SimpleNamespace
+    from uq.interrupts import _unraisable_hook
+    seen = []
+    hook = _unraisable_hook(seen.append)
+
+    def __del__(self):
+        pass
+    __del__.__qualname__, __del__.__module__ = "Client.__del__", "distributed.client"
+    client = SimpleNamespace(exc_type=RuntimeError, exc_value=RuntimeError("IOLoop is closed"),
+                             object=__del__)
+    other = SimpleNamespace(exc_type=RuntimeError, exc_value=RuntimeError("IOLoop is closed"),
+                            object=print)
+    hook(client)
+    hook(other)
+    assert seen == [other]
