@@ -45,6 +45,30 @@ def test_moments(rng, n, nan_share):
     assert np.all(np.abs(m21 - m22) <= _sum_bound(deviations) + 1e-300)
 
 
+def _masked_moments(block):
+    """The moments with every value masked by its finiteness (statnumpy's general path)."""
+    finite = np.isfinite(block)
+    count = finite.sum(axis=1)
+    mean = np.divide(np.where(finite, block, 0.0).sum(axis=1), count,
+                     out=np.zeros(len(count)), where=count > 0)
+    return count, mean, (np.where(finite, block - mean[:, None], 0.0) ** 2).sum(axis=1)
+
+
+@pytest.mark.parametrize("n", [0, 1, 4097])
+def test_moments_of_finite_values_are_the_masked_ones_bit_for_bit(rng, n):
+    """The all-finite shortcut adds the same values in the same order as the masked
+    path; a finite block whose sum overflows takes the masked path (same result)."""
+    columns = _columns(rng, 3, n)
+    if n:
+        columns[2, :2] = np.finfo(float).max              # its sum overflows to inf
+    count, mean, m2 = np.empty(3, dtype=np.int64), np.empty(3), np.empty(3)
+    with np.errstate(over="ignore"):                  # (the overflow is the point)
+        statnumpy.moments(columns, 0, n, count, mean, m2)
+        expected = _masked_moments(columns)
+    for got, expected in zip((count, mean, m2), expected):
+        np.testing.assert_array_equal(got, expected)
+
+
 def test_resultant(rng):
     """Deviations up to +-200 deg (the kernel's polynomials near 0, libm beyond)."""
     columns = np.ascontiguousarray(rng.uniform(-200, 200, (4, 3000)))

@@ -50,6 +50,14 @@ def moments(columns, start, stop, count, mean, m2):
     columns[e, start:stop], for every element e (mean 0 where none is finite, as the
     kernel's)."""
     block = columns[:, start:stop]
+    total = block.sum(axis=1)
+    if np.isfinite(total).all():
+        # every value finite (a non-finite one makes its row's sum non-finite): the
+        # sums below without their masks, the same additions in the same order
+        count[:] = block.shape[1]
+        mean[:] = total / block.shape[1] if block.shape[1] else 0.0
+        m2[:] = ((block - mean[:, None]) ** 2).sum(axis=1)
+        return
     finite = np.isfinite(block)
     count[:] = finite.sum(axis=1)
     total = np.where(finite, block, 0.0).sum(axis=1)
