@@ -74,3 +74,20 @@ def test_band_energy_is_zero_only_where_the_spectrum_underflows():
     from uq.physics.waves import band_energy
     assert band_energy(8.0, 3.3, 256, (0.5 / 8, 4 / 8)) == pytest.approx(1 / 16, rel=1e-2)
     assert not band_energy(8.0, 3.3, 32, (1e-4, 2e-4)) > 0        # 0 or NaN (0 / 0)
+
+
+def test_a_spectrum_asked_for_again_is_not_computed_again(monkeypatch):
+    """wavespectra's scaling reads the whole call stack (0.1-0.2 s a call deep in a run):
+    the same bins of the same sea are computed once, and give the same components."""
+    import wavespectra.construct.frequency as frequency
+    from uq.physics import waves
+    calls, original = [], frequency.jonswap
+    monkeypatch.setattr(frequency, "jonswap", lambda *a, **k: calls.append(1) or original(*a, **k))
+    waves._jonswap_bins.cache_clear()
+    response = {"roll": (4.0, 1.5), "heave": (1.0, 0.0)}
+    first = waves.jonswap_components(2.5, 7.0, 3.3, 24, (0.5 / 7, 4 / 7), response)
+    again = waves.jonswap_components(2.5, 7.0, 3.3, 24, (0.5 / 7, 4 / 7), response)
+    other = waves.jonswap_components(3.0, 7.0, 3.3, 24, (0.5 / 7, 4 / 7), response)
+    assert first == again and len(calls) == 2            # (the second sea: its own call)
+    assert waves.significant_height(other, "heave") == pytest.approx(3.0, rel=1e-12)
+    waves._jonswap_bins.cache_clear()
