@@ -27,3 +27,31 @@ def test_a_close_that_works_is_left_alone():
     client = types.SimpleNamespace(status="running", close=lambda: calls.append(1))
     _close_after_stop(client)
     assert calls == [1] and client.status == "running"
+
+
+def test_a_local_cluster_leaves_this_process_s_environment_as_it_was(monkeypatch):
+    """dask's nanny writes its workers' variables (MALLOC_TRIM_THRESHOLD_=65536, ...)
+    into the spawning process's environment; every later child would inherit them."""
+    import os
+    import pytest
+    pytest.importorskip("distributed")
+    from uq.pipeline.cluster import local_cluster
+    monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)
+    monkeypatch.setenv("OMP_NUM_THREADS", "3")
+    before = dict(os.environ)
+    with local_cluster(1) as client:
+        assert client.submit(os.getenv, "MALLOC_TRIM_THRESHOLD_").result() == "65536"
+        assert dict(os.environ) == before            # restored once the workers started
+    assert dict(os.environ) == before
+
+
+def test_restore_environment_removes_adds_and_resets(monkeypatch):
+    import os
+    from uq.pipeline.cluster import restore_environment
+    monkeypatch.setenv("UQ_TEST_KEPT", "1")
+    monkeypatch.delenv("UQ_TEST_ADDED", raising=False)
+    before = dict(os.environ)
+    monkeypatch.setenv("UQ_TEST_ADDED", "x")
+    monkeypatch.setenv("UQ_TEST_KEPT", "2")
+    restore_environment(before)
+    assert dict(os.environ) == before

@@ -12,6 +12,7 @@ itself, and the driver's part of it is serial (``uq.bench.sweep.serial_fraction`
 None of it changes a number: the chunks are a fixed function of the scenario.
 """
 import contextlib
+import os
 
 #: dask settings of the local cluster (:func:`local_cluster`), dask's own config keys.
 CLUSTER_SETTINGS = {
@@ -31,10 +32,12 @@ def local_cluster(workers, starting=contextlib.nullcontext, **options):
     ``host``). The client is not made dask's default scheduler."""
     import dask
     from dask.distributed import Client, LocalCluster
+    environment = dict(os.environ)
     with dask.config.set(CLUSTER_SETTINGS):
         with starting():
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
                                    processes=True, dashboard_address=":0", **options)
+        restore_environment(environment)
         client = None
         try:
             with cluster:
@@ -51,6 +54,21 @@ def local_cluster(workers, starting=contextlib.nullcontext, **options):
             # print "Exception ignored in: Client.__del__ ... IOLoop is closed"
             if client is not None and client.status != "closed":
                 client.status = "closed"
+            restore_environment(environment)
+
+
+def restore_environment(environment):
+    """Make ``os.environ`` `environment` again. dask's nanny sets its workers' variables
+    (``distributed.nanny.pre-spawn-environ``: ``MALLOC_TRIM_THRESHOLD_=65536``,
+    ``OMP_NUM_THREADS=1`` and others) in this process's own environment before it
+    spawns them; left there, every later child of this process inherits them (a
+    record-mode ``uq run`` started after a cluster took 3x its time, most of it in the
+    kernel returning memory)."""
+    for key in set(os.environ) - set(environment):
+        del os.environ[key]
+    for key, value in environment.items():
+        if os.environ.get(key) != value:
+            os.environ[key] = value
 
 
 def _close_after_stop(client):
