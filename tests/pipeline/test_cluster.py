@@ -33,8 +33,6 @@ def test_a_local_cluster_leaves_this_process_s_environment_as_it_was(monkeypatch
     """dask's nanny writes its workers' variables (MALLOC_TRIM_THRESHOLD_=65536, ...)
     into the spawning process's environment; every later child would inherit them."""
     import os
-    import pytest
-    pytest.importorskip("distributed")
     from uq.pipeline.cluster import local_cluster
     monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)
     monkeypatch.setenv("OMP_NUM_THREADS", "3")
