@@ -73,8 +73,8 @@ def first_run(name):
             out[f"{kind}_load"] = load
             # (after the warm run too: a compile it started would otherwise run on
             # beside the next scenario's runs)
-            out[f"background_after_{kind}_s"] = _wait_for_background(cache)
-        out["background_after_s"] = out.pop("background_after_cold_s")
+            waited = _wait_for_background(cache)
+            out["background_after_s" if kind == "cold" else "background_after_warm_s"] = waited
         out["over_warm_s"] = out["cold_s"] - out["warm_s"]
         out["command"] = f"uq {shipped_command(name)}"
         if shipped_command(name) == "run":            # a folder's file has other names
@@ -109,7 +109,7 @@ def measure(names=None, progress=None):
                         f"first_run_{name}_load": row["cold_load"],
                         f"first_run_{name}_background_after_s": row["background_after_s"],
                         f"first_run_{name}_background_after_warm_s":
-                            row.get("background_after_warm_s", 0.0)})
+                            row["background_after_warm_s"]})
         if "warm_compiled" in row:
             figures[f"first_run_{name}_warm_compiled"] = int(row["warm_compiled"])
             figures[f"first_run_{name}_largest_difference"] = row["largest_difference"]

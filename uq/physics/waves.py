@@ -93,9 +93,8 @@ def _jonswap_bins(tp, gamma, components, low, high, hs):
     from wavespectra.construct.frequency import jonswap        # (imports dask: lazily)
     width = (high - low) / components
     frequencies = low + width * (np.arange(components) + 0.5)
-    with np.errstate(all="ignore"):
-        shape = np.asarray(jonswap(frequencies, fp=1.0 / tp, gamma=gamma, hs=hs).values,
-                           dtype=float)
+    shape = np.asarray(jonswap(frequencies, fp=1.0 / tp, gamma=gamma, hs=hs).values,
+                       dtype=float)
     frequencies.flags.writeable = shape.flags.writeable = False
     return frequencies, shape
 

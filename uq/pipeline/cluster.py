@@ -34,10 +34,12 @@ def local_cluster(workers, starting=contextlib.nullcontext, **options):
     from dask.distributed import Client, LocalCluster
     environment = dict(os.environ)
     with dask.config.set(CLUSTER_SETTINGS):
-        with starting():
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
-                                   processes=True, dashboard_address=":0", **options)
-        restore_environment(environment)
+        try:
+            with starting():
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
+                                       processes=True, dashboard_address=":0", **options)
+        finally:                                 # (a start that failed wrote them too)
+            restore_environment(environment)
         client = None
         try:
             with cluster:
