@@ -97,12 +97,23 @@ def test_a_warm_cache_runs_the_compiled_model_bit_for_bit():
 
 CHILD = """
 import json, sys
+import uq.pipeline.runner
 from uq.pipeline.runner import run
+if len(sys.argv) > 3:                          # the threads of auto's numpy chunks
+    import threading
+    uq.pipeline.runner.NUMPY_CHUNK_THREADS = int(sys.argv[3])
+    chunk, names = uq.pipeline.runner.run_chunk, set()
+    def run_chunk(*args, **kwargs):              # (said on stdout: the threads it ran on)
+        names.add(threading.current_thread().name.split("_")[0])
+        return chunk(*args, **kwargs)
+    uq.pipeline.runner.run_chunk = run_chunk
 from uq.pipeline.scenario import load_scenario
 from uq.pipeline.shipped import scenario_path
 changes = json.loads(sys.argv[1])
 result = run(load_scenario(scenario_path(changes.pop("name")), changes), model="auto")
 result.to_netcdf(sys.argv[2])
+if len(sys.argv) > 3:
+    print(json.dumps(sorted(names)))
 """
 
 
@@ -141,21 +152,34 @@ def test_a_cold_cache_runs_numpy_compiles_nothing_and_agrees(tmp_path, name, cha
             assert gap <= 1e-9 * np.nanmax(np.abs(values)) + 1e-12, (variable, gap)
 
 
-def test_numpy_chunks_on_threads_are_the_sequential_ones_bit_for_bit(tmp_path):
+@pytest.mark.parametrize("name, changes, chunks", [
+    ("rubio2022_half_cone", {"sampling.n": 300}, 7),
+    # record mode: the first chunk draws every scene's records, the later ones on threads
+    ("floating_lidar_ti", {"sampling.n": 300, "record.duration": 120, "record.count": 2,
+                           "sweep.turbulence.intensity": [0.06, 0.12]}, 4),
+])
+def test_numpy_chunks_on_threads_are_the_sequential_ones_bit_for_bit(tmp_path, name, changes,
+                                                                     chunks):
     """A cold cache's sweep of many chunks: after the first, auto's numpy chunks run on
-    threads; each is the same bytes as the numpy model's sequential run (model="numpy")."""
-    changes = {"sampling.n": 300}                # rubio2022_half_cone: 7 chunks of scenes
-    cache = tmp_path / "numba"
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(cache), "PYTHONPATH": str(ROOT)}
-    out = tmp_path / "auto.nc"
-    done = subprocess.run([sys.executable, "-c", CHILD,
-                           json.dumps({"name": "rubio2022_half_cone", **changes}), str(out)],
-                          env=env, capture_output=True, text=True, preexec_fn=cpu_limited())
-    assert done.returncode == 0, child_failure(done)
-    with xr.open_dataset(out) as cold:
-        cold = cold.load()
-    assert cold.attrs["model"].startswith("numpy for 7 of 7 chunks")
-    sequential = run(load_scenario(scenario_path("rubio2022_half_cone"), changes),
-                     model="numpy")
+    two threads (set, whatever the machine's cores); each is the same bytes as in the
+    same run with its chunks in sequence (one thread; both with numba's cache empty, so
+    a record's kernels are numpy's too)."""
+    results = {}
+    for threads in (2, 1):
+        cache = tmp_path / f"numba{threads}"
+        env = {**os.environ, "NUMBA_CACHE_DIR": str(cache), "PYTHONPATH": str(ROOT)}
+        out = tmp_path / f"auto{threads}.nc"
+        done = subprocess.run([sys.executable, "-c", CHILD, json.dumps({"name": name, **changes}),
+                               str(out), str(threads)], env=env, capture_output=True,
+                              text=True, preexec_fn=cpu_limited())
+        assert done.returncode == 0, child_failure(done)
+        ran_on = json.loads(done.stdout.strip().splitlines()[-1])
+        assert ran_on == (["MainThread", "uq-chunk"] if threads > 1 else ["MainThread"])
+        with xr.open_dataset(out) as result:
+            results[threads] = result.load()
+        assert results[threads].attrs["model"].startswith(
+            f"numpy for {chunks} of {chunks} chunks")
+    cold, sequential = results[2], results[1]
+    assert set(cold.data_vars) == set(sequential.data_vars)
     for name in sequential.data_vars:
         np.testing.assert_array_equal(cold[name].values, sequential[name].values, name)

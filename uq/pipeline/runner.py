@@ -230,14 +230,17 @@ NUMPY_CHUNK_THREADS = min(4, usable_cpus())
 def _local(scenario, plan, chunks, seed, choice, kernels_ready=None):
     """Chunks in this process, yielded in order as ``(index, dataset, None)``. Once
     ``auto`` runs the numpy model (a kernel missing from numba's cache), the remaining
-    chunks of a run without records go to :data:`NUMPY_CHUNK_THREADS` threads (each chunk
-    is the same whichever thread computes it: its draws come from the seed alone)."""
+    chunks go to :data:`NUMPY_CHUNK_THREADS` threads (each chunk is the same whichever
+    thread computes it: its draws come from the seed alone). In record mode the first
+    chunk draws every scene's records (:func:`uq.pipeline.records.draw_first_records`,
+    in sequence, its FFTs on the cores); the later chunks find them drawn and are the
+    model's and the records' statistics: floating_lidar_ti's 11 later chunks in 6.2 s
+    in sequence, 4.7 s on 2 threads (2 cores; 2.8 s compiled)."""
     chunks = list(chunks)
     while chunks:
         chunk = chunks.pop(0)
         yield chunk.index, run_chunk(scenario, plan, chunk, seed, choice, kernels_ready), None
-        if (choice.missing and len(chunks) > 1 and NUMPY_CHUNK_THREADS > 1
-                and "turbulence" not in scenario.settings):
+        if choice.missing and len(chunks) > 1 and NUMPY_CHUNK_THREADS > 1:
             yield from _in_threads(scenario, plan, chunks, seed, choice)
             return
 
