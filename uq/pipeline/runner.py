@@ -235,7 +235,7 @@ def _local(scenario, plan, chunks, seed, choice, kernels_ready=None):
     chunk draws every scene's records (:func:`uq.pipeline.records.draw_first_records`,
     in sequence, its FFTs on the cores); the later chunks find them drawn and are the
     model's and the records' statistics: floating_lidar_ti's 11 later chunks in 6.2 s
-    in sequence, 4.7 s on 2 threads (2 cores; 2.8 s compiled)."""
+    in sequence, 4.7 s on 2 threads (2 cores; the compiled model 3.5 s)."""
     chunks = list(chunks)
     while chunks:
         chunk = chunks.pop(0)
