@@ -179,3 +179,40 @@ def test_a_cold_then_a_warm_run_agree(tmp_path):
         assert cold.attrs["model"].startswith("numpy for 1 of 1 chunks")
         assert "model" not in warm.attrs
         _assert_agree(warm.load(), cold.load(), 5.0)     # the scenario's wind speed
+
+
+@pytest.mark.parametrize("name, changes, expected", [
+    ("rubio2022_case_i", {}, ("ins_trig", "geometry")),
+    ("nacelle_fixed", {}, ("ins_trig", "geometry_mounted")),          # lidar.mount.tilt 90
+])
+def test_a_run_loads_the_static_kernels_it_calls(name, changes, expected):
+    """``uq run`` loads ahead the real kernels of the geometry its scenes use (a tilted
+    mount's or the upward lidar's), so that a cache ``uq warmup --for`` filled holds
+    every kernel it asks for (it asked for the upward lidar's on a nacelle, found it
+    missing and started a background compile after a warmup)."""
+    from uq.cli.run import static_kernels
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.shipped import scenario_path
+    assert static_kernels(load_scenario(scenario_path(name), changes)) == expected
+
+
+def test_a_nacelle_run_calls_the_kernels_it_loads_ahead():
+    """The kernels a nacelle's run calls include the mounted geometry (and not the upward
+    lidar's): the real kernels a short run in this process asks for, recorded."""
+    from uq.pipeline.runner import run
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.shipped import scenario_path
+    from uq.physics import fusedkernels
+    called = []
+    real = fusedkernels.compiled(float)
+    original = type(real).__getitem__
+
+    def record(self, name):
+        called.append(name)
+        return original(self, name)
+    type(real).__getitem__ = record
+    try:
+        run(load_scenario(scenario_path("nacelle_fixed"), {"sampling.n": 64}))
+    finally:
+        type(real).__getitem__ = original
+    assert "geometry_mounted" in called and "geometry" not in called

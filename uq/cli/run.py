@@ -172,8 +172,21 @@ def _load_kernels(scenario):
         import uq.physics.fusedmotionkernels  # noqa: F401
         return
     from uq.physics import fusedkernels
-    for name in ("ins_trig", "geometry"):         # the complex kernels: a large GUM grid's
+    for name in static_kernels(scenario):         # the complex kernels: a large GUM grid's
         fusedkernels.compiled(float)[name]
+
+
+def static_kernels(scenario):
+    """The real kernels of the static model :func:`_load_kernels` loads: the INS's
+    trigonometry and the true beams' geometry, a tilted mount's (``geometry_mounted``)
+    where the file or its sweep tilts the mount, the upward lidar's where not (loading
+    one the run never calls would find it missing from a cache ``uq warmup --for``
+    filled, and start a needless background compile)."""
+    from uq.pipeline.mountsection import tilt_of
+    tilts = [tilt_of(scenario.settings["lidar"])] + list(
+        (scenario.settings.get("sweep") or {}).get("lidar.mount.tilt", []))
+    return ("ins_trig",) + tuple(sorted({"geometry_mounted" if float(tilt) else "geometry"
+                                         for tilt in tilts}))
 
 
 def check_scale_out(args):
