@@ -184,6 +184,9 @@ def test_a_cold_then_a_warm_run_agree(tmp_path):
 @pytest.mark.parametrize("name, changes, expected", [
     ("rubio2022_case_i", {}, ("ins_trig", "geometry")),
     ("nacelle_fixed", {}, ("ins_trig", "geometry_mounted")),          # lidar.mount.tilt 90
+    # a sweep over the tilt (upward and along the bow): both geometries
+    ("nacelle_fixed", {"sweep.lidar.mount.tilt": [0, 90], "outputs": ["wind_speed"]},
+     ("ins_trig", "geometry", "geometry_mounted")),
 ])
 def test_a_run_loads_the_static_kernels_it_calls(name, changes, expected):
     """``uq run`` loads ahead the real kernels of the geometry its scenes use (a tilted

@@ -181,10 +181,16 @@ def static_kernels(scenario):
     trigonometry and the true beams' geometry, a tilted mount's (``geometry_mounted``)
     where the file or its sweep tilts the mount, the upward lidar's where not (loading
     one the run never calls would find it missing from a cache ``uq warmup --for``
-    filled, and start a needless background compile)."""
+    filled, and start a needless background compile). The tilt of each of the sweep's
+    groups, as the runner assigns it (a linked key's included)."""
+    import itertools
     from uq.pipeline.mountsection import tilt_of
-    tilts = [tilt_of(scenario.settings["lidar"])] + list(
-        (scenario.settings.get("sweep") or {}).get("lidar.mount.tilt", []))
+    from uq.pipeline.sweep import group_assignments, sweep_plan
+    plan = sweep_plan(scenario)
+    tilt = tilt_of(scenario.settings["lidar"])
+    tilts = {group_assignments(scenario, plan, group).get("lidar.mount.tilt", tilt)
+             for group in itertools.product(*(range(len(values))
+                                              for values in plan.group_values))}
     return ("ins_trig",) + tuple(sorted({"geometry_mounted" if float(tilt) else "geometry"
                                          for tilt in tilts}))
 
