@@ -277,6 +277,29 @@ def test_the_performance_page_is_read_from_a_bench_file(tmp_path):
     assert "| `sweep_mc_over_draw_floor` | 2.25 | ≤ 2.5 | yes |" in page and "16 cores" in page
 
 
+def test_the_performance_page_tables_every_first_run(tmp_path):
+    """Each scenario's first run is a row of the bench's own figures, the largest
+    difference first; a repeated one shows its pairs' range; the row's figures are not
+    listed again below."""
+    figures = {"first_run_a_s": 4.0, "warm_run_a_s": 3.5, "first_run_a_over_warm_s": 0.5,
+               "first_run_a_pairs": 1, "first_run_a_over_warm_min_s": 0.5,
+               "first_run_a_over_warm_max_s": 0.5, "first_run_a_largest_difference": 1e-14,
+               "first_run_a_warm_compiled": 1,
+               "first_run_b_s": 30.0, "warm_run_b_s": 27.0, "first_run_b_over_warm_s": 3.0,
+               "first_run_b_pairs": 3, "first_run_b_over_warm_min_s": -1.0,
+               "first_run_b_over_warm_max_s": 9.0, "first_run_b_load": 0.4,
+               "first_run_worst_over_warm_s": 3.0}
+    path = tmp_path / "bench.json"
+    path.write_text(json.dumps({"figures": figures, "machine": "2 cores"}))
+    page = uqdocs.performance_page(path)
+    table = page[page.index("## First runs"):page.index("## Every other")]
+    rows = [line for line in table.splitlines() if line.startswith("| `")]
+    assert rows == ["| `b` | 30.0 | 27.0 | +3.0 | 3 (-1.0 to +9.0) | - | - |",
+                    "| `a` | 4.0 | 3.5 | +0.5 | 1 | 1e-14 | yes |"]
+    rest = page[page.index("## Every other"):]
+    assert "`first_run_b_load`" in rest and "`first_run_a_s`" not in rest
+
+
 def test_the_validation_page_names_tests_that_exist():
     text = (DOCS / "validation.md").read_text()
     named = set(re.findall(r"`(tests/[\w/]+\.py)`", text))

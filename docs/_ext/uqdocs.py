@@ -212,12 +212,59 @@ def performance_page(path):
         for scene, method, seconds, extrapolated in result.time_to_target:
             lines.append(f"| `{scene}` | `{method}` | {_number(seconds)} | "
                          f"{'yes' if extrapolated else 'no'} |")
-    others = sorted(set(result.figures) - set(TARGETS))
+    first_lines, shown = first_run_table(result.figures)
+    lines += first_lines
+    others = sorted(set(result.figures) - set(TARGETS) - shown)
     if others:
         lines += ["", "## Every other figure of the run", "",
                   "| figure | value |", "|---|---|"]
         lines += [f"| `{name}` | {_number(result.figures[name])} |" for name in others]
     return "\n".join(lines) + "\n"
+
+
+_FIRST_RUN = re.compile(r"first_run_(?P<name>\w+)_over_warm_s")
+
+
+def first_run_table(figures):
+    """(Markdown lines, the figures they show) of the first-run table: each shipped
+    scenario's first run with numba's cache empty against the same run with it filled
+    (:mod:`uq.bench.firstrun`), the largest difference first; no lines where the run did
+    not measure them."""
+    names = [m["name"] for m in map(_FIRST_RUN.fullmatch, figures)
+             if m and m["name"] != "worst"]
+    if not names:
+        return [], set()
+    from uq.bench.firstrun import PAIRS_OF_LONG_RUNS, REPEATED_RUN_S
+    names.sort(key=lambda name: -figures[f"first_run_{name}_over_warm_s"])
+    lines = ["", "## First runs", "",
+             "Each shipped scenario's command in a new process with numba's cache empty "
+             "(the numpy model runs while the kernels compile in the background), then, "
+             "once that compile has ended, the same command with the cache filled: wall "
+             f"times. A scenario whose warm run takes {REPEATED_RUN_S:g} s or more is "
+             f"measured in {PAIRS_OF_LONG_RUNS} such pairs; its row gives the medians and "
+             "the range of the differences. "
+             "\"Largest difference\" is the largest absolute difference of the wind "
+             "outputs' Monte Carlo statistics between the two runs (`uq run` files).", "",
+             "| scenario | cache empty [s] | cache filled [s] | over [s] | pairs (range [s]) "
+             "| largest difference | filled run compiled |", "|---|---|---|---|---|---|---|"]
+    shown = set()
+    for name in names:
+        keys = {key: f"first_run_{name}_{key}" for key in (
+            "s", "over_warm_s", "pairs", "over_warm_min_s", "over_warm_max_s",
+            "largest_difference", "warm_compiled")}
+        keys["warm"] = f"warm_run_{name}_s"
+        value = {key: figures.get(figure) for key, figure in keys.items()}
+        pairs = int(value["pairs"] or 1)
+        spread = (f"{pairs} ({value['over_warm_min_s']:+.1f} to "
+                  f"{value['over_warm_max_s']:+.1f})" if pairs > 1 else "1")
+        compiled = {None: "-", 1.0: "yes", 0.0: "**no**"}[value["warm_compiled"]]
+        lines.append(f"| `{name}` | {value['s']:.1f} | {value['warm']:.1f} | "
+                     f"{value['over_warm_s']:+.1f} | {spread} | "
+                     f"{_number(value['largest_difference'])} | {compiled} |")
+        shown.update(figure for key, figure in keys.items()
+                     if key in ("s", "warm", "over_warm_s", "pairs", "over_warm_min_s",
+                                "over_warm_max_s", "largest_difference", "warm_compiled"))
+    return lines, shown
 
 
 # --- Sphinx -----------------------------------------------------------------------------

@@ -221,6 +221,42 @@ def test_the_first_run_figures_name_the_worst(monkeypatch):
     assert figures["first_run_worst_over_warm_s"] == 4.0
     assert figures["first_run_worst_name"] == "b"
     assert figures["first_run_a_warm_compiled"] == 1
+    assert figures["first_run_a_pairs"] == figures["first_run_b_pairs"] == 1   # short runs
+
+
+def test_a_long_first_run_is_the_median_of_its_pairs(monkeypatch):
+    """A scenario whose warm run takes REPEATED_RUN_S or more is measured in
+    PAIRS_OF_LONG_RUNS pairs and reported as the median difference, the spread beside it;
+    whether it is repeated depends on its length, not on the difference (a short run
+    over the target is measured once)."""
+    from uq.bench import firstrun
+    long_run = firstrun.REPEATED_RUN_S + 10.0
+    script = {"long": iter([(long_run + 9.0, long_run), (long_run + 1.0, long_run + 2.0),
+                            (long_run + 3.0, long_run)]),
+              "short": iter([(8.0, 1.0)])}
+    calls = []
+
+    def fake(name):
+        calls.append(name)
+        cold, warm = next(script[name])
+        return {"cold_s": cold, "warm_s": warm, "over_warm_s": cold - warm,
+                "cold_load": 0.1, "background_after_s": 9.0,
+                "background_after_warm_s": 0.0, "warm_compiled": name == "short",
+                "largest_difference": {"long": 2e-15, "short": 1e-15}[name]}
+    monkeypatch.setattr(firstrun, "first_run", fake)
+    figures = firstrun.measure(["long", "short"])
+    assert calls == ["long"] * firstrun.PAIRS_OF_LONG_RUNS + ["short"]
+    assert firstrun.PAIRS_OF_LONG_RUNS == 3          # the script above has three pairs
+    assert figures["first_run_long_pairs"] == 3
+    assert figures["first_run_long_over_warm_s"] == 3.0        # median of 9, -1, 3
+    assert (figures["first_run_long_over_warm_min_s"],
+            figures["first_run_long_over_warm_max_s"]) == (-1.0, 9.0)
+    assert figures["warm_run_long_s"] == long_run               # median of the warm runs
+    assert figures["first_run_long_warm_compiled"] == 0          # not every warm run
+    assert figures["first_run_long_largest_difference"] == 2e-15
+    assert figures["first_run_short_pairs"] == 1
+    assert figures["first_run_worst_name"] == "short"           # 7 s over, one pair
+    assert figures["first_run_worst_over_warm_s"] == 7.0
 
 
 def test_scale_out_is_bit_identical_to_one_process():
