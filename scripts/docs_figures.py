@@ -20,6 +20,7 @@ speed table (``--only speed``: that table alone, from the file as it is).
 import argparse
 import hashlib
 import json
+import math
 import os
 import platform
 import re
@@ -160,20 +161,51 @@ def table_nacelle(folder):
     return "\n".join(lines)
 
 
-def table_profile(folder):
-    """uq fit of floating_lidar_profile: 95 % credible intervals, propagated and naive."""
+def _profile_cells(folder):
+    """The profile table's rows: (label, [(low, high, low's MCSE, high's MCSE) per fit],
+    truth or None) of ``uq fit``'s result in `folder`."""
     ds = _open(folder, "f_fit.nc")
-    lines = [_row("95 % interval", "propagated", "naive", "truth"), _row("---", "---", "---", "---")]
+    rows = []
     for parameter, label in (("reference_speed", "U_ref [m/s]"), ("shear", "shear")):
         cells = []
         for fit in ("propagated", "naive"):
             at = ds.sel(fit=fit, parameter=parameter)
-            cells.append(f"[{float(at['posterior_low95']):.3f}, "
-                         f"{float(at['posterior_high95']):.3f}]")
+            cells.append(tuple(float(at[name]) for name in (
+                "posterior_low95", "posterior_high95", "posterior_low95_mcse",
+                "posterior_high95_mcse")))
         truth = ds.sel(parameter=parameter)["true_value"] if "true_value" in ds else None
-        lines.append(_row(label, *cells, f"{float(truth.values.ravel()[0]):g}"
-                          if truth is not None else "-"))
+        rows.append((label, cells, None if truth is None else float(truth.values.ravel()[0])))
+    return rows
+
+
+def table_profile(folder):
+    """uq fit of floating_lidar_profile: 95 % credible intervals, propagated and naive."""
+    lines = [_row("95 % interval", "propagated", "naive", "truth"), _row("---", "---", "---", "---")]
+    for label, cells, truth in _profile_cells(folder):
+        lines.append(_row(label, *(f"[{low:.3f}, {high:.3f}]" for low, high, *_ in cells),
+                          "-" if truth is None else f"{truth:g}"))
     return "\n".join(lines)
+
+
+#: Standard errors between two chains' quantiles before the profile table's numbers
+#: count as different: 4 (a false alarm once in ~16,000 numbers for a normal error).
+MCSE_SIGMAS = 4.0
+
+
+def tolerances_profile(folder):
+    """The absolute tolerance of each number of :func:`table_profile`, in its order: an
+    interval's end is a quantile of a finite chain whose bits depend on the machine's
+    floating point (another CPU's libm draws another chain), so two runs' ends differ
+    by the chains' Monte Carlo error, ``MCSE_SIGMAS * sqrt(2) * MCSE`` (two independent
+    chains), and one unit of the written last digit; None (the header's 95, the truth):
+    the written digits."""
+    out = [None]                                                      # "95 % interval"
+    for _, cells, truth in _profile_cells(folder):
+        for _, _, low_error, high_error in cells:
+            out += [MCSE_SIGMAS * math.sqrt(2.0) * error + 1.01e-3
+                    for error in (low_error, high_error)]
+        out += [] if truth is None else [None]
+    return out
 
 
 def table_golden(folder):
@@ -271,6 +303,10 @@ def table_speed(path=BENCH_FILE):
              "figure on the [performance](docs/performance.md) page)"]
     return "\n".join(lines)
 
+
+#: README table name -> the absolute tolerance of each of its numbers, where it is not
+#: one unit of the written last digit (a Markov chain's quantiles)
+TOLERANCES = {"profile_fit": tolerances_profile}
 
 #: README table name -> (runs it needs, the function that renders it)
 TABLES = {
