@@ -585,6 +585,17 @@ RECORD_FFT_WORKERS = 2
 #: compile; with fewer it waits for the run to end (beside it, it slowed the run by
 #: 20-30 % on 2 cores and ended after it).
 BACKGROUND_BESIDE_MIN_CPUS = 5
+#: Estimated CPU time of a run's model [s] (uq.pipeline.estimate.RunSize.model_seconds:
+#: its trials and scenes, not its start or records) from which the background compile
+#: runs beside the run on any number of CPUs (uq.cli.firstrun.compile_beside): a long
+#: first run then takes the compiled model once it is cached, instead of the numpy model
+#: throughout. Measured on an idle 2-core machine, `uq run rubio2022_misalignment` with
+#: an empty cache, waiting for the run to end against beside it: sampling.n = 50,000
+#: (estimated 26 s) 29.4 against 32.7 s (19.1 s warm); 75,000 (39 s) 41.9 against
+#: 35.9 s (18.9 s warm); 120,000 (62 s) 61.2 against 41.5 s (25.8 s warm); 200,000
+#: (104 s) 98.8 against 43.0 s (27.7 s warm): the two cross near 30 s. The shipped
+#: files' models are estimated at 9 s at most.
+BACKGROUND_BESIDE_MIN_MODEL_CPU_S = 30.0
 
 #: Cell averaging of the Mann tensor near the k1 axis (turbulencebox.cell_averaged_factors)
 #: [1]: cells with |k1| <= CELL_AVERAGE_K1 max(dk2, dk3), beyond which the tensor varies

@@ -130,6 +130,51 @@ def test_the_compile_runs_beside_the_run_only_with_a_core_to_spare(monkeypatch, 
     assert firstrun.compile_beside() is beside
 
 
+@pytest.mark.parametrize("model_seconds, beside", [(0.0, False), (29.9, False),
+                                                   (30.0, True), (float("nan"), False)])
+def test_a_long_run_compiles_beside_itself_on_two_cores(monkeypatch, model_seconds, beside):
+    """On 2 CPUs a run whose model is estimated at BACKGROUND_BESIDE_MIN_MODEL_CPU_S or
+    more has the compile beside it (no run's pid for the child to wait for); a shorter
+    one, or one not estimated (NaN), has it wait."""
+    from uq.constants import BACKGROUND_BESIDE_MIN_MODEL_CPU_S
+    assert BACKGROUND_BESIDE_MIN_MODEL_CPU_S == 30.0          # the cases above
+    monkeypatch.setattr("uq.cpus.usable_cpus", lambda: 2)
+    assert firstrun.compile_beside(model_seconds) is beside
+    monkeypatch.setattr(firstrun, "_take_lock", lambda: os.open(os.devnull, os.O_RDONLY))
+    commands = []
+    monkeypatch.setattr(firstrun.subprocess, "Popen",
+                        lambda command, **kwargs: commands.append(command))
+    firstrun.BackgroundCompile([{"name": "x"}], model_seconds)
+    os.unlink(commands[0][3])                                  # the settings' file
+    assert commands[0][5:] == ([] if beside else [str(os.getpid())])
+
+
+@pytest.mark.parametrize("n, long", [(10_000, False), (100_000, True)])
+def test_uq_run_gives_the_compile_its_models_estimate(monkeypatch, tmp_path, n, long):
+    """uq run hands its scenario's estimated model CPU (uq check's estimate, without the
+    start and records) to the background compile: rubio2022_misalignment as shipped
+    (10^4 trials a scene, 5 s) has it wait on 2 CPUs, at 10^5 trials (52 s) beside."""
+    from uq.pipeline.estimate import run_size
+    from uq.pipeline.scenario import load_scenario
+    from uq.pipeline.shipped import scenario_path
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def background(args, settings, agreement="", model_seconds=0.0):
+        seen.append(model_seconds)
+        raise Stop
+    monkeypatch.setattr(firstrun, "Background", background)
+    with pytest.raises(Stop):
+        main(["run", "rubio2022_misalignment", "-q", "--set", f"sampling.n={n}",
+              "-o", str(tmp_path / "m.nc")])
+    scenario = load_scenario(scenario_path("rubio2022_misalignment"), {"sampling.n": n})
+    assert seen == [run_size(scenario).model_seconds()]
+    monkeypatch.setattr("uq.cpus.usable_cpus", lambda: 2)
+    assert firstrun.compile_beside(seen[0]) is long
+
+
 def test_turned_off_the_run_compiles_itself(tmp_path, monkeypatch):
     """UQ_BACKGROUND_COMPILE=0 (the suite's setting): --model auto is --model compiled,
     no background process."""

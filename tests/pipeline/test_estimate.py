@@ -74,6 +74,20 @@ def test_record_mode_counts_records_and_kaimal_is_not_estimated():
     assert math.isnan(kaimal.seconds[0]) and "not estimated" in kaimal.estimate()
 
 
+def test_the_model_seconds_leave_out_the_start_and_the_records():
+    """What decides whether a first run's compile runs beside it (uq.cli.firstrun):
+    the trials' and scenes' parts, not the command's start or the records."""
+    plain = size()
+    assert plain.model_seconds() == pytest.approx(
+        part(plain, "static model") + part(plain, "per scene"))
+    assert plain.model_seconds() == pytest.approx(plain.seconds[0] - COSTS["fixed"])
+    records = size(**{"turbulence": {"intensity": 0.1},
+                      "record": {"duration": 600, "count": 4}, "sweep": {}})
+    assert records.model_seconds() == pytest.approx(
+        records.seconds[0] - COSTS["fixed"] - part(records, "records"))
+    assert records.model_seconds() < part(records, "records") / 100
+
+
 def test_the_estimate_runs_no_model(monkeypatch):
     """Nothing of the model is called (the engine and the runner are replaced by
     functions that fail)."""

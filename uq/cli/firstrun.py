@@ -90,15 +90,16 @@ class Background:
         How the numpy model's numbers compare with the compiled one's (said).
     """
 
-    def __init__(self, args, settings, agreement="the same numbers to 1e-12"):
+    def __init__(self, args, settings, agreement="the same numbers to 1e-12",
+                 model_seconds=0.0):
         self.args, self.settings, self.compile = args, settings, None
-        self.agreement = agreement
+        self.agreement, self.model_seconds = agreement, model_seconds
 
     def start(self, missing=None):
         """Start the compile (once) and say so on stderr; returns its ``ended``
         (whether to try the compiled model again)."""
         if self.compile is None:
-            self.compile = BackgroundCompile(self.settings)
+            self.compile = BackgroundCompile(self.settings, self.model_seconds)
             whose = (f"process {self.compile.pid}" if self.compile.pid else
                      "another uq's process")
             if not getattr(self.args, "quiet", False):     # a notice, as "compiling"
@@ -125,7 +126,7 @@ class BackgroundCompile:
         cache).
     """
 
-    def __init__(self, settings):
+    def __init__(self, settings, model_seconds=0.0):
         self.child = None
         lock = _take_lock()
         if lock is None:
@@ -138,7 +139,7 @@ class BackgroundCompile:
             # its own session (a Ctrl-C at the terminal is the run's, not its); nothing
             # of it on the terminal; the lock's descriptor inherited: it holds the lock
             # until it ends (the run may end first)
-            after = [] if compile_beside() else [str(os.getpid())]
+            after = [] if compile_beside(model_seconds) else [str(os.getpid())]
             self.child = subprocess.Popen(
                 [sys.executable, "-m", "uq.cli.firstrun", path, str(lock)] + after,
                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
@@ -176,18 +177,22 @@ def lower_priority():
         pass
 
 
-def compile_beside():
-    """Whether the background compile may run beside the run that started it: only
-    where a core is left to it (more usable CPUs than the
+def compile_beside(model_seconds=0.0):
+    """Whether the background compile may run beside the run that started it: where a
+    core is left to it (more usable CPUs than the
     :data:`~uq.pipeline.runner.NUMPY_CHUNK_THREADS` a run's numpy chunks take, or the
-    two threads of a record's FFTs). Else it compiles a record's kernels (which the
-    run takes as soon as they are in the cache) and waits for the run to end before the
-    rest: measured on 2 cores, a compile beside the run, even at the idle class, slowed
-    it by 20-30 % (the first run of rubio2022_tilt 17.4 s against 10.3 s after it) and
-    never ended before it, so no chunk took the compiled model."""
-    from uq.constants import BACKGROUND_BESIDE_MIN_CPUS
+    two threads of a record's FFTs), or where the run's model is estimated at
+    `model_seconds` [s] of CPU or more, :data:`~uq.constants.
+    BACKGROUND_BESIDE_MIN_MODEL_CPU_S` (its later chunks then take the compiled model).
+    Else it compiles a record's kernels (which the run takes as soon as they are in the
+    cache) and waits for the run to end before the rest: measured on 2 cores, a compile
+    beside a short run, even at the idle class, slowed it by 20-30 % (the first run of
+    rubio2022_tilt 17.4 s against 10.3 s after it) and ended after it, so no chunk took
+    the compiled model."""
+    from uq.constants import BACKGROUND_BESIDE_MIN_CPUS, BACKGROUND_BESIDE_MIN_MODEL_CPU_S
     from uq.cpus import usable_cpus
-    return usable_cpus() >= BACKGROUND_BESIDE_MIN_CPUS
+    return (usable_cpus() >= BACKGROUND_BESIDE_MIN_CPUS
+            or model_seconds >= BACKGROUND_BESIDE_MIN_MODEL_CPU_S)
 
 
 def _wait_for_exit(pid):

@@ -77,7 +77,9 @@ def command(args):
     compiling = getattr(args, "compile_notice", None)
     if args.model == "auto" and not firstrun.wanted(args):
         args.model = "compiled"              # compiles what it calls first (module doc)
-    background = firstrun.Background(args, [scenario.settings])
+    from uq.pipeline.estimate import run_size
+    background = firstrun.Background(args, [scenario.settings],
+                                     model_seconds=run_size(scenario).model_seconds())
     load_kernels(args, scenario, background)
     before_run = compiling.seconds if compiling else 0.0     # compiled before the run
     new_folders = missing_folders(output.parent)

@@ -24,8 +24,8 @@ machine with numba's cache warm:
 
 The estimate is CPU time: a run on an idle machine takes about as long on the clock, a
 busy one longer; the first run after an install runs the numpy model while its kernels
-compile in the background (``uq run --model auto``, :data:`NUMPY_FACTOR`). It is meant to tell a run of seconds from one of minutes or
-hours, within a factor of ~2.
+compile in the background (``uq run --model auto``, :data:`FIRST_RUN_FACTOR`). It is
+meant to tell a run of seconds from one of minutes or hours, within a factor of ~2.
 """
 import math
 from dataclasses import dataclass
@@ -45,10 +45,13 @@ COSTS = {
     "record": 4.7e-3,        # per record and second of it (sathe2011_ti, Mann, pulsed)
     "fixed": 1.9,            # the command's start and imports (README: 1.87 s)
 }
-#: The numpy model's CPU time over the compiled model's on the shipped scenarios [1]: what
-#: a first run after an install costs more, while its kernels compile in the background
-#: (measured by ``uq bench``'s first-run figures; ``uq warmup`` compiles them ahead).
-NUMPY_FACTOR = (1, 4)
+#: A first run's wall time over the same run's with numba's cache filled, at most [1]:
+#: measured on an idle 2-core machine, 1.5x on the shipped scenarios
+#: (floating_lidar_waves 4.4 s against 3.0 s, in uq bench) and 1.5-1.9x on
+#: rubio2022_misalignment at 5 x 10^4 to 2 x 10^5 trials a scene (1.9x at 7.5 x 10^4,
+#: where the compile ends a third of the way into the run; uq.constants.
+#: BACKGROUND_BESIDE_MIN_MODEL_CPU_S).
+FIRST_RUN_FACTOR = 2
 #: Fewest RNG blocks adaptive sampling draws before its stopping rule can be met.
 ADAPTIVE_MIN_BLOCKS = 2
 
@@ -82,6 +85,12 @@ class RunSize:
     seconds: tuple
     parts: tuple
 
+    def model_seconds(self):
+        """Estimated CPU seconds of the run's model at the fewest trials: its parts but
+        the command's start (``fixed``) and the records' boxes and statistics."""
+        return sum(seconds for name, seconds in self.parts
+                   if name not in ("fixed", "records"))
+
     def describe(self):
         """The size in words: ``36 scenes x 100000 trials, 1 gate``."""
         low, high = self.trials
@@ -112,8 +121,8 @@ class RunSize:
                           if seconds >= 0.05 * max(s for _, s in self.parts))
         return (f"from calibrated per-trial costs, not by running the model ({parts}; "
                 f"2-core machine; a busy machine takes longer, and the first run after an "
-                f"install up to {NUMPY_FACTOR[1]}x longer: the numpy model runs until a background "
-                "process has compiled the kernels)")
+                f"install up to {FIRST_RUN_FACTOR:g}x longer: the numpy model runs until a "
+                "background process has compiled the kernels)")
 
 
 def _duration(seconds):
