@@ -35,7 +35,7 @@ def test_a_missing_kernel_simulates_with_numpy_and_compiles_beside(tmp_path, mon
     class Fake:
         pid = 4321
 
-        def __init__(self, settings):
+        def __init__(self, settings, model_seconds=0.0):
             started.append([s["name"] for s in settings])
 
         def ended(self):
